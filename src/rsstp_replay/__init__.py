@@ -1,0 +1,1 @@
+"""RSSTP replay: read recordings, reconstruct memory and model, audit, export, view."""

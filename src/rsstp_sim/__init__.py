@@ -1,0 +1,1 @@
+"""RSSTP simulator: a 2D multi-joint arm, its internal model, memory and strategies."""

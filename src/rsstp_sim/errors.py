@@ -1,0 +1,41 @@
+"""The simulator's exception hierarchy: one root, one subclass per condition."""
+
+from __future__ import annotations
+
+__all__ = [
+    "RsstpError",
+    "ScenarioError",
+    "ModelError",
+    "MemoryRangeError",
+    "StrategyError",
+    "GraphvizMissing",
+    "RecordingError",
+]
+
+
+class RsstpError(Exception):
+    """Root of every error this project raises on purpose."""
+
+
+class ScenarioError(RsstpError):
+    """A scenario file or built-in name is invalid; the message names file, key path and problem."""
+
+
+class ModelError(RsstpError):
+    """An operation on a transition system refers to a state or action it does not have."""
+
+
+class MemoryRangeError(RsstpError):
+    """A memory index (for example in ``compare``) is out of range or otherwise invalid."""
+
+
+class StrategyError(RsstpError):
+    """A strategy name is unknown, its parameters are invalid, or it returned an invalid action."""
+
+
+class GraphvizMissing(RsstpError):
+    """The Graphviz ``dot`` program is needed for SVG/PNG output and was not found."""
+
+
+class RecordingError(RsstpError):
+    """A recording cannot be written (existing output, unwritable directory, ...)."""
