@@ -10,6 +10,7 @@ __all__ = [
     "StrategyError",
     "GraphvizMissing",
     "RecordingError",
+    "ActionError",
 ]
 
 
@@ -39,3 +40,7 @@ class GraphvizMissing(RsstpError):
 
 class RecordingError(RsstpError):
     """A recording cannot be written (existing output, unwritable directory, ...)."""
+
+
+class ActionError(RsstpError):
+    """An action is not one of the scenario's actions."""

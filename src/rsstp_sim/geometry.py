@@ -1,0 +1,387 @@
+"""Pure numpy geometry of the arm: kinematics, blocked moves, feedback, distances.
+
+Everything here is vectorised over a batch of poses so that the world (one
+pose at a time, cached) and the ground-truth enumeration (whole frontiers at
+once) share one implementation.
+
+Conventions (``../shared/DESIGN.md`` section 1): joint angles are integer
+degrees in ``[0, 360)``; angle ``i`` is relative to link ``i-1`` (the first to
+the +x axis); the base is at the origin; coordinates are float64. Positions
+arrays have ``n + 1`` rows: the base, then the tip of every link.
+
+Swept collision is exact: turning joint ``k`` rotates links ``k..n-1`` rigidly
+about joint ``k``. A moving link meets a disk during the turn exactly when the
+disk's centre, turned the opposite way, comes within the radius of the link's
+start position: the minimum distance between an *arc* and a *segment*. Two
+segments that start apart first touch with an endpoint of one on the other,
+so moving-versus-fixed link contacts reduce to the same arc-segment test.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Literal, Protocol
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+__all__ = [
+    "ArmGeometry",
+    "Blocker",
+    "COS_DEG",
+    "SIN_DEG",
+    "arc_segment_distance",
+    "feedback",
+    "joint_positions",
+    "move_blockers",
+    "obstacle_distances",
+    "point_segment_distance",
+    "pose_blocker",
+    "pose_blockers",
+    "segment_distance",
+]
+
+FloatArray = NDArray[np.float64]
+IntArray = NDArray[np.int64]
+
+
+def _trig_tables() -> tuple[FloatArray, FloatArray]:
+    radians = np.deg2rad(np.arange(360, dtype=np.float64))
+    cos, sin = np.cos(radians), np.sin(radians)
+    # Exact values where they exist, so poses on the axes compare exactly.
+    cos[[90, 270]] = 0.0
+    sin[[0, 180]] = 0.0
+    cos[180], sin[270] = -1.0, -1.0
+    cos.flags.writeable = False
+    sin.flags.writeable = False
+    return cos, sin
+
+
+COS_DEG, SIN_DEG = _trig_tables()
+"""Cosine and sine of every integer degree 0..359 (exact on the axes)."""
+
+_TWO_PI = 2.0 * np.pi
+_ANGLE_SLACK = 1e-12
+CONTACT_EPS = 1e-9
+"""Contacts closer than this fraction of the total arm length count as touching."""
+
+
+def joint_positions(angles_deg: ArrayLike, lengths: ArrayLike) -> FloatArray:
+    """Positions of the base and of every link tip, shape ``(..., n + 1, 2)``.
+
+    ``p_k = sum_{i<=k} L_i (cos phi_i, sin phi_i)`` with ``phi_i = sum_{j<=i} theta_j``.
+    """
+    theta = np.asarray(angles_deg, dtype=np.int64)
+    lengths_arr = np.asarray(lengths, dtype=np.float64)
+    phi = np.cumsum(theta, axis=-1) % 360
+    steps = np.stack([COS_DEG[phi], SIN_DEG[phi]], axis=-1) * lengths_arr[:, None]
+    zeros = np.zeros((*theta.shape[:-1], 1, 2), dtype=np.float64)
+    return np.concatenate([zeros, np.cumsum(steps, axis=-2)], axis=-2)
+
+
+def point_segment_distance(x: ArrayLike, a: ArrayLike, b: ArrayLike) -> FloatArray:
+    """Distance from points ``x`` to segments ``a``-``b`` (broadcast over leading axes)."""
+    x_, a_, b_ = (np.asarray(v, dtype=np.float64) for v in (x, a, b))
+    ab = b_ - a_
+    denom = np.einsum("...i,...i->...", ab, ab)
+    t = np.einsum("...i,...i->...", x_ - a_, ab) / np.where(denom > 0, denom, 1.0)
+    t = np.clip(t, 0.0, 1.0)
+    foot = a_ + t[..., None] * ab
+    return np.asarray(np.hypot(*np.moveaxis(x_ - foot, -1, 0)), dtype=np.float64)
+
+
+def _cross(u: FloatArray, v: FloatArray) -> FloatArray:
+    return np.asarray(u[..., 0] * v[..., 1] - u[..., 1] * v[..., 0], dtype=np.float64)
+
+
+def segment_distance(a: ArrayLike, b: ArrayLike, c: ArrayLike, d: ArrayLike) -> FloatArray:
+    """Distance between segments ``a``-``b`` and ``c``-``d``; 0 when they cross or touch."""
+    a_, b_, c_, d_ = (np.asarray(v, dtype=np.float64) for v in (a, b, c, d))
+    o1, o2 = _cross(b_ - a_, c_ - a_), _cross(b_ - a_, d_ - a_)
+    o3, o4 = _cross(d_ - c_, a_ - c_), _cross(d_ - c_, b_ - c_)
+    crossing = (o1 * o2 < 0) & (o3 * o4 < 0)
+    ends = np.minimum(
+        np.minimum(point_segment_distance(a_, c_, d_), point_segment_distance(b_, c_, d_)),
+        np.minimum(point_segment_distance(c_, a_, b_), point_segment_distance(d_, a_, b_)),
+    )
+    return np.where(crossing, 0.0, ends)
+
+
+def _in_arc(direction: FloatArray, start: FloatArray, delta: FloatArray) -> NDArray[np.bool_]:
+    """Whether angles ``direction`` lie on the arc from ``start`` turning by signed ``delta``."""
+    rel = np.where(delta >= 0, direction - start, start - direction) % _TWO_PI
+    return np.asarray(rel <= np.abs(delta) + _ANGLE_SLACK)
+
+
+def arc_segment_distance(
+    pivot: ArrayLike, point: ArrayLike, delta_rad: ArrayLike, a: ArrayLike, b: ArrayLike
+) -> FloatArray:
+    """Minimum distance between segment ``a``-``b`` and the arc that ``point`` traces
+    when turned about ``pivot`` by every angle between 0 and ``delta_rad`` (signed, CCW > 0).
+
+    Exact: the minimum is attained at an arc end, a segment end, a crossing of
+    the segment's line with the circle, or a point of the circle whose normal is
+    the line's normal; every candidate inside the arc is measured.
+    """
+    p, q, a_, b_ = (np.asarray(v, dtype=np.float64) for v in (pivot, point, a, b))
+    delta = np.asarray(delta_rad, dtype=np.float64)
+    p, q, a_, b_ = np.broadcast_arrays(p, q, a_, b_)
+    delta = np.broadcast_to(delta, p.shape[:-1])
+
+    v = q - p
+    rho = np.hypot(v[..., 0], v[..., 1])
+    start = np.arctan2(v[..., 1], v[..., 0])
+    cos_d, sin_d = np.cos(delta), np.sin(delta)
+    q_end = p + np.stack([v[..., 0] * cos_d - v[..., 1] * sin_d,
+                          v[..., 0] * sin_d + v[..., 1] * cos_d], axis=-1)
+
+    best = np.minimum(point_segment_distance(q, a_, b_), point_segment_distance(q_end, a_, b_))
+
+    # Segment ends against the arc.
+    for end in (a_, b_):
+        w = end - p
+        r_end = np.hypot(w[..., 0], w[..., 1])
+        inside = _in_arc(np.arctan2(w[..., 1], w[..., 0]), start, delta)
+        to_ends = np.minimum(np.hypot(*np.moveaxis(end - q, -1, 0)),
+                             np.hypot(*np.moveaxis(end - q_end, -1, 0)))
+        best = np.minimum(best, np.where(inside, np.abs(r_end - rho), to_ends))
+
+    # Interior candidates on the circle, relative to the segment's line.
+    ab = b_ - a_
+    ab_len2 = np.einsum("...i,...i->...", ab, ab)
+    t = np.einsum("...i,...i->...", p - a_, ab) / ab_len2
+    foot = a_ + t[..., None] * ab
+    to_foot = foot - p
+    h = np.hypot(to_foot[..., 0], to_foot[..., 1])
+    unit_ab = ab / np.sqrt(ab_len2)[..., None]
+    safe_h = np.where(h > 0, h, 1.0)[..., None]
+    normal = to_foot / safe_h
+    half_chord = np.sqrt(np.maximum(rho * rho - h * h, 0.0))
+    crosses = rho >= h
+    candidates = (
+        (p + rho[..., None] * normal, h > 0),
+        (p - rho[..., None] * normal, h > 0),
+        (foot + half_chord[..., None] * unit_ab, crosses),
+        (foot - half_chord[..., None] * unit_ab, crosses),
+    )
+    for x, valid in candidates:
+        w = x - p
+        inside = valid & _in_arc(np.arctan2(w[..., 1], w[..., 0]), start, delta)
+        best = np.where(inside, np.minimum(best, point_segment_distance(x, a_, b_)), best)
+    return np.asarray(best, dtype=np.float64)
+
+
+BlockerKind = Literal["fold", "obstacle", "links"]
+
+
+@dataclass(frozen=True, slots=True)
+class Blocker:
+    """Why a move was blocked.
+
+    ``fold``: ``indices == (joint,)``, the joint whose relative angle would reach 180.
+    ``obstacle``: ``indices == (link, obstacle)``.
+    ``links``: ``indices == (link_i, link_j)`` with ``link_i < link_j - 1``.
+    """
+
+    kind: BlockerKind
+    indices: tuple[int, ...]
+
+    def describe(self) -> str:
+        if self.kind == "fold":
+            return f"joint {self.indices[0]} would fold back onto link {self.indices[0] - 1}"
+        if self.kind == "obstacle":
+            return f"link {self.indices[0]} meets obstacle {self.indices[1]}"
+        return f"links {self.indices[0]} and {self.indices[1]} intersect"
+
+
+class _ScenarioLike(Protocol):
+    @property
+    def lengths(self) -> Sequence[float]: ...
+    @property
+    def obstacles(self) -> Sequence[object]: ...
+    @property
+    def collision(self) -> str: ...
+
+
+@dataclass(frozen=True)
+class ArmGeometry:
+    """The numeric view of a scenario that the geometry functions need.
+
+    Blocker codes (one int per move, 0 = free) are laid out as: ``k`` for a fold
+    at joint ``k`` (1..n-1), then ``n + i*m + j`` for link ``i`` meeting
+    obstacle ``j``, then ``n + n*m + i*n + j`` for links ``i < j``.
+    """
+
+    lengths: FloatArray
+    centers: FloatArray
+    radii: FloatArray
+    swept: bool
+    eps: float
+
+    @classmethod
+    def from_scenario(cls, scenario: _ScenarioLike) -> ArmGeometry:
+        lengths = np.asarray(scenario.lengths, dtype=np.float64)
+        centers = np.array([o.center for o in scenario.obstacles],  # type: ignore[attr-defined]
+                           dtype=np.float64).reshape(-1, 2)
+        radii = np.array([o.radius for o in scenario.obstacles],  # type: ignore[attr-defined]
+                         dtype=np.float64)
+        return cls(lengths, centers, radii, scenario.collision == "swept",
+                   CONTACT_EPS * float(lengths.sum()))
+
+    @property
+    def n(self) -> int:
+        return int(self.lengths.shape[0])
+
+    @property
+    def m(self) -> int:
+        return int(self.radii.shape[0])
+
+    def decode(self, code: int) -> Blocker | None:
+        n, m = self.n, self.m
+        if code == 0:
+            return None
+        if code < n:
+            return Blocker("fold", (code,))
+        code -= n
+        if code < n * m:
+            return Blocker("obstacle", divmod(code, m))
+        return Blocker("links", divmod(code - n * m, n))
+
+    def _pairs(self) -> tuple[IntArray, IntArray]:
+        i, j = np.triu_indices(self.n, k=2)
+        return i.astype(np.int64), j.astype(np.int64)
+
+
+def _first_codes(
+    geo: ArmGeometry,
+    fold: NDArray[np.bool_],
+    obstacle: NDArray[np.bool_],
+    links: NDArray[np.bool_],
+    fold_joint: IntArray,
+) -> IntArray:
+    """Combine per-category hits into one blocker code per row (fold, obstacle, links)."""
+    n, m = geo.n, geo.m
+    batch = fold.shape[0]
+    codes = np.zeros(batch, dtype=np.int64)
+    pi, pj = geo._pairs()
+    if pi.size:
+        hit = links.any(axis=1)
+        first = np.argmax(links, axis=1)
+        codes = np.where(hit, n + n * m + pi[first] * n + pj[first], codes)
+    if m:
+        flat = obstacle.reshape(batch, n * m)
+        hit = flat.any(axis=1)
+        codes = np.where(hit, n + np.argmax(flat, axis=1), codes)
+    return np.where(fold, fold_joint, codes)
+
+
+def pose_blockers(geo: ArmGeometry, angles_deg: ArrayLike) -> IntArray:
+    """Static validity of a batch of poses ``(B, n)``: blocker code per pose (0 = valid)."""
+    theta = np.atleast_2d(np.asarray(angles_deg, dtype=np.int64))
+    pos = joint_positions(theta, geo.lengths)
+    a, b = pos[:, :-1], pos[:, 1:]
+    folded = theta[:, 1:] == 180
+    fold = folded.any(axis=1)
+    fold_joint = np.argmax(folded, axis=1) + 1 if geo.n > 1 else np.zeros(len(theta), np.int64)
+    obstacle = (
+        point_segment_distance(geo.centers[None, None], a[:, :, None], b[:, :, None])
+        <= geo.radii + geo.eps
+    )
+    pi, pj = geo._pairs()
+    links = segment_distance(a[:, pi], b[:, pi], a[:, pj], b[:, pj]) <= geo.eps
+    return _first_codes(geo, fold, obstacle, links, fold_joint)
+
+
+def pose_blocker(scenario: _ScenarioLike, angles_deg: Sequence[int]) -> Blocker | None:
+    """Why a single pose is invalid, or None when it is valid."""
+    geo = ArmGeometry.from_scenario(scenario)
+    return geo.decode(int(pose_blockers(geo, [list(angles_deg)])[0]))
+
+
+def move_blockers(geo: ArmGeometry, angles_deg: ArrayLike, joints: ArrayLike,
+                  delta_deg: ArrayLike) -> IntArray:
+    """Blocker code for turning ``joints[b]`` by ``delta_deg[b]`` from pose ``angles_deg[b]``.
+
+    The start poses must be valid. Swept mode checks the whole motion; endpoint
+    mode (the thesis behaviour) only the end pose.
+    """
+    theta = np.atleast_2d(np.asarray(angles_deg, dtype=np.int64))
+    batch, n = theta.shape
+    joint = np.broadcast_to(np.asarray(joints, dtype=np.int64), (batch,))
+    delta = np.broadcast_to(np.asarray(delta_deg, dtype=np.int64), (batch,))
+    rows = np.arange(batch)
+    end = theta.copy()
+    end[rows, joint] = (end[rows, joint] + delta) % 360
+    if not geo.swept:
+        return pose_blockers(geo, end)
+
+    # Fold: the turning joint (not the base) passes through or stops at 180.
+    rel = np.where(delta >= 0, 180 - theta[rows, joint], theta[rows, joint] - 180) % 360
+    fold = (joint >= 1) & (rel <= np.abs(delta))
+    fold_joint = joint
+
+    pos = joint_positions(theta, geo.lengths)
+    a, b = pos[:, :-1], pos[:, 1:]
+    pivot = pos[rows, joint]  # (B, 2)
+    delta_rad = np.deg2rad(delta.astype(np.float64))
+    link = np.arange(n)
+    moving = link[None, :] >= joint[:, None]  # (B, n)
+
+    # Moving links against obstacles: centres turned the opposite way.
+    if geo.m:
+        dist = arc_segment_distance(
+            pivot[:, None, None], geo.centers[None, None], -delta_rad[:, None, None],
+            a[:, :, None], b[:, :, None],
+        )
+        obstacle = (dist <= geo.radii + geo.eps) & moving[:, :, None]
+    else:
+        obstacle = np.zeros((batch, n, 0), dtype=bool)
+
+    # Moving link j against fixed link i (i < j - 1): ends of the moving link on
+    # the fixed one, or ends of the fixed link (turned back) on the moving one.
+    pi, pj = geo._pairs()
+    if pi.size:
+        pv = pivot[:, None]
+        d = delta_rad[:, None]
+        fixed_a, fixed_b, move_a, move_b = a[:, pi], b[:, pi], a[:, pj], b[:, pj]
+        contact = np.minimum.reduce([
+            arc_segment_distance(pv, move_a, d, fixed_a, fixed_b),
+            arc_segment_distance(pv, move_b, d, fixed_a, fixed_b),
+            arc_segment_distance(pv, fixed_a, -d, move_a, move_b),
+            arc_segment_distance(pv, fixed_b, -d, move_a, move_b),
+        ])
+        relevant = (pi[None, :] < joint[:, None]) & (pj[None, :] >= joint[:, None])
+        links = (contact <= geo.eps) & relevant
+    else:
+        links = np.zeros((batch, 0), dtype=bool)
+    return _first_codes(geo, fold, obstacle, links, fold_joint)
+
+
+def feedback(
+    tips: ArrayLike, points: ArrayLike, lengths: ArrayLike, tolerance_abs: float
+) -> tuple[NDArray[np.bool_], FloatArray]:
+    """Sensation and float closeness for tips ``(..., n, 2)`` and feedback points ``(n, 2)``.
+
+    Sensation: every tip within ``tolerance_abs`` of its point. Closeness (thesis
+    4.6): mean over joints of ``1 - |p_k - f_k| / (|f_k| + sum_{i<=k} L_i)``, in
+    [0, 1] and 1 exactly at the point.
+    """
+    tips_ = np.asarray(tips, dtype=np.float64)
+    points_ = np.asarray(points, dtype=np.float64)
+    gap = np.hypot(*np.moveaxis(tips_ - points_, -1, 0))
+    reach = np.hypot(points_[:, 0], points_[:, 1]) + np.cumsum(np.asarray(lengths, np.float64))
+    sensation = np.all(gap <= tolerance_abs, axis=-1)
+    closeness = np.clip(1.0 - gap / reach, 0.0, 1.0).mean(axis=-1)
+    return np.asarray(sensation), np.asarray(closeness, dtype=np.float64)
+
+
+def obstacle_distances(tips: ArrayLike, centers: ArrayLike, radii: ArrayLike) -> FloatArray:
+    """Distance from every tip to every obstacle's surface, ``|p_k - c_j| - r_j`` (thesis 4.5).
+
+    Shape ``(..., n, m)``; negative would mean inside (never for a valid pose's tips).
+    """
+    tips_ = np.asarray(tips, dtype=np.float64)[..., :, None, :]
+    diff = tips_ - np.asarray(centers, dtype=np.float64)
+    return np.asarray(np.hypot(diff[..., 0], diff[..., 1]) - np.asarray(radii, np.float64),
+                      dtype=np.float64)
