@@ -1,0 +1,647 @@
+"""The agent's internal model: a labelled transition system over internal states.
+
+The thesis (section 3.1.1) keeps the model as a dense "transition matrix": row
+``i``, column ``j`` holds the sorted list of actions leading from internal state
+``i`` to internal state ``j``, and four operations reshape it: ``add`` and
+``delete`` a transition, ``split`` a state (duplicate its row and column) and
+``merge`` two states (union of their rows and columns).
+
+Here states carry stable integer ids that are never reused, transitions are
+stored sparsely (successors per state and action, plus an incoming index so
+that ``split`` and ``merge`` cost time proportional to the degree of the states
+involved), and the dense matrix is only a view (:meth:`TransitionSystem.to_matrix`).
+Every operation that changes the model is logged as an :class:`Operation`, so a
+recording can carry the operations and a replay can rebuild the model at any
+step with :meth:`TransitionSystem.apply`.
+
+Two defects of the original platform are fixed here (DESIGN.md section 1):
+``merge`` moves a current state that disappears onto the surviving state
+(defect 9), and a duplicated action label inside one matrix cell is one
+transition, not nondeterminism (defect 10).
+
+>>> model = TransitionSystem.universal([0, 1])
+>>> model.to_matrix()
+[[[0, 1]]]
+>>> model.split(0)
+1
+>>> model.to_matrix()
+[[[0, 1], [0, 1]], [[0, 1], [0, 1]]]
+>>> model.is_deterministic()
+False
+>>> model.merge(0, 1)
+0
+>>> model == TransitionSystem.universal([0, 1])
+True
+"""
+
+from __future__ import annotations
+
+import bisect
+import operator
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from typing import Literal
+
+from rsstp_sim.errors import ModelError
+
+__all__ = ["DeterminismReport", "Operation", "TransitionSystem"]
+
+OperationKind = Literal["split", "merge", "add", "delete"]
+_ARITY: dict[str, int] = {"split": 1, "merge": 2, "add": 3, "delete": 3}
+
+
+@dataclass(frozen=True, slots=True)
+class Operation:
+    """One change applied to a transition system, as logged and replayed.
+
+    ``args`` is ``(s,)`` for split, ``(s, t)`` for merge and ``(s, t, a)`` for
+    add and delete. ``result`` is the new state's id for split, the surviving
+    ``s`` for merge and ``None`` for add and delete. ``changed`` is ``False``
+    only for an add of an existing or a delete of a missing transition; such
+    no-ops are never logged by :class:`TransitionSystem`.
+    """
+
+    kind: OperationKind
+    args: tuple[int, ...]
+    result: int | None
+    changed: bool = True
+
+
+@dataclass(frozen=True, slots=True)
+class DeterminismReport:
+    """Which (state, action) pairs break determinism (thesis 4.3) or have no successor.
+
+    ``nondeterministic`` lists ``(state, action, successors)`` for every pair
+    with more than one successor; ``empty`` lists ``(state, action)`` for every
+    action of the model's alphabet with no successor. Both are sorted.
+    """
+
+    nondeterministic: tuple[tuple[int, int, tuple[int, ...]], ...]
+    empty: tuple[tuple[int, int], ...]
+
+    @property
+    def deterministic(self) -> bool:
+        """Every (state, action) has at most one successor."""
+        return not self.nondeterministic
+
+    @property
+    def complete(self) -> bool:
+        """Every (state, action) has exactly one successor."""
+        return not self.nondeterministic and not self.empty
+
+
+def _as_int(value: object, what: str) -> int:
+    """``value`` as an int (numpy integers welcome, bools and floats refused)."""
+    if isinstance(value, bool):
+        raise ModelError(f"{what} must be an integer, got {value!r}")
+    try:
+        return operator.index(value)  # type: ignore[arg-type]
+    except TypeError:
+        raise ModelError(f"{what} must be an integer, got {value!r}") from None
+
+
+def _as_action(value: object, what: str) -> int:
+    action = _as_int(value, what)
+    if action < 0:
+        raise ModelError(f"{what} must be an integer >= 0, got {action}")
+    return action
+
+
+class TransitionSystem:
+    """A nondeterministic labelled transition system with a current state.
+
+    States are integer ids (``0 .. n_states-1`` at construction; :meth:`split`
+    hands out ``next_id`` and ids are never reused). Actions are integers
+    ``>= 0``; the alphabet (:attr:`actions`) is given at construction and grows
+    with every action used in :meth:`add`. ``version`` counts the operations
+    that changed the model; :meth:`drain_operations` hands them out.
+    """
+
+    __slots__ = (
+        "_out",
+        "_in",
+        "_actions",
+        "_actions_sorted",
+        "_current",
+        "_version",
+        "_next_id",
+        "_n_nondeterministic",
+        "_ops",
+        "_states_sorted",
+        "_index",
+    )
+    __hash__ = None  # type: ignore[assignment]
+
+    def __init__(self, n_states: int = 1, *, actions: Iterable[int] = ()) -> None:
+        n = _as_int(n_states, "n_states")
+        if n < 1:
+            raise ModelError(f"a transition system needs n_states >= 1, got {n}")
+        # _out[s][a]: sorted tuple of successors (no empty entries);
+        # _in[t][a]: set of predecessors (no empty entries).
+        self._out: dict[int, dict[int, tuple[int, ...]]] = {s: {} for s in range(n)}
+        self._in: dict[int, dict[int, set[int]]] = {s: {} for s in range(n)}
+        self._actions: set[int] = {_as_action(a, "action") for a in actions}
+        self._actions_sorted: tuple[int, ...] | None = None
+        self._current = 0
+        self._version = 0
+        self._next_id = n
+        self._n_nondeterministic = 0
+        self._ops: list[Operation] = []
+        self._states_sorted: tuple[int, ...] | None = None
+        self._index: dict[int, int] | None = None
+
+    @classmethod
+    def universal(cls, actions: Iterable[int]) -> TransitionSystem:
+        """One state with a self-loop for every action: the model that knows nothing."""
+        model = cls(1, actions=actions)
+        for a in model.actions:
+            model._link(0, a, 0)
+        return model
+
+    # ----------------------------------------------------------------- views
+
+    @property
+    def actions(self) -> tuple[int, ...]:
+        """The action alphabet, sorted."""
+        if self._actions_sorted is None:
+            self._actions_sorted = tuple(sorted(self._actions))
+        return self._actions_sorted
+
+    @property
+    def states(self) -> tuple[int, ...]:
+        """The state ids, sorted."""
+        if self._states_sorted is None:
+            self._states_sorted = tuple(sorted(self._out))
+        return self._states_sorted
+
+    @property
+    def current(self) -> int:
+        """The current internal state."""
+        return self._current
+
+    @current.setter
+    def current(self, s: int) -> None:
+        self._check(s, "set current")
+        self._current = s
+
+    @property
+    def version(self) -> int:
+        """0 at construction, +1 for every operation that changed the model."""
+        return self._version
+
+    @property
+    def next_id(self) -> int:
+        """The id the next :meth:`split` will create."""
+        return self._next_id
+
+    def __len__(self) -> int:
+        return len(self._out)
+
+    def __contains__(self, s: object) -> bool:
+        return s in self._out
+
+    def __repr__(self) -> str:
+        n_transitions = sum(len(ts) for out in self._out.values() for ts in out.values())
+        return (
+            f"TransitionSystem(states={len(self)}, transitions={n_transitions}, "
+            f"actions={self.actions}, current={self._current}, version={self._version})"
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, TransitionSystem):
+            return NotImplemented
+        return (
+            self._current == other._current
+            and self._actions == other._actions
+            and self._out == other._out
+        )
+
+    def successors(self, s: int, a: int) -> tuple[int, ...]:
+        """The sorted successors of ``s`` under action ``a``; ``()`` when there are none."""
+        try:
+            return self._out[s].get(a, ())
+        except KeyError:
+            raise ModelError(f"successors: unknown state {s!r}") from None
+
+    def is_deterministic(self) -> bool:
+        """Every (state, action) has at most one successor (O(1), kept incrementally)."""
+        return self._n_nondeterministic == 0
+
+    def determinism_report(self) -> DeterminismReport:
+        """The pairs with several successors and the pairs with none (thesis 4.3)."""
+        nondeterministic: list[tuple[int, int, tuple[int, ...]]] = []
+        empty: list[tuple[int, int]] = []
+        for s in self.states:
+            out = self._out[s]
+            for a in sorted(out):
+                if len(out[a]) > 1:
+                    nondeterministic.append((s, a, out[a]))
+            empty.extend((s, a) for a in self.actions if a not in out)
+        return DeterminismReport(tuple(nondeterministic), tuple(empty))
+
+    def transitions(self) -> list[tuple[int, int, int]]:
+        """Every transition as ``(source, action, target)``, sorted."""
+        return [
+            (s, a, t)
+            for s in self.states
+            for a, targets in sorted(self._out[s].items())
+            for t in targets
+        ]
+
+    def index_of(self, s: int) -> int:
+        """The row/column of state ``s`` in the dense matrix view."""
+        if self._index is None:
+            self._index = {state: i for i, state in enumerate(self.states)}
+        try:
+            return self._index[s]
+        except KeyError:
+            raise ModelError(f"index_of: unknown state {s!r}") from None
+
+    def state_at(self, index: int) -> int:
+        """The state at row/column ``index`` of the dense matrix view."""
+        states = self.states
+        if not isinstance(index, int) or not 0 <= index < len(states):
+            raise ModelError(f"state_at: index {index!r} is not in range 0..{len(states) - 1}")
+        return states[index]
+
+    def to_matrix(self) -> list[list[list[int]]]:
+        """The thesis's matrix: cell ``[i][j]`` lists the actions from state ``i`` to ``j``."""
+        n = len(self)
+        matrix: list[list[list[int]]] = [[[] for _ in range(n)] for _ in range(n)]
+        for s, a, t in self.transitions():
+            matrix[self.index_of(s)][self.index_of(t)].append(a)
+        return matrix
+
+    @classmethod
+    def from_matrix(
+        cls, matrix: Sequence[Sequence[Sequence[int]]], *, actions: Iterable[int] = ()
+    ) -> TransitionSystem:
+        """Build states ``0..n-1`` from the thesis's square matrix of action lists.
+
+        A label repeated inside one cell is one transition (the original
+        platform counted it as nondeterminism).
+        """
+        n = len(matrix)
+        if n < 1:
+            raise ModelError("from_matrix: the matrix is empty; it needs at least one row")
+        model = cls(n, actions=actions)
+        for i, row in enumerate(matrix):
+            if isinstance(row, str | bytes) or len(row) != n:
+                raise ModelError(
+                    f"from_matrix: row {i} must have {n} cells (square matrix), got {row!r}"
+                )
+            for j, cell in enumerate(row):
+                if isinstance(cell, str | bytes) or not isinstance(cell, Iterable):
+                    raise ModelError(f"from_matrix: cell [{i}][{j}] must be a list, got {cell!r}")
+                for a in cell:
+                    action = _as_action(a, f"from_matrix: action in cell [{i}][{j}]")
+                    model._actions_add(action)
+                    model._link(i, action, j)
+        return model
+
+    # ------------------------------------------------------------ operations
+
+    def add(self, s: int, t: int, a: int) -> bool:
+        """Add the transition ``s -a-> t``; ``True`` when it is new."""
+        self._check(s, "add")
+        self._check(t, "add")
+        action = _as_action(a, "add: action")
+        self._actions_add(action)
+        if not self._link(s, action, t):
+            return False
+        self._log(Operation("add", (s, t, action), None))
+        return True
+
+    def delete(self, s: int, t: int, a: int) -> bool:
+        """Delete the transition ``s -a-> t``; ``True`` when it existed."""
+        self._check(s, "delete")
+        self._check(t, "delete")
+        action = _as_action(a, "delete: action")
+        if not self._unlink(s, action, t):
+            return False
+        self._log(Operation("delete", (s, t, action), None))
+        return True
+
+    def split(self, s: int) -> int:
+        """Create ``s'`` with copies of every transition out of and into ``s``; return ``s'``.
+
+        A self-loop on ``s`` yields ``s->s``, ``s->s'``, ``s'->s`` and ``s'->s'``,
+        like duplicating the matrix row and column. The current state stays.
+        """
+        self._check(s, "split")
+        new = self._next_id
+        outgoing = [(a, t) for a, targets in self._out[s].items() for t in targets]
+        incoming = [(u, a) for a, sources in self._in[s].items() for u in sources]
+        self._next_id += 1
+        self._out[new] = {}
+        self._in[new] = {}
+        self._states_changed()
+        for a, t in outgoing:
+            self._link(new, a, t)
+            if t == s:
+                self._link(new, a, new)
+        for u, a in incoming:
+            self._link(u, a, new)
+        self._log(Operation("split", (s,), new))
+        return new
+
+    def merge(self, s: int, t: int) -> int:
+        """Redirect every transition of ``t`` to ``s`` (union), remove ``t``; return ``s``.
+
+        A current state of ``t`` becomes ``s``.
+        """
+        self._check(s, "merge")
+        self._check(t, "merge")
+        if s == t:
+            raise ModelError(f"merge: cannot merge state {s} with itself")
+        outgoing = [(a, v) for a, targets in self._out[t].items() for v in targets]
+        incoming = [(u, a) for a, sources in self._in[t].items() for u in sources]
+        for a, v in outgoing:
+            self._unlink(t, a, v)
+        for u, a in incoming:
+            if u != t:  # self-loops went with the outgoing ones
+                self._unlink(u, a, t)
+        del self._out[t]
+        del self._in[t]
+        self._states_changed()
+        for a, v in outgoing:
+            self._link(s, a, s if v == t else v)
+        for u, a in incoming:
+            self._link(s if u == t else u, a, s)
+        if self._current == t:
+            self._current = s
+        self._log(Operation("merge", (s, t), s))
+        return s
+
+    def apply(self, op: Operation) -> None:
+        """Replay a logged operation exactly; an inconsistent one raises :class:`ModelError`."""
+        arity = _ARITY.get(op.kind)
+        if arity is None:
+            raise ModelError(f"apply: unknown operation kind {op.kind!r}")
+        if len(op.args) != arity:
+            raise ModelError(f"apply: {op.kind} takes {arity} arguments, got {op.args!r}")
+        if op.kind == "split":
+            (s,) = op.args
+            self._check(s, "apply split")
+            if op.result != self._next_id:
+                raise ModelError(
+                    f"apply: split of state {s} recorded new state {op.result!r}, "
+                    f"but the next id here is {self._next_id}"
+                )
+            self.split(s)
+        elif op.kind == "merge":
+            s, t = op.args
+            self._check(s, "apply merge")
+            self._check(t, "apply merge")
+            if op.result != s:
+                raise ModelError(f"apply: merge({s}, {t}) recorded result {op.result!r}, not {s}")
+            self.merge(s, t)
+        else:
+            s, t, a = op.args
+            self._check(s, f"apply {op.kind}")
+            self._check(t, f"apply {op.kind}")
+            exists = t in self._out[s].get(a, ())
+            if op.changed == (exists if op.kind == "add" else not exists):
+                state = "already exists" if exists else "does not exist"
+                raise ModelError(
+                    f"apply: {op.kind}({s}, {t}, {a}) recorded changed={op.changed}, "
+                    f"but the transition {state}"
+                )
+            if op.kind == "add":
+                self.add(s, t, a)
+            else:
+                self.delete(s, t, a)
+
+    def drain_operations(self) -> list[Operation]:
+        """The operations applied since the last drain; clears that buffer."""
+        ops, self._ops = self._ops, []
+        return ops
+
+    # ---------------------------------------------------- copies and formats
+
+    def copy(self) -> TransitionSystem:
+        """A deep copy (current, version, next id and actions included) with an empty op log."""
+        other = TransitionSystem.__new__(TransitionSystem)
+        other._out = {s: dict(out) for s, out in self._out.items()}
+        other._in = {t: {a: set(us) for a, us in inc.items()} for t, inc in self._in.items()}
+        other._actions = set(self._actions)
+        other._actions_sorted = self._actions_sorted
+        other._current = self._current
+        other._version = self._version
+        other._next_id = self._next_id
+        other._n_nondeterministic = self._n_nondeterministic
+        other._ops = []
+        other._states_sorted = self._states_sorted
+        other._index = self._index
+        return other
+
+    def snapshot(self) -> dict[str, object]:
+        """A JSON-ready sparse form; :meth:`from_snapshot` reads it back."""
+        return {
+            "states": list(self.states),
+            "next_id": self._next_id,
+            "current": self._current,
+            "actions": list(self.actions),
+            "transitions": [[s, a, t] for s, a, t in self.transitions()],
+        }
+
+    @classmethod
+    def from_snapshot(cls, data: Mapping[str, object], *, version: int = 0) -> TransitionSystem:
+        """Rebuild a model from :meth:`snapshot` output, validating every field."""
+        for key in ("states", "next_id", "current", "actions", "transitions"):
+            if key not in data:
+                raise ModelError(f"snapshot: missing key {key!r}")
+        states = [_as_int(s, "snapshot: states[]") for s in _as_list(data["states"], "states")]
+        if not states or len(set(states)) != len(states) or min(states) < 0:
+            raise ModelError(
+                f"snapshot: states must be distinct non-negative ids, at least one; got {states}"
+            )
+        next_id = _as_int(data["next_id"], "snapshot: next_id")
+        if next_id <= max(states):
+            raise ModelError(f"snapshot: next_id {next_id} must exceed every state id")
+        current = _as_int(data["current"], "snapshot: current")
+        if current not in states:
+            raise ModelError(f"snapshot: current {current} is not one of the states")
+        actions = {
+            _as_action(a, "snapshot: actions[]") for a in _as_list(data["actions"], "actions")
+        }
+        model = cls(1, actions=actions)
+        model._out = {s: {} for s in states}
+        model._in = {s: {} for s in states}
+        model._states_changed()
+        model._current = current
+        model._next_id = next_id
+        model._version = _as_int(version, "version")
+        for k, item in enumerate(_as_list(data["transitions"], "transitions")):
+            where = f"snapshot: transitions[{k}]"
+            triple = _as_list(item, f"transitions[{k}]")
+            if len(triple) != 3:
+                raise ModelError(f"{where} must be [source, action, target], got {item!r}")
+            s, t = _as_int(triple[0], where), _as_int(triple[2], where)
+            a = _as_action(triple[1], f"{where} action")
+            if s not in model._out or t not in model._out:
+                raise ModelError(f"{where} refers to an unknown state: {item!r}")
+            if a not in actions:
+                raise ModelError(f"{where} uses action {a}, not in actions {sorted(actions)}")
+            model._link(s, a, t)
+        return model
+
+    def is_isomorphic(self, other: TransitionSystem, *, respect_current: bool = False) -> bool:
+        """Same shape up to a renaming of state ids (actions are not renamed).
+
+        With ``respect_current`` the renaming must also map current to current.
+        Colour refinement prunes a backtracking search: fine for the model
+        sizes of this project, exponential only on highly symmetric inputs.
+        """
+        if (
+            len(self) != len(other)
+            or self._actions != other._actions
+            or len(self.transitions()) != len(other.transitions())
+        ):
+            return False
+        colours_a, colours_b = _refine_jointly(self, other, respect_current=respect_current)
+        if sorted(colours_a.values()) != sorted(colours_b.values()):
+            return False
+        return _match(self, other, colours_a, colours_b)
+
+    # -------------------------------------------------------------- internals
+
+    def _check(self, s: object, operation: str) -> None:
+        if s not in self._out:
+            states = self.states
+            known = f"states: {list(states)}" if len(states) <= 20 else f"{len(states)} states"
+            raise ModelError(f"{operation}: unknown state {s!r} ({known})")
+
+    def _log(self, op: Operation) -> None:
+        self._ops.append(op)
+        self._version += 1
+
+    def _states_changed(self) -> None:
+        self._states_sorted = None
+        self._index = None
+
+    def _actions_add(self, a: int) -> None:
+        if a not in self._actions:
+            self._actions.add(a)
+            self._actions_sorted = None
+
+    def _link(self, s: int, a: int, t: int) -> bool:
+        """Insert ``s -a-> t`` keeping the tuples sorted and the counter right."""
+        out = self._out[s]
+        targets = out.get(a, ())
+        i = bisect.bisect_left(targets, t)
+        if i < len(targets) and targets[i] == t:
+            return False
+        out[a] = targets[:i] + (t,) + targets[i:]
+        if len(targets) == 1:
+            self._n_nondeterministic += 1
+        self._in[t].setdefault(a, set()).add(s)
+        return True
+
+    def _unlink(self, s: int, a: int, t: int) -> bool:
+        out = self._out[s]
+        targets = out.get(a, ())
+        if t not in targets:
+            return False
+        if len(targets) == 1:
+            del out[a]
+        else:
+            out[a] = tuple(v for v in targets if v != t)
+            if len(targets) == 2:
+                self._n_nondeterministic -= 1
+        sources = self._in[t][a]
+        sources.discard(s)
+        if not sources:
+            del self._in[t][a]
+        return True
+
+
+def _as_list(value: object, what: str) -> list[object]:
+    if isinstance(value, str | bytes | Mapping) or not isinstance(value, Iterable):
+        raise ModelError(f"snapshot: {what} must be a list, got {value!r}")
+    return list(value)
+
+
+def _edge_labels(model: TransitionSystem) -> dict[tuple[int, int], frozenset[int]]:
+    labels: dict[tuple[int, int], set[int]] = {}
+    for s, a, t in model.transitions():
+        labels.setdefault((s, t), set()).add(a)
+    return {edge: frozenset(actions) for edge, actions in labels.items()}
+
+
+def _refine_jointly(
+    a: TransitionSystem, b: TransitionSystem, *, respect_current: bool
+) -> tuple[dict[int, int], dict[int, int]]:
+    """Stable colours of both systems' states, comparable across the two (1-WL)."""
+    systems = (a, b)
+    colours: list[dict[int, int]] = [
+        {s: int(respect_current and s == m.current) for s in m.states} for m in systems
+    ]
+    n_classes = len({c for cs in colours for c in cs.values()})
+    while True:
+        signatures = [
+            {
+                s: (
+                    cs[s],
+                    tuple(sorted((act, cs[t]) for act, t in _out_pairs(m, s))),
+                    tuple(sorted((act, cs[u]) for u, act in _in_pairs(m, s))),
+                )
+                for s in m.states
+            }
+            for m, cs in zip(systems, colours, strict=True)
+        ]
+        palette = {
+            sig: i for i, sig in enumerate(sorted({x for sg in signatures for x in sg.values()}))
+        }
+        colours = [{s: palette[sig] for s, sig in sg.items()} for sg in signatures]
+        if len(palette) == n_classes:
+            return colours[0], colours[1]
+        n_classes = len(palette)
+
+
+def _out_pairs(model: TransitionSystem, s: int) -> list[tuple[int, int]]:
+    return [(a, t) for a, targets in model._out[s].items() for t in targets]
+
+
+def _in_pairs(model: TransitionSystem, t: int) -> list[tuple[int, int]]:
+    return [(u, a) for a, sources in model._in[t].items() for u in sources]
+
+
+def _match(
+    a: TransitionSystem, b: TransitionSystem, colours_a: dict[int, int], colours_b: dict[int, int]
+) -> bool:
+    """Backtracking search for a colour-preserving bijection that preserves every edge label."""
+    labels_a, labels_b = _edge_labels(a), _edge_labels(b)
+    by_colour: dict[int, list[int]] = {}
+    for s in b.states:
+        by_colour.setdefault(colours_b[s], []).append(s)
+    order = sorted(a.states, key=lambda s: (len(by_colour[colours_a[s]]), s))
+    mapping: dict[int, int] = {}
+    used: set[int] = set()
+    empty: frozenset[int] = frozenset()
+
+    def consistent(x: int, y: int) -> bool:
+        if labels_a.get((x, x), empty) != labels_b.get((y, y), empty):
+            return False
+        for u, v in mapping.items():
+            if labels_a.get((x, u), empty) != labels_b.get((y, v), empty):
+                return False
+            if labels_a.get((u, x), empty) != labels_b.get((v, y), empty):
+                return False
+        return True
+
+    def extend(k: int) -> bool:
+        if k == len(order):
+            return True
+        x = order[k]
+        for y in by_colour[colours_a[x]]:
+            if y not in used and consistent(x, y):
+                mapping[x] = y
+                used.add(y)
+                if extend(k + 1):
+                    return True
+                del mapping[x]
+                used.discard(y)
+        return False
+
+    return extend(0)

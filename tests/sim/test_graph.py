@@ -1,0 +1,151 @@
+"""Tests for the Graphviz drawing of a transition system."""
+
+from __future__ import annotations
+
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+
+from rsstp_sim.errors import GraphvizMissing, ModelError, RsstpError
+from rsstp_sim.graph import layout, render, to_dot
+from rsstp_sim.transition_system import TransitionSystem
+
+FIGURE_16 = [
+    [[0], [0, 1], [], []],
+    [[0], [0], [0, 1], []],
+    [[1], [], [], [0]],
+    [[1], [0], [0, 1], []],
+]
+
+needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz 'dot' not installed")
+
+
+@pytest.fixture
+def model() -> TransitionSystem:
+    return TransitionSystem.from_matrix(FIGURE_16)
+
+
+def _edges(source: str) -> dict[tuple[str, str], str]:
+    found = re.findall(r'^\s*(\d+) -> (\d+) \[label="?([\d,]+)"?\]$', source, flags=re.M)
+    return {(s, t): label for s, t, label in found}
+
+
+def test_to_dot_has_one_labelled_edge_per_matrix_cell(model: TransitionSystem) -> None:
+    source = to_dot(model)
+    expected = {
+        (str(i), str(j)): ",".join(map(str, cell))
+        for i, row in enumerate(FIGURE_16)
+        for j, cell in enumerate(row)
+        if cell
+    }
+    assert _edges(source) == expected
+    assert "forcelabels=true" in source
+    assert source.startswith("digraph transition_system {")
+
+
+def test_to_dot_is_deterministic(model: TransitionSystem) -> None:
+    rebuilt = TransitionSystem(4)
+    for s, a, t in reversed(model.transitions()):
+        rebuilt.add(s, t, a)
+    assert to_dot(model) == to_dot(model.copy()) == to_dot(rebuilt)
+
+
+def test_to_dot_highlights_the_current_state(model: TransitionSystem) -> None:
+    filled = re.compile(r"^\s*(\d+) \[.*style=filled.*\]$", flags=re.M)
+    assert filled.findall(to_dot(model)) == ["0"]
+    model.current = 2
+    assert filled.findall(to_dot(model)) == ["2"]
+    assert filled.findall(to_dot(model, current=3)) == ["3"]
+    with pytest.raises(ModelError, match=r"to_dot: current state 9 is not in the model"):
+        to_dot(model, current=9)
+
+
+def test_to_dot_title_and_positions(model: TransitionSystem) -> None:
+    positions = {s: (10.0 * s, 5.5) for s in model.states}
+    source = to_dot(model, positions=positions, title="Figure 16")
+    assert 'label="Figure 16"' in source
+    assert '2 [pos="20.00,5.50!"]' in source
+    with pytest.raises(ModelError, match=r"positions missing for states \[3\]"):
+        to_dot(model, positions={0: (0, 0), 1: (1, 1), 2: (2, 2)})
+
+
+@needs_dot
+def test_layout_places_every_state_deterministically(model: TransitionSystem) -> None:
+    model.split(1)
+    positions = layout(model)
+    assert sorted(positions) == list(model.states)
+    assert len(set(positions.values())) == len(model)
+    assert all(isinstance(c, float) for xy in positions.values() for c in xy)
+    assert layout(model) == positions
+
+
+@needs_dot
+def test_render_svg_writes_only_the_picture(model: TransitionSystem, tmp_path: Path) -> None:
+    out = render(model, tmp_path / "model.svg")
+    assert out == tmp_path / "model.svg"
+    text = out.read_text(encoding="utf-8")
+    assert "<svg" in text and "</svg>" in text
+    assert ">0,1<" in text
+    assert [p.name for p in tmp_path.iterdir()] == ["model.svg"]
+
+
+@needs_dot
+def test_render_with_positions_keeps_nodes_in_place(
+    model: TransitionSystem, tmp_path: Path
+) -> None:
+    bigger = model.copy()
+    bigger.split(3)
+    positions = layout(bigger)
+    first = render(model, tmp_path / "a.svg", positions=positions).read_text(encoding="utf-8")
+    second = render(bigger, tmp_path / "b.svg", positions=positions).read_text(encoding="utf-8")
+
+    def node_centres(svg: str) -> dict[str, tuple[str, str]]:
+        pattern = r"<title>(\d+)</title>\s*<ellipse [^>]*cx=\"([-\d.]+)\" cy=\"([-\d.]+)\""
+        return {m[0]: (m[1], m[2]) for m in re.findall(pattern, svg)}
+
+    a, b = node_centres(first), node_centres(second)
+    assert sorted(a) == ["0", "1", "2", "3"]
+    assert sorted(b) == ["0", "1", "2", "3", "4"]
+    assert all(a[s] == b[s] for s in a)
+
+
+@needs_dot
+def test_render_png_and_explicit_format(model: TransitionSystem, tmp_path: Path) -> None:
+    png = render(model, tmp_path / "model.png")
+    assert png.read_bytes().startswith(b"\x89PNG")
+    pdf = render(model, tmp_path / "picture", format="pdf")
+    assert pdf.read_bytes().startswith(b"%PDF")
+
+
+@pytest.mark.parametrize("suffix", ["dot", "gv"])
+def test_render_source_needs_no_program(
+    model: TransitionSystem, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, suffix: str
+) -> None:
+    monkeypatch.setenv("PATH", str(tmp_path))
+    out = render(model, tmp_path / f"model.{suffix}", current=1)
+    assert out.read_text(encoding="utf-8") == to_dot(model, current=1)
+
+
+@pytest.mark.parametrize("suffix", ["svg", "png", "pdf"])
+def test_render_without_graphviz_says_how_to_fix_it(
+    model: TransitionSystem, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, suffix: str
+) -> None:
+    monkeypatch.setenv("PATH", str(tmp_path))
+    with pytest.raises(GraphvizMissing, match=r"apt-get install graphviz\) or write \.dot"):
+        render(model, tmp_path / f"model.{suffix}")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_layout_without_graphviz(model: TransitionSystem, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(shutil, "which", lambda _name: None)
+    with pytest.raises(GraphvizMissing, match=r"Graphviz 'dot' not found"):
+        layout(model)
+
+
+def test_render_refuses_unknown_formats(model: TransitionSystem, tmp_path: Path) -> None:
+    with pytest.raises(RsstpError, match=r"expected one of svg, png, pdf, dot, gv, got 'txt'"):
+        render(model, tmp_path / "model.txt")
+    with pytest.raises(RsstpError, match=r"got 'no suffix'"):
+        render(model, tmp_path / "model")
