@@ -14,7 +14,7 @@ import numpy as np
 
 from rsstp_sim import geometry
 from rsstp_sim.errors import ActionError
-from rsstp_sim.geometry import ArmGeometry, Blocker, FloatArray
+from rsstp_sim.geometry import ArmGeometry, Blocker, FloatArray, IntArray
 from rsstp_sim.scenario import Scenario
 
 __all__ = ["Pose", "World"]
@@ -62,6 +62,8 @@ class World:
         actions = np.asarray(scenario.actions, dtype=np.int64)
         self._action_joint = actions // 2
         self._action_delta = np.where(actions % 2 == 0, scenario.step_deg, -scenario.step_deg)
+        self._offsets = self._box_offsets()
+        self._blockers: dict[int, Blocker] = {}
         self._poses: dict[int, Pose] = {}
         self._moves: dict[int, dict[int, tuple[int, Blocker | None]]] = {}
         self._start = self._encode(scenario.initial_deg)
@@ -81,38 +83,80 @@ class World:
         """The cached :class:`Pose` for a pose code (see :attr:`pose_code`)."""
         pose = self._poses.get(code)
         if pose is None:
-            pose = self._make_pose(code)
-            self._poses[code] = pose
+            self._prefetch(code)
+            pose = self._poses[code]
         return pose
 
-    def _make_pose(self, code: int) -> Pose:
-        angles = self._decode(code)
+    def _box_offsets(self) -> IntArray:
+        """Angle offsets of the poses computed together on a cache miss (about 350)."""
+        n = self.scenario.n_joints
+        radius = max(1, int(round((350 ** (1.0 / n) - 1) / 2)))
+        span = np.arange(-radius, radius + 1, dtype=np.int64) * self.scenario.step_deg
+        grid = np.stack(np.meshgrid(*([span] * n), indexing="ij"), axis=-1)
+        return grid.reshape(-1, n)
+
+    def _prefetch(self, code: int) -> None:
+        """Compute, in one vectorised batch, the poses and moves around ``code``.
+
+        Numpy's per-call overhead dwarfs the arithmetic for one pose, so a miss
+        fills a box of neighbouring poses at once (invalid ones included: they
+        are never reached, so their entries are never read).
+        """
+        angles = np.asarray(self._decode(code), dtype=np.int64)
+        box = (angles + self._offsets) % 360
+        codes = box @ self._radix
+        codes, first = np.unique(codes, return_index=True)
+        box = box[first]
+        fresh = np.array([c not in self._moves for c in codes.tolist()], dtype=bool)
+        box, codes = box[fresh], codes[fresh]
+
+        n_actions = len(self._action_joint)
+        starts = np.repeat(box, n_actions, axis=0)
+        joints = np.tile(self._action_joint, len(box))
+        deltas = np.tile(self._action_delta, len(box))
+        blockers = geometry.move_blockers(self.geometry, starts, joints, deltas)
+        rows = np.arange(len(starts))
+        turned = (starts[rows, joints] + deltas) % 360
+        targets = np.repeat(codes, n_actions) + (turned - starts[rows, joints]) * self._radix[joints]
+        targets = np.where(blockers == 0, targets, np.repeat(codes, n_actions))
+        decode = self._blocker
+        actions = self.scenario.actions
+        target_list, blocker_list = targets.tolist(), blockers.tolist()
+        for i, pose_code in enumerate(codes.tolist()):
+            base = i * n_actions
+            self._moves[pose_code] = {
+                action: (target_list[base + k], decode(blocker_list[base + k]))
+                for k, action in enumerate(actions)
+            }
+
+        missing = np.array([c not in self._poses for c in codes.tolist()], dtype=bool)
+        self._make_poses(box[missing], codes[missing])
+        if code not in self._poses:  # only when the box held it already (cannot happen twice)
+            self._make_poses(angles[None, :], np.array([code]))
+
+    def _blocker(self, blocker_code: int) -> Blocker | None:
+        if not blocker_code:
+            return None
+        blocker = self._blockers.get(blocker_code)
+        if blocker is None:
+            blocker = self._blockers[blocker_code] = self.geometry.decode(blocker_code)
+        return blocker
+
+    def _make_poses(self, angles: IntArray, codes: IntArray) -> None:
         positions = geometry.joint_positions(angles, self.geometry.lengths)
         positions.flags.writeable = False
-        tips = positions[1:]
+        tips = positions[:, 1:]
         sensation, closeness = geometry.feedback(
             tips, self._points, self.geometry.lengths, self._tolerance_abs
         )
         distances = geometry.obstacle_distances(tips, self.geometry.centers, self.geometry.radii)
         distances.flags.writeable = False
-        return Pose(code, angles, positions, bool(sensation), float(closeness), distances)
-
-    def _make_moves(self, code: int) -> dict[int, tuple[int, Blocker | None]]:
-        angles = np.asarray(self._decode(code), dtype=np.int64)
-        batch = np.broadcast_to(angles, (len(self._action_joint), len(angles)))
-        codes = geometry.move_blockers(self.geometry, batch, self._action_joint, self._action_delta)
-        moves: dict[int, tuple[int, Blocker | None]] = {}
-        for action, joint, delta, blocker_code in zip(
-            self.scenario.actions, self._action_joint, self._action_delta, codes.tolist(),
-            strict=True,
+        for i, (pose_code, sensed, close) in enumerate(
+            zip(codes.tolist(), sensation.tolist(), closeness.tolist(), strict=True)
         ):
-            if blocker_code:
-                moves[action] = (code, self.geometry.decode(blocker_code))
-            else:
-                turned = (int(angles[joint]) + int(delta)) % 360
-                moves[action] = (code + (turned - int(angles[joint])) * int(self._radix[joint]),
-                                 None)
-        return moves
+            self._poses[pose_code] = Pose(
+                pose_code, tuple(angles[i].tolist()), positions[i], sensed, close, distances[i]
+            )
 
     # -- the current pose ----------------------------------------------------
 
@@ -127,7 +171,8 @@ class World:
         """Execute an action; return None when the arm moved, else why it was blocked."""
         moves = self._moves.get(self._code)
         if moves is None:
-            moves = self._moves[self._code] = self._make_moves(self._code)
+            self._prefetch(self._code)
+            moves = self._moves[self._code]
         try:
             code, blocker = moves[action]
         except KeyError:
@@ -145,7 +190,8 @@ class World:
         """Where an action would lead from the current pose, without moving."""
         moves = self._moves.get(self._code)
         if moves is None:
-            moves = self._moves[self._code] = self._make_moves(self._code)
+            self._prefetch(self._code)
+            moves = self._moves[self._code]
         if action not in moves:
             raise ActionError(f"action {action!r} is not one of the scenario's actions "
                               f"{list(moves)}")

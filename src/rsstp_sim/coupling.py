@@ -1,0 +1,189 @@
+"""Coupling the agent with the world, one step at a time (DESIGN.md section 2).
+
+One step: the strategy picks an action; the world executes it (blocked or
+not); the internal state moves to a successor of (current state, action),
+chosen by the run's seeded generator when there are several, and stays (with
+a ``no_transition`` event) when there is none; the memory gets the entry; the
+strategy may refine the model. The agent never sees whether the move was
+blocked: that is ground truth, kept for analysis.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from typing import Literal, NamedTuple
+
+import numpy as np
+
+from rsstp_sim.errors import ActionError, StrategyError
+from rsstp_sim.geometry import Blocker
+from rsstp_sim.memory import Memory
+from rsstp_sim.scenario import Scenario
+from rsstp_sim.strategies import AgentView, Strategy
+from rsstp_sim.transition_system import Operation, TransitionSystem
+from rsstp_sim.world import World
+
+__all__ = ["Event", "RunSummary", "Runner", "StepOutcome"]
+
+EventKind = Literal["no_transition", "note"]
+
+
+class StepOutcome(NamedTuple):
+    """What happened in one step (the ground truth ``blocker`` included)."""
+
+    step: int
+    action: int
+    state_before: int
+    state_after: int
+    blocker: Blocker | None
+    no_transition: bool
+
+
+@dataclass(frozen=True, slots=True)
+class Event:
+    """Something worth a line in the log: a step with no transition, or a strategy note."""
+
+    step: int
+    kind: EventKind
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
+class RunSummary:
+    steps: int
+    blocked: int
+    no_transition: int
+    sensations: dict[bool, int] = field(default_factory=dict)
+    model_states: int = 0
+    model_transitions: int = 0
+    deterministic: bool = True
+
+    def to_text(self) -> str:
+        seen = ", ".join(f"{str(k).lower()}: {v}" for k, v in sorted(self.sensations.items()))
+        return (
+            f"steps: {self.steps}\n"
+            f"blocked moves: {self.blocked}\n"
+            f"steps with no transition in the model: {self.no_transition}\n"
+            f"sensations seen: {seen}\n"
+            f"model: {self.model_states} states, {self.model_transitions} transitions, "
+            f"{'deterministic' if self.deterministic else 'nondeterministic'}"
+        )
+
+
+class Runner:
+    """Runs a strategy in a scenario with one seeded generator per run.
+
+    ``on_event`` receives every :class:`Event`; ``on_model_change`` receives the
+    model operations applied during a step (or at reset) as soon as the step
+    ends. Both are how a recorder observes the run from outside.
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        strategy: Strategy,
+        *,
+        seed: int,
+        on_event: Callable[[Event], None] | None = None,
+        on_model_change: Callable[[int, Sequence[Operation]], None] | None = None,
+    ) -> None:
+        if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+            raise StrategyError(f"seed must be an integer >= 0, got {seed!r}")
+        self.scenario = scenario
+        self.strategy = strategy
+        self.seed = seed
+        self.world = World(scenario)
+        self._on_event = on_event
+        self._on_model_change = on_model_change
+        self.reset()
+
+    def reset(self) -> None:
+        """Start over: world at the start pose, fresh model and memory, entry 0 written."""
+        self.rng = np.random.default_rng(self.seed)
+        pose = self.world.reset()
+        self.model: TransitionSystem = self.strategy.initial_model(self.scenario.actions)
+        self.model.drain_operations()
+        self.memory = Memory()
+        self.memory.reset(self.model.current, pose.sensation, pose.feedback)
+        self.agent = AgentView(self.memory, self.model, self.scenario.actions, self.rng,
+                               self._note)
+        self.blocked = 0
+        self.no_transition = 0
+        self._step = 0
+        self.strategy.reset(self.agent)
+        self._version = self.model.version
+        self._flush_model()
+
+    @property
+    def step_index(self) -> int:
+        """Steps taken since the reset."""
+        return self._step
+
+    def _note(self, text: str) -> None:
+        if self._on_event is not None:
+            self._on_event(Event(self._step, "note", text))
+
+    def _flush_model(self) -> None:
+        ops = self.model.drain_operations()
+        self._version = self.model.version
+        if ops and self._on_model_change is not None:
+            self._on_model_change(self._step, ops)
+
+    def step(self) -> StepOutcome:
+        """One coupled step (see the module docstring)."""
+        model = self.model
+        action = self.strategy.choose_action(self.agent)
+        try:
+            blocker = self.world.move(action)
+        except ActionError as exc:
+            raise StrategyError(f"strategy {self.strategy.name!r}: {exc}") from None
+        self._step += 1
+        before = model.current
+        successors = model.successors(before, action)
+        if len(successors) == 1:
+            after = successors[0]
+        elif successors:
+            after = successors[int(self.rng.integers(len(successors)))]
+        else:
+            after = before
+        empty = not successors
+        if after != before:
+            model.current = after
+        pose = self.world.current
+        self.memory.append(action, after, pose.sensation, pose.feedback)
+        if blocker is not None:
+            self.blocked += 1
+        if empty:
+            self.no_transition += 1
+            if self._on_event is not None:
+                self._on_event(Event(self._step, "no_transition",
+                                     f"no transition from state {before} by action {action}: "
+                                     f"the internal state stays"))
+        self.strategy.refine(self.agent)
+        if model.version != self._version:
+            self._flush_model()
+        return StepOutcome(self._step, action, before, after, blocker, empty)
+
+    def run(self, steps: int) -> RunSummary:
+        """Take ``steps`` more steps and summarise the run so far."""
+        if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
+            raise StrategyError(f"steps must be an integer >= 0, got {steps!r}")
+        step = self.step
+        for _ in range(steps):
+            step()
+        return self.summary()
+
+    def summary(self) -> RunSummary:
+        sensations = self.memory.sensations
+        true = int(np.count_nonzero(sensations))
+        seen = {False: len(sensations) - true, True: true}
+        return RunSummary(
+            steps=self._step,
+            blocked=self.blocked,
+            no_transition=self.no_transition,
+            sensations={k: v for k, v in seen.items() if v},
+            model_states=len(self.model),
+            model_transitions=len(self.model.transitions()),
+            deterministic=self.model.is_deterministic(),
+        )

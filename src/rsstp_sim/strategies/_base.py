@@ -1,0 +1,100 @@
+"""The strategy protocol: what a learning strategy sees and may do."""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+
+from rsstp_sim.memory import Memory
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = ["AgentView", "Strategy", "StrategyBase"]
+
+
+class AgentView:
+    """The agent as a strategy sees it: its own memory and model, nothing of the world.
+
+    - ``memory``: the :class:`~rsstp_sim.memory.Memory` so far (read it, do not write it).
+    - ``model``: the internal :class:`~rsstp_sim.transition_system.TransitionSystem`;
+      refine it with ``split``, ``merge``, ``add`` and ``delete``; ``model.current``
+      is the internal state, which a strategy may also set (re-localisation).
+    - ``actions``: the actions the agent may take.
+    - ``rng``: the run's seeded generator; the only source of randomness allowed.
+    - ``note(text)``: a strategy note, recorded as an event at the current step.
+
+    Ground truth (angles, positions, blocked moves, obstacle distances) is
+    deliberately absent: a strategy learns from actions and sensations only.
+    """
+
+    __slots__ = ("memory", "model", "actions", "rng", "_notes")
+
+    def __init__(self, memory: Memory, model: TransitionSystem, actions: tuple[int, ...],
+                 rng: np.random.Generator, notes: Callable[[str], None]) -> None:
+        self.memory = memory
+        self.model = model
+        self.actions = actions
+        self.rng = rng
+        self._notes = notes
+
+    @property
+    def state(self) -> int:
+        """The current internal state."""
+        return self.model.current
+
+    @property
+    def step(self) -> int:
+        """The number of steps taken so far (the memory's last entry index)."""
+        return len(self.memory) - 1
+
+    def note(self, text: str) -> None:
+        self._notes(text)
+
+
+@runtime_checkable
+class Strategy(Protocol):
+    """Decides actions and refines the internal model.
+
+    The runner calls ``initial_model`` and ``reset`` once, then each step
+    ``choose_action`` before the move and ``refine`` after the memory entry of
+    that step has been written.
+    """
+
+    name: ClassVar[str]
+
+    def params(self) -> Mapping[str, Any]: ...
+    def initial_model(self, actions: tuple[int, ...]) -> TransitionSystem: ...
+    def reset(self, agent: AgentView) -> None: ...
+    def choose_action(self, agent: AgentView) -> int: ...
+    def refine(self, agent: AgentView) -> None: ...
+
+
+class StrategyBase:
+    """Convenient defaults: the one-state model with a self-loop per action, no refinement.
+
+    A new strategy needs only a ``name`` and ``choose_action``::
+
+        class Clockwise(StrategyBase):
+            name = "clockwise"
+
+            def choose_action(self, agent: AgentView) -> int:
+                return agent.actions[-1]
+    """
+
+    name: ClassVar[str] = "base"
+
+    def params(self) -> Mapping[str, Any]:
+        return {}
+
+    def initial_model(self, actions: tuple[int, ...]) -> TransitionSystem:
+        return TransitionSystem.universal(actions)
+
+    def reset(self, agent: AgentView) -> None:
+        return None
+
+    def choose_action(self, agent: AgentView) -> int:
+        raise NotImplementedError(f"strategy {self.name!r} must implement choose_action")
+
+    def refine(self, agent: AgentView) -> None:
+        return None
