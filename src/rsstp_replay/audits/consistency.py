@@ -1,0 +1,350 @@
+"""The consistency audit: which internal states does the memory itself prove wrong?
+
+A *contradiction* for internal state ``s`` is two times ``i < j`` with ``s_i == s_j == s`` and a
+``k >= 1`` such that the actions ``a_{i+1..i+k} == a_{j+1..j+k}``, the sensations
+``o_{i+1..i+k-1} == o_{j+1..j+k-1}`` and ``o_{i+k} != o_{j+k}`` (with ``j + k <= T``). No
+deterministic model that labels those times with ``s`` can be right. The sensations at ``i`` and
+``j`` themselves are not compared.
+
+The thesis compared sub-memories pair by pair (``O(T^2)`` pairs, minutes at 100k steps). Here the
+memory after each time is a suffix of the string ``y_t = (a_t, o_t)``, ``t = 1..T``, and:
+
+- two times contradict iff their suffixes, after a common prefix of length ``l``, both go on with
+  the same action and (necessarily) different sensations; then ``k = l + 1``;
+- sorting all suffixes (prefix doubling) and, per state, reading its times in suffix order, the
+  contradicting pairs are exactly those between two *sibling* groups ``(a, false)`` and
+  ``(a, true)`` of a node of the (virtual) suffix tree of that state's times. Such siblings are
+  adjacent in suffix order, separated by one boundary whose LCP is the node's depth.
+
+So every contradicting pair of groups is one boundary between neighbours; its earliest end is
+``max(first time in the left group, first time in the right group) + k``, and its best witness is
+those two first times. The whole audit is ``O(T log T)`` numpy work.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from rsstp_sim.errors import MemoryRangeError
+from rsstp_sim.memory import Memory
+
+__all__ = [
+    "ConsistencyFindings",
+    "StateContradiction",
+    "Witness",
+    "audit_consistency",
+    "find_contradictions",
+]
+
+_IntArray = npt.NDArray[np.int64]
+
+
+@dataclass(frozen=True, slots=True)
+class Witness:
+    """Two times ``i < j`` in the same internal state; the ``k`` actions after each are
+    ``actions``, the sensations agree until the last of them and differ after it."""
+
+    i: int
+    j: int
+    actions: tuple[int, ...]
+
+    @property
+    def k(self) -> int:
+        """The number of actions, ``k >= 1``: the sensations differ at ``i + k`` and ``j + k``."""
+        return len(self.actions)
+
+
+@dataclass(frozen=True, slots=True)
+class StateContradiction:
+    """One internal state the memory proves wrong.
+
+    ``witness`` is the shortest (smallest ``k``; ties: smallest ``j + k``, then smallest ``i``).
+    ``first_step`` is the first step ``t`` such that the memory prefix ``0..t`` already contains
+    a contradiction for this state (the minimum of ``j + k`` over all contradicting pairs).
+    ``pairs`` counts the contradicting pairs ``(i, j)`` (each has exactly one ``k``).
+    """
+
+    state: int
+    witness: Witness
+    first_step: int
+    pairs: int
+
+
+@dataclass(frozen=True, slots=True)
+class ConsistencyFindings:
+    """The result of the consistency audit over a memory of ``steps`` steps (``T``)."""
+
+    contradictions: tuple[StateContradiction, ...]
+    steps: int
+
+    @property
+    def consistent(self) -> bool:
+        """True when no internal state is contradicted."""
+        return not self.contradictions
+
+    @property
+    def first_contradiction_step(self) -> int | None:
+        """The first step at which the memory contains any contradiction; None if consistent."""
+        if not self.contradictions:
+            return None
+        return min(found.first_step for found in self.contradictions)
+
+    def to_text(self) -> str:
+        """Human readable: one line per contradicted state, or one line saying it is consistent."""
+        if not self.contradictions:
+            return f"consistent: no contradiction in {self.steps} steps"
+        lines = []
+        for found in self.contradictions:
+            witness = found.witness
+            lines.append(
+                f"state {found.state}: contradictory from step {found.first_step}; "
+                f"shortest witness: steps {witness.i} and {witness.j} then actions "
+                f"{list(witness.actions)} (k={witness.k}); {found.pairs} contradicting "
+                f"pair{'' if found.pairs == 1 else 's'}"
+            )
+        return "\n".join(lines)
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict (plain ints, bools, lists)."""
+        return {
+            "steps": self.steps,
+            "consistent": self.consistent,
+            "first_contradiction_step": self.first_contradiction_step,
+            "contradictions": [
+                {
+                    "state": found.state,
+                    "first_step": found.first_step,
+                    "pairs": found.pairs,
+                    "witness": {
+                        "i": found.witness.i,
+                        "j": found.witness.j,
+                        "k": found.witness.k,
+                        "actions": list(found.witness.actions),
+                    },
+                }
+                for found in self.contradictions
+            ],
+        }
+
+
+def audit_consistency(memory: Memory) -> ConsistencyFindings:
+    """Find every internal state the memory contradicts (see the module docstring)."""
+    return find_contradictions(memory.actions, memory.internal_states, memory.sensations)
+
+
+def find_contradictions(
+    actions: npt.ArrayLike, states: npt.ArrayLike, sensations: npt.ArrayLike
+) -> ConsistencyFindings:
+    """The consistency audit over memory columns, as in :class:`~rsstp_sim.memory.Memory`.
+
+    ``actions[0]`` (the reset's, -1 in a memory) is ignored; actions and states may be any
+    integers, sensations must be booleans. ``O(T log T)`` time, ``O(T log T)`` memory.
+    Raises :class:`MemoryRangeError` for columns of different lengths, of the wrong kind, or
+    empty (the audit needs at least the reset entry).
+    """
+    action_column, state_column, sensation_column = _validated(actions, states, sensations)
+    steps = len(action_column) - 1
+    if steps < 2:  # a contradiction needs i < j and j + k <= T with k >= 1
+        return ConsistencyFindings((), steps)
+    # The string y_p = (a_{p+1}, o_{p+1}), p = 0..T-1: the suffix at p is the memory after time p.
+    action_codes = np.unique(action_column[1:], return_inverse=True)[1].astype(np.int64)
+    symbols = 2 * action_codes + sensation_column[1:]
+    rank_levels = _prefix_doubling_ranks(symbols)
+
+    # Every time p = 0..T-1 (time T has nothing after it), sorted by (state, suffix rank).
+    state_ids, state_codes = np.unique(state_column[:steps], return_inverse=True)
+    order = np.lexsort((rank_levels[-1], state_codes))
+    sorted_codes = state_codes[order]
+    same_state = sorted_codes[1:] == sorted_codes[:-1]
+    left, right = order[:-1][same_state], order[1:][same_state]
+    lcp = _common_prefix_lengths(left, right, rank_levels)
+    del rank_levels
+    # A pair of neighbours with common prefix l contradicts iff both go on and the next
+    # actions agree (the sensations then differ, or the common prefix would be longer).
+    contradicts = (left + lcp < steps) & (right + lcp < steps)
+    contradicts[contradicts] = (
+        action_codes[(left + lcp)[contradicts]] == action_codes[(right + lcp)[contradicts]]
+    )
+    if not contradicts.any():
+        return ConsistencyFindings((), steps)
+
+    # boundary_lcp[b]: common prefix of sorted neighbours b-1 and b; -1 between states and at
+    # both ends, so the groups found below never cross a state.
+    size = len(order)
+    boundary_lcp = np.full(size + 1, -1, dtype=np.int64)
+    boundary_lcp[1:size][same_state] = lcp
+    boundaries = (np.flatnonzero(same_state) + 1)[contradicts]
+    depth = boundary_lcp[boundaries]
+    group_start, group_end = _sibling_groups(boundary_lcp, boundaries)
+    first_times = _RangeMin(order)
+    first_left = first_times.query(group_start, boundaries - 1)
+    first_right = first_times.query(boundaries, group_end - 1)
+    witness_i = np.minimum(first_left, first_right)
+    witness_j = np.maximum(first_left, first_right)
+    k = depth + 1
+    pairs = (boundaries - group_start) * (group_end - boundaries)
+    boundary_state = sorted_codes[boundaries]
+    return ConsistencyFindings(
+        _per_state(state_ids, boundary_state, witness_i, witness_j, k, pairs, action_column),
+        steps,
+    )
+
+
+def _validated(
+    actions: npt.ArrayLike, states: npt.ArrayLike, sensations: npt.ArrayLike
+) -> tuple[_IntArray, npt.NDArray[Any], _IntArray]:
+    columns = {
+        "actions": np.asarray(actions),
+        "states": np.asarray(states),
+        "sensations": np.asarray(sensations),
+    }
+    for name, column in columns.items():
+        if column.ndim != 1:
+            raise MemoryRangeError(f"{name}: expected a one-dimensional array, got {column.shape}")
+    lengths = {name: len(column) for name, column in columns.items()}
+    if len(set(lengths.values())) != 1:
+        raise MemoryRangeError(f"the columns must have the same length, got {lengths}")
+    if lengths["actions"] == 0:
+        raise MemoryRangeError("the audit needs at least entry 0 (the reset); the memory is empty")
+    if columns["actions"].dtype.kind not in "iu":
+        raise MemoryRangeError(f"actions: expected integers, got {columns['actions'].dtype}")
+    if columns["sensations"].dtype.kind != "b":
+        raise MemoryRangeError(f"sensations: expected booleans, got {columns['sensations'].dtype}")
+    return (
+        columns["actions"].astype(np.int64, copy=False),
+        columns["states"],
+        columns["sensations"].astype(np.int64),
+    )
+
+
+def _prefix_doubling_ranks(symbols: _IntArray) -> list[_IntArray]:
+    """Ranks of every suffix's prefixes of length 1, 2, 4, ...: ``levels[e][p] == levels[e][q]``
+    iff the suffixes at ``p`` and ``q`` agree on their first ``2**e`` symbols (shorter suffixes
+    sort first). Stops as soon as all ranks differ: the last level is the suffix order."""
+    size = len(symbols)
+    rank = np.unique(symbols, return_inverse=True)[1].astype(np.int64)
+    levels = [rank]
+    distinct = int(rank.max()) + 1
+    half = 1
+    while distinct < size:
+        following = np.zeros(size, dtype=np.int64)
+        following[: size - half] = rank[half:] + 1
+        key = rank * (size + 1) + following
+        by_key = np.argsort(key)
+        sorted_key = key[by_key]
+        new_group = np.empty(size, dtype=np.int64)
+        new_group[0] = 0
+        np.not_equal(sorted_key[1:], sorted_key[:-1], out=new_group[1:])
+        rank = np.empty(size, dtype=np.int64)
+        rank[by_key] = np.cumsum(new_group)
+        levels.append(rank)
+        distinct = int(rank[by_key[-1]]) + 1
+        half *= 2
+    return levels
+
+
+def _common_prefix_lengths(
+    left: _IntArray, right: _IntArray, rank_levels: list[_IntArray]
+) -> _IntArray:
+    """Longest common prefix of the suffixes at ``left[x]`` and ``right[x]`` (all distinct),
+    by binary lifting over the doubling levels (it is below ``2**(len(rank_levels) - 1)``)."""
+    size = len(rank_levels[0])
+    lcp = np.zeros(len(left), dtype=np.int64)
+    for level in range(len(rank_levels) - 2, -1, -1):
+        span = 1 << level
+        at_left, at_right = left + lcp, right + lcp
+        fits = (at_left + span <= size) & (at_right + span <= size)
+        ranks = rank_levels[level]
+        fits[fits] = ranks[at_left[fits]] == ranks[at_right[fits]]
+        lcp += span * fits
+    return lcp
+
+
+def _sibling_groups(boundary_lcp: _IntArray, boundaries: _IntArray) -> tuple[_IntArray, _IntArray]:
+    """For each boundary ``b`` of depth ``d``: the sibling groups it separates are the sorted
+    entries ``[start, b)`` and ``[b, end)``, bounded by the nearest boundaries of depth ``<= d``."""
+    depth = boundary_lcp[boundaries]
+    mins = _RangeMin(boundary_lcp)
+    top = len(mins.levels) - 1
+    # Left: largest boundary c < b with boundary_lcp[c] <= d; boundary_lcp[0] == -1 stops it.
+    position = boundaries.copy()  # invariant: boundary_lcp[position:b] > d
+    for level in range(top, -1, -1):
+        span = 1 << level
+        candidate = position - span
+        move = candidate >= 0
+        move[move] = mins.levels[level][candidate[move]] > depth[move]
+        position[move] = candidate[move]
+    start = position - 1
+    # Right: smallest boundary c > b with boundary_lcp[c] <= d; boundary_lcp[-1] == -1 stops it.
+    position = boundaries + 1  # invariant: boundary_lcp[b+1:position] > d
+    last = len(boundary_lcp) - 1
+    for level in range(top, -1, -1):
+        span = 1 << level
+        move = position + span - 1 <= last
+        move[move] = mins.levels[level][position[move]] > depth[move]
+        position[move] += span
+    return start, position
+
+
+class _RangeMin:
+    """Sparse table: ``levels[e][x] = min(values[x : x + 2**e])``."""
+
+    def __init__(self, values: _IntArray) -> None:
+        self.levels = [values]
+        span = 1
+        while 2 * span <= len(values):
+            previous = self.levels[-1]
+            self.levels.append(np.minimum(previous[:-span], previous[span:]))
+            span *= 2
+
+    def query(self, first: _IntArray, last: _IntArray) -> _IntArray:
+        """``min(values[first[x] : last[x] + 1])`` for every ``x`` (non-empty ranges)."""
+        length = last - first + 1
+        level = np.zeros(len(first), dtype=np.int64)
+        while True:  # level = floor(log2(length)), exact in integers
+            grow = (2 << level) <= length
+            if not grow.any():
+                break
+            level += grow
+        result = np.empty(len(first), dtype=np.int64)
+        for value in np.unique(level):
+            chosen = level == value
+            table = self.levels[int(value)]
+            result[chosen] = np.minimum(
+                table[first[chosen]], table[last[chosen] - (1 << int(value)) + 1]
+            )
+        return result
+
+
+def _per_state(
+    state_ids: npt.NDArray[Any],
+    boundary_state: _IntArray,
+    witness_i: _IntArray,
+    witness_j: _IntArray,
+    k: _IntArray,
+    pairs: _IntArray,
+    action_column: _IntArray,
+) -> tuple[StateContradiction, ...]:
+    """Reduce the contradicting boundaries to one finding per state."""
+    best = np.lexsort((witness_i, witness_j, k, boundary_state))
+    states_in_order = boundary_state[best]
+    starts = np.flatnonzero(np.r_[True, states_in_order[1:] != states_in_order[:-1]])
+    first_step = np.minimum.reduceat((witness_j + k)[best], starts)
+    pair_total = np.add.reduceat(pairs[best], starts)
+    findings = []
+    for index, boundary in enumerate(best[starts]):
+        i, j, length = int(witness_i[boundary]), int(witness_j[boundary]), int(k[boundary])
+        state = state_ids[states_in_order[starts[index]]]
+        findings.append(
+            StateContradiction(
+                state=int(state),
+                witness=Witness(i, j, tuple(int(a) for a in action_column[i + 1 : i + length + 1])),
+                first_step=int(first_step[index]),
+                pairs=int(pair_total[index]),
+            )
+        )
+    return tuple(findings)
