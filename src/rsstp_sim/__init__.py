@@ -1,1 +1,73 @@
-"""RSSTP simulator: a 2D multi-joint arm, its internal model, memory and strategies."""
+"""RSSTP simulator: a 2D multi-joint arm, its internal model, memory and strategies.
+
+The world (:class:`World`) is the arm among circular obstacles; the agent
+keeps a :class:`Memory` and an internal :class:`TransitionSystem`; a
+:class:`Strategy` decides actions and refinements; a :class:`Runner` couples
+them one step at a time with one seeded generator per run.
+"""
+
+from rsstp_sim.coupling import Event, Runner, RunSummary, StepOutcome
+from rsstp_sim.errors import (
+    ActionError,
+    GraphvizMissing,
+    MemoryRangeError,
+    ModelError,
+    RecordingError,
+    RsstpError,
+    ScenarioError,
+    StrategyError,
+)
+from rsstp_sim.geometry import Blocker
+from rsstp_sim.memory import CompareKind, CompareResult, Memory, MemoryEntry
+from rsstp_sim.scenario import Obstacle, Scenario, builtin_scenarios, load_scenario, parse_scenario
+from rsstp_sim.strategies import (
+    AgentView,
+    RandomStrategy,
+    ScriptStrategy,
+    Strategy,
+    StrategyBase,
+    builtin_strategies,
+    make_strategy,
+)
+from rsstp_sim.transition_system import DeterminismReport, Operation, TransitionSystem
+from rsstp_sim.world import Pose, World
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "ActionError",
+    "AgentView",
+    "Blocker",
+    "CompareKind",
+    "CompareResult",
+    "DeterminismReport",
+    "Event",
+    "GraphvizMissing",
+    "Memory",
+    "MemoryEntry",
+    "MemoryRangeError",
+    "ModelError",
+    "Obstacle",
+    "Operation",
+    "Pose",
+    "RandomStrategy",
+    "RecordingError",
+    "RsstpError",
+    "RunSummary",
+    "Runner",
+    "Scenario",
+    "ScenarioError",
+    "ScriptStrategy",
+    "StepOutcome",
+    "Strategy",
+    "StrategyBase",
+    "StrategyError",
+    "TransitionSystem",
+    "World",
+    "__version__",
+    "builtin_scenarios",
+    "builtin_strategies",
+    "load_scenario",
+    "make_strategy",
+    "parse_scenario",
+]

@@ -106,8 +106,7 @@ class Runner:
         self.model.drain_operations()
         self.memory = Memory()
         self.memory.reset(self.model.current, pose.sensation, pose.feedback)
-        self.agent = AgentView(self.memory, self.model, self.scenario.actions, self.rng,
-                               self._note)
+        self.agent = AgentView(self.memory, self.model, self.scenario.actions, self.rng, self._note)
         self.blocked = 0
         self.no_transition = 0
         self._step = 0
@@ -157,9 +156,14 @@ class Runner:
         if empty:
             self.no_transition += 1
             if self._on_event is not None:
-                self._on_event(Event(self._step, "no_transition",
-                                     f"no transition from state {before} by action {action}: "
-                                     f"the internal state stays"))
+                self._on_event(
+                    Event(
+                        self._step,
+                        "no_transition",
+                        f"no transition from state {before} by action {action}: "
+                        f"the internal state stays",
+                    )
+                )
         self.strategy.refine(self.agent)
         if model.version != self._version:
             self._flush_model()

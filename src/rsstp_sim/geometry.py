@@ -133,8 +133,9 @@ def arc_segment_distance(
     rho = np.hypot(v[..., 0], v[..., 1])
     start = np.arctan2(v[..., 1], v[..., 0])
     cos_d, sin_d = np.cos(delta), np.sin(delta)
-    q_end = p + np.stack([v[..., 0] * cos_d - v[..., 1] * sin_d,
-                          v[..., 0] * sin_d + v[..., 1] * cos_d], axis=-1)
+    q_end = p + np.stack(
+        [v[..., 0] * cos_d - v[..., 1] * sin_d, v[..., 0] * sin_d + v[..., 1] * cos_d], axis=-1
+    )
 
     best = np.minimum(point_segment_distance(q, a_, b_), point_segment_distance(q_end, a_, b_))
 
@@ -143,8 +144,9 @@ def arc_segment_distance(
         w = end - p
         r_end = np.hypot(w[..., 0], w[..., 1])
         inside = _in_arc(np.arctan2(w[..., 1], w[..., 0]), start, delta)
-        to_ends = np.minimum(np.hypot(*np.moveaxis(end - q, -1, 0)),
-                             np.hypot(*np.moveaxis(end - q_end, -1, 0)))
+        to_ends = np.minimum(
+            np.hypot(*np.moveaxis(end - q, -1, 0)), np.hypot(*np.moveaxis(end - q_end, -1, 0))
+        )
         best = np.minimum(best, np.where(inside, np.abs(r_end - rho), to_ends))
 
     # Interior candidates on the circle, relative to the segment's line.
@@ -222,12 +224,21 @@ class ArmGeometry:
     @classmethod
     def from_scenario(cls, scenario: _ScenarioLike) -> ArmGeometry:
         lengths = np.asarray(scenario.lengths, dtype=np.float64)
-        centers = np.array([o.center for o in scenario.obstacles],  # type: ignore[attr-defined]
-                           dtype=np.float64).reshape(-1, 2)
-        radii = np.array([o.radius for o in scenario.obstacles],  # type: ignore[attr-defined]
-                         dtype=np.float64)
-        return cls(lengths, centers, radii, scenario.collision == "swept",
-                   CONTACT_EPS * float(lengths.sum()))
+        centers = np.array(
+            [o.center for o in scenario.obstacles],  # type: ignore[attr-defined]
+            dtype=np.float64,
+        ).reshape(-1, 2)
+        radii = np.array(
+            [o.radius for o in scenario.obstacles],  # type: ignore[attr-defined]
+            dtype=np.float64,
+        )
+        return cls(
+            lengths,
+            centers,
+            radii,
+            scenario.collision == "swept",
+            CONTACT_EPS * float(lengths.sum()),
+        )
 
     @property
     def n(self) -> int:
@@ -299,8 +310,9 @@ def pose_blocker(scenario: _ScenarioLike, angles_deg: Sequence[int]) -> Blocker 
     return geo.decode(int(pose_blockers(geo, [list(angles_deg)])[0]))
 
 
-def move_blockers(geo: ArmGeometry, angles_deg: ArrayLike, joints: ArrayLike,
-                  delta_deg: ArrayLike) -> IntArray:
+def move_blockers(
+    geo: ArmGeometry, angles_deg: ArrayLike, joints: ArrayLike, delta_deg: ArrayLike
+) -> IntArray:
     """Blocker code for turning ``joints[b]`` by ``delta_deg[b]`` from pose ``angles_deg[b]``.
 
     The start poses must be valid. Swept mode checks the whole motion; endpoint
@@ -331,8 +343,11 @@ def move_blockers(geo: ArmGeometry, angles_deg: ArrayLike, joints: ArrayLike,
     # Moving links against obstacles: centres turned the opposite way.
     if geo.m:
         dist = arc_segment_distance(
-            pivot[:, None, None], geo.centers[None, None], -delta_rad[:, None, None],
-            a[:, :, None], b[:, :, None],
+            pivot[:, None, None],
+            geo.centers[None, None],
+            -delta_rad[:, None, None],
+            a[:, :, None],
+            b[:, :, None],
         )
         obstacle = (dist <= geo.radii + geo.eps) & moving[:, :, None]
     else:
@@ -345,12 +360,14 @@ def move_blockers(geo: ArmGeometry, angles_deg: ArrayLike, joints: ArrayLike,
         pv = pivot[:, None]
         d = delta_rad[:, None]
         fixed_a, fixed_b, move_a, move_b = a[:, pi], b[:, pi], a[:, pj], b[:, pj]
-        contact = np.minimum.reduce([
-            arc_segment_distance(pv, move_a, d, fixed_a, fixed_b),
-            arc_segment_distance(pv, move_b, d, fixed_a, fixed_b),
-            arc_segment_distance(pv, fixed_a, -d, move_a, move_b),
-            arc_segment_distance(pv, fixed_b, -d, move_a, move_b),
-        ])
+        contact = np.minimum.reduce(
+            [
+                arc_segment_distance(pv, move_a, d, fixed_a, fixed_b),
+                arc_segment_distance(pv, move_b, d, fixed_a, fixed_b),
+                arc_segment_distance(pv, fixed_a, -d, move_a, move_b),
+                arc_segment_distance(pv, fixed_b, -d, move_a, move_b),
+            ]
+        )
         relevant = (pi[None, :] < joint[:, None]) & (pj[None, :] >= joint[:, None])
         links = (contact <= geo.eps) & relevant
     else:
@@ -383,5 +400,6 @@ def obstacle_distances(tips: ArrayLike, centers: ArrayLike, radii: ArrayLike) ->
     """
     tips_ = np.asarray(tips, dtype=np.float64)[..., :, None, :]
     diff = tips_ - np.asarray(centers, dtype=np.float64)
-    return np.asarray(np.hypot(diff[..., 0], diff[..., 1]) - np.asarray(radii, np.float64),
-                      dtype=np.float64)
+    return np.asarray(
+        np.hypot(diff[..., 0], diff[..., 1]) - np.asarray(radii, np.float64), dtype=np.float64
+    )

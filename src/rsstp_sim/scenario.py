@@ -149,7 +149,9 @@ class _Validator:
         shown = "missing" if found is _MISSING else f"found {found!r}"
         return ScenarioError(f"{self.origin}: {key}: expected {expected}, {shown}")
 
-    def unknown_keys(self, table: Mapping[str, object], allowed: frozenset[str], where: str) -> None:
+    def unknown_keys(
+        self, table: Mapping[str, object], allowed: frozenset[str], where: str
+    ) -> None:
         for key in sorted(set(table) - allowed):
             path = f"{where}.{key}" if where else key
             raise ScenarioError(
@@ -165,8 +167,9 @@ class _Validator:
         self.unknown_keys(value, _SECTIONS[key], key)
         return value
 
-    def integer(self, value: object, key: str, *, low: int | None = None, high: int | None = None
-                ) -> int:
+    def integer(
+        self, value: object, key: str, *, low: int | None = None, high: int | None = None
+    ) -> int:
         if isinstance(value, bool) or not isinstance(value, int):
             raise self.fail(key, "an integer", value)
         if (low is not None and value < low) or (high is not None and value > high):
@@ -268,8 +271,9 @@ class _Validator:
         if collision not in ("swept", "endpoint"):
             raise self.fail("motion.collision", '"swept" or "endpoint"', collision)
 
-        name = data.get("name", Path(self.origin).stem if self.origin.endswith(".toml")
-                        else self.origin)
+        name = data.get(
+            "name", Path(self.origin).stem if self.origin.endswith(".toml") else self.origin
+        )
         if not isinstance(name, str):
             raise self.fail("name", "a string", name)
         description = data.get("description", "")

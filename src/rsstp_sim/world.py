@@ -117,7 +117,8 @@ class World:
         blockers = geometry.move_blockers(self.geometry, starts, joints, deltas)
         rows = np.arange(len(starts))
         turned = (starts[rows, joints] + deltas) % 360
-        targets = np.repeat(codes, n_actions) + (turned - starts[rows, joints]) * self._radix[joints]
+        turn = (turned - starts[rows, joints]) * self._radix[joints]
+        targets = np.repeat(codes, n_actions) + turn
         targets = np.where(blockers == 0, targets, np.repeat(codes, n_actions))
         decode = self._blocker
         actions = self.scenario.actions
@@ -139,7 +140,9 @@ class World:
             return None
         blocker = self._blockers.get(blocker_code)
         if blocker is None:
-            blocker = self._blockers[blocker_code] = self.geometry.decode(blocker_code)
+            decoded = self.geometry.decode(blocker_code)
+            assert decoded is not None  # a non-zero code always names a blocker
+            blocker = self._blockers[blocker_code] = decoded
         return blocker
 
     def _make_poses(self, angles: IntArray, codes: IntArray) -> None:
@@ -193,8 +196,9 @@ class World:
             self._prefetch(self._code)
             moves = self._moves[self._code]
         if action not in moves:
-            raise ActionError(f"action {action!r} is not one of the scenario's actions "
-                              f"{list(moves)}")
+            raise ActionError(
+                f"action {action!r} is not one of the scenario's actions {list(moves)}"
+            )
         code, blocker = moves[action]
         return self.pose(code), blocker
 

@@ -40,5 +40,6 @@ def make_strategy(name: str, params: Mapping[str, Any] | None = None) -> Strateg
     try:
         return factory(**dict(params or {}))
     except TypeError as exc:
-        raise StrategyError(f"strategy {name!r}: invalid parameters {dict(params or {})}: {exc}"
-                            ) from None
+        raise StrategyError(
+            f"strategy {name!r}: invalid parameters {dict(params or {})}: {exc}"
+        ) from None

@@ -30,8 +30,14 @@ class AgentView:
 
     __slots__ = ("memory", "model", "actions", "rng", "_notes")
 
-    def __init__(self, memory: Memory, model: TransitionSystem, actions: tuple[int, ...],
-                 rng: np.random.Generator, notes: Callable[[str], None]) -> None:
+    def __init__(
+        self,
+        memory: Memory,
+        model: TransitionSystem,
+        actions: tuple[int, ...],
+        rng: np.random.Generator,
+        notes: Callable[[str], None],
+    ) -> None:
         self.memory = memory
         self.model = model
         self.actions = actions

@@ -1,0 +1,177 @@
+"""``rsstp-sim``: list scenarios, run strategies, draw models.
+
+Bad input gets one line on stderr naming the problem and exit code 2; never a
+traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any, NoReturn
+
+from rsstp_sim import graph
+from rsstp_sim.coupling import Runner
+from rsstp_sim.errors import RsstpError
+from rsstp_sim.scenario import builtin_scenarios, load_scenario
+from rsstp_sim.strategies import builtin_strategies, make_strategy
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = ["main"]
+
+PROG = "rsstp-sim"
+
+
+class UsageError(RsstpError):
+    """A command-line argument is invalid."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
+
+def _parse_params(items: Sequence[str]) -> dict[str, Any]:
+    """``key=value`` pairs; values are JSON when they parse as JSON, else strings."""
+    params: dict[str, Any] = {}
+    for item in items:
+        key, sep, raw = item.partition("=")
+        if not sep or not key:
+            raise UsageError(f"--param expects key=value, got {item!r}")
+        try:
+            params[key] = json.loads(raw)
+        except json.JSONDecodeError:
+            params[key] = raw
+    return params
+
+
+def _add_run_arguments(parser: argparse.ArgumentParser, *, steps_default: int) -> None:
+    parser.add_argument("scenario", help="a built-in scenario name or a scenario .toml file")
+    parser.add_argument(
+        "--strategy",
+        default="random",
+        help=f"strategy name ({', '.join(builtin_strategies())}); default random",
+    )
+    parser.add_argument(
+        "--param",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="strategy parameter (JSON value), repeatable; e.g. actions=[0,1]",
+    )
+    parser.add_argument(
+        "--steps",
+        type=_non_negative,
+        default=steps_default,
+        help=f"steps to run (default {steps_default})",
+    )
+    parser.add_argument("--seed", type=_non_negative, default=0, help="seed (default 0)")
+
+
+def _non_negative(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}")
+    return value
+
+
+def _runner(args: argparse.Namespace) -> Runner:
+    scenario = load_scenario(args.scenario)
+    strategy = make_strategy(args.strategy, _parse_params(args.param))
+    return Runner(scenario, strategy, seed=args.seed)
+
+
+def _cmd_scenarios(args: argparse.Namespace) -> int:
+    scenarios = builtin_scenarios()
+    width = max(map(len, scenarios))
+    for name, description in scenarios.items():
+        print(f"{name:<{width}}  {description}")
+    return 0
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    runner = _runner(args)
+    started = time.perf_counter()
+    summary = runner.run(args.steps)
+    seconds = time.perf_counter() - started
+    print(f"scenario: {runner.scenario.name}  strategy: {args.strategy}  seed: {args.seed}")
+    print(summary.to_text())
+    rate = f" ({summary.steps / seconds:,.0f} steps/s)" if seconds > 0 and summary.steps else ""
+    print(f"time: {seconds:.2f} s{rate}")
+    return 0
+
+
+def _cmd_graph(args: argparse.Namespace) -> int:
+    if args.matrix is not None:
+        try:
+            matrix = json.loads(args.matrix)
+        except json.JSONDecodeError as exc:
+            raise UsageError(f"--matrix is not JSON: {exc}") from None
+        if not isinstance(matrix, list):
+            raise UsageError("--matrix must be a JSON list of lists of action lists")
+        model = TransitionSystem.from_matrix(matrix)
+    else:
+        if args.scenario is None:
+            raise UsageError("graph needs a SCENARIO or --matrix")
+        runner = _runner(args)
+        runner.run(args.steps)
+        model = runner.model
+    out = Path(args.output)
+    if out.exists() and not args.force:
+        raise UsageError(f"{out}: already exists (use --force to overwrite)")
+    try:
+        written = graph.render(model, out)
+    except OSError as exc:
+        raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    print(f"wrote {written} ({len(model)} states)")
+    return 0
+
+
+def _build_parser() -> _Parser:
+    parser = _Parser(prog=PROG, description="RSSTP simulator: scenarios, strategies, models.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("scenarios", help="list the built-in scenarios")
+    p.set_defaults(func=_cmd_scenarios)
+
+    p = sub.add_parser("run", help="run a strategy and print a summary")
+    _add_run_arguments(p, steps_default=1000)
+    p.set_defaults(func=_cmd_run)
+
+    p = sub.add_parser("graph", help="draw a model (the one a run ends with, or a thesis matrix)")
+    p.add_argument("scenario", nargs="?", help="scenario to run first (omit with --matrix)")
+    p.add_argument("--matrix", help="a thesis-format matrix as JSON, e.g. '[[[0],[1]],[[1],[0]]]'")
+    p.add_argument("--strategy", default="random")
+    p.add_argument("--param", action="append", default=[], metavar="KEY=VALUE")
+    p.add_argument("--steps", type=_non_negative, default=1000)
+    p.add_argument("--seed", type=_non_negative, default=0)
+    p.add_argument("-o", "--output", required=True, help="output file: .svg, .png, .pdf or .dot")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.set_defaults(func=_cmd_graph)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; returns the exit code (0 ok, 2 bad input, 130 interrupted)."""
+    parser = _build_parser()
+    try:
+        args = parser.parse_args(argv)
+        func: Callable[[argparse.Namespace], int] = args.func
+        return func(args)
+    except RsstpError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())
