@@ -1,0 +1,439 @@
+"""Ground truth: the world as a finite Moore machine, minimised (DESIGN.md section 5).
+
+Joint angles are integers, so the poses reachable from the start pose are
+finitely many. With a blocked move read as a self-loop, those poses and the
+scenario's actions form a deterministic machine whose output in a pose is the
+boolean sensation: a Moore machine. Its minimisation (partition refinement) is
+the smallest internal model that predicts every sensation correctly, the
+reference against which a learned model is judged (:func:`check_equivalence`).
+
+Poses are identified by their code ``sum_i angle_i * 360**i`` (as in
+:class:`~rsstp_sim.world.World`). The enumeration is breadth-first over whole
+frontiers, every frontier's moves computed in vectorised batches; nothing here
+loops over poses in Python.
+
+>>> from rsstp_sim.scenario import load_scenario
+>>> truth = compute_truth(load_scenario("thesis-roulette"))
+>>> truth.n_poses, truth.n_sensed, truth.n_classes
+(4, 1, 4)
+>>> truth.class_of([180]), truth.class_next.tolist()
+(2, [[1], [2], [3], [0]])
+>>> check_equivalence(truth.minimal_model(), {0: True, 1: False, 2: False, 3: False}, truth)
+>>> check_equivalence(truth.minimal_model(), {0: True, 1: False, 2: True, 3: False}, truth)
+(0, 0)
+"""
+
+from __future__ import annotations
+
+import math
+import operator
+import time
+from collections import deque
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rsstp_sim import geometry
+from rsstp_sim.errors import ModelError, RsstpError
+from rsstp_sim.geometry import ArmGeometry, IntArray
+from rsstp_sim.scenario import Scenario
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = [
+    "GroundTruth",
+    "TruthError",
+    "check_equivalence",
+    "compute_truth",
+    "format_truth",
+    "pose_space_size",
+]
+
+BoolArray = NDArray[np.bool_]
+
+CHUNK_ROWS = 50_000
+"""Moves (pose, action pairs) checked per call of :func:`geometry.move_blockers`."""
+
+
+class TruthError(RsstpError):
+    """The ground truth cannot be computed (pose space too large) or does not know a pose."""
+
+
+@dataclass(frozen=True, eq=False)
+class GroundTruth:
+    """The reachable poses of a scenario as a Moore machine, and its minimisation.
+
+    Pose index ``p`` (``0 .. P-1``) follows the sorted pose codes. For action
+    ``actions[k]`` (see :class:`~rsstp_sim.world.World`), ``next_pose[p, k]``
+    is the pose reached from ``p`` (``p`` itself when ``blocked[p, k]``).
+    ``true_class[p]`` is the pose's class in the minimal machine; classes are
+    numbered breadth-first from the start pose's class (0) over the actions in
+    order, so the numbering depends only on the machine's behaviour.
+    ``seconds`` (wall time of the computation) takes no part in equality.
+    Arrays are read-only.
+    """
+
+    scenario_name: str
+    actions: tuple[int, ...]
+    pose_codes: IntArray
+    angles_deg: IntArray
+    sensation: BoolArray
+    next_pose: IntArray
+    blocked: BoolArray
+    start_index: int
+    true_class: IntArray
+    class_next: IntArray
+    class_sensation: BoolArray
+    seconds: float = field(default=0.0, compare=False)
+
+    def __post_init__(self) -> None:
+        for array in self._arrays():
+            array.flags.writeable = False
+
+    def _arrays(self) -> tuple[np.ndarray, ...]:
+        return (
+            self.pose_codes,
+            self.angles_deg,
+            self.sensation,
+            self.next_pose,
+            self.blocked,
+            self.true_class,
+            self.class_next,
+            self.class_sensation,
+        )
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, GroundTruth):
+            return NotImplemented
+        return (self.scenario_name, self.actions, self.start_index) == (
+            other.scenario_name,
+            other.actions,
+            other.start_index,
+        ) and all(
+            np.array_equal(a, b) for a, b in zip(self._arrays(), other._arrays(), strict=True)
+        )
+
+    __hash__ = None  # type: ignore[assignment]
+
+    @property
+    def n_poses(self) -> int:
+        """Reachable poses."""
+        return int(self.pose_codes.shape[0])
+
+    @property
+    def n_classes(self) -> int:
+        """States of the minimal Moore machine."""
+        return int(self.class_sensation.shape[0])
+
+    @property
+    def n_sensed(self) -> int:
+        """Reachable poses whose sensation is true."""
+        return int(np.count_nonzero(self.sensation))
+
+    @property
+    def n_joints(self) -> int:
+        return int(self.angles_deg.shape[1])
+
+    def pose_index(self, angles_deg: Sequence[int]) -> int:
+        """Index of the pose with these joint angles (degrees, taken modulo 360)."""
+        angles = list(angles_deg)
+        if len(angles) != self.n_joints:
+            raise TruthError(
+                f"{self.scenario_name}: expected {self.n_joints} joint angles, "
+                f"found {len(angles)}: {angles!r}"
+            )
+        try:
+            code = sum((operator.index(a) % 360) * 360**i for i, a in enumerate(angles))
+        except TypeError:
+            raise TruthError(
+                f"{self.scenario_name}: joint angles must be integers, found {angles!r}"
+            ) from None
+        index = int(np.searchsorted(self.pose_codes, code))
+        if index == self.n_poses or int(self.pose_codes[index]) != code:
+            raise TruthError(
+                f"{self.scenario_name}: the pose {[a % 360 for a in angles]} "
+                f"is not reachable from the start pose"
+            )
+        return index
+
+    def class_of(self, angles_deg: Sequence[int]) -> int:
+        """Class (minimal machine state) of the pose with these joint angles."""
+        return int(self.true_class[self.pose_index(angles_deg)])
+
+    def minimal_model(self) -> TransitionSystem:
+        """The minimal machine as a deterministic, complete model; current = start class 0."""
+        model = TransitionSystem(self.n_classes, actions=self.actions)
+        for c, row in enumerate(self.class_next.tolist()):
+            for action, target in zip(self.actions, row, strict=True):
+                model.add(c, target, action)
+        model.drain_operations()
+        return model
+
+    def class_labels(self) -> dict[int, bool]:
+        """The sensation of every class, as :func:`check_equivalence` takes labels."""
+        return dict(enumerate(self.class_sensation.tolist()))
+
+    def to_json(self) -> dict[str, object]:
+        """A JSON-ready summary (sizes and timing, not the machine itself)."""
+        return {
+            "scenario": self.scenario_name,
+            "actions": list(self.actions),
+            "reachable_poses": self.n_poses,
+            "sensed_poses": self.n_sensed,
+            "minimal_model_states": self.n_classes,
+            "seconds": round(self.seconds, 6),
+        }
+
+
+def format_truth(truth: GroundTruth) -> str:
+    """Human-readable summary lines (for ``rsstp-sim truth``)."""
+    return "\n".join(
+        [
+            f"scenario: {truth.scenario_name}",
+            f"actions: {' '.join(map(str, truth.actions))}",
+            f"reachable poses: {truth.n_poses:,}",
+            f"sensed poses: {truth.n_sensed:,}",
+            f"minimal model: {truth.n_classes:,} states",
+            f"seconds: {truth.seconds:.3f}",
+        ]
+    )
+
+
+# --------------------------------------------------------------- enumeration
+
+
+def pose_space_size(scenario: Scenario) -> int:
+    """An upper bound on the reachable poses, known before enumerating.
+
+    Joint ``k`` only takes the angles ``initial_k + j * gcd(step, 360)`` (mod
+    360), that is ``360 / gcd(step, 360)`` values, and keeps its initial angle
+    when no action turns it.
+    """
+    return math.prod(_lattice_sizes(scenario))
+
+
+def _lattice_sizes(scenario: Scenario) -> list[int]:
+    values = 360 // math.gcd(scenario.step_deg, 360)
+    moving = {a // 2 for a in scenario.actions}
+    return [values if k in moving else 1 for k in range(scenario.n_joints)]
+
+
+def compute_truth(scenario: Scenario, *, max_poses: int = 2_000_000) -> GroundTruth:
+    """Enumerate the reachable poses of ``scenario`` and minimise their Moore machine.
+
+    Refuses (:class:`TruthError`) when :func:`pose_space_size` exceeds ``max_poses``.
+    """
+    started = time.perf_counter()
+    bound = pose_space_size(scenario)
+    if bound > max_poses:
+        raise TruthError(
+            f"{scenario.name}: the pose space has {bound:,} poses, more than the "
+            f"limit of {max_poses:,} (pass a larger max_poses)"
+        )
+    geo = ArmGeometry.from_scenario(scenario)
+    pose_codes, next_pose, start_index = _enumerate(scenario, geo)
+    radix = 360 ** np.arange(scenario.n_joints, dtype=np.int64)
+    angles = (pose_codes[:, None] // radix) % 360
+    sensation = _sensation(scenario, geo, angles)
+    blocked = next_pose == np.arange(len(pose_codes))[:, None]
+
+    classes = _refine(next_pose, sensation)
+    true_class, class_next, class_sensation = _canonical(classes, next_pose, sensation, start_index)
+    return GroundTruth(
+        scenario_name=scenario.name,
+        actions=tuple(scenario.actions),
+        pose_codes=pose_codes,
+        angles_deg=angles,
+        sensation=sensation,
+        next_pose=next_pose,
+        blocked=blocked,
+        start_index=start_index,
+        true_class=true_class,
+        class_next=class_next,
+        class_sensation=class_sensation,
+        seconds=time.perf_counter() - started,
+    )
+
+
+def _enumerate(scenario: Scenario, geo: ArmGeometry) -> tuple[IntArray, IntArray, int]:
+    """Breadth-first search over frontiers: sorted pose codes, next-pose indices, start index."""
+    n = scenario.n_joints
+    radix = 360 ** np.arange(n, dtype=np.int64)
+    actions = np.asarray(scenario.actions, dtype=np.int64)
+    n_actions = len(actions)
+    action_joint = actions // 2
+    action_delta = np.where(actions % 2 == 0, scenario.step_deg, -scenario.step_deg)
+    code_step = action_delta * radix[action_joint]
+
+    # Dense visited flags over the lattice of angles a joint can take (see pose_space_size).
+    sizes = np.asarray(_lattice_sizes(scenario), dtype=np.int64)
+    spacing = math.gcd(scenario.step_deg, 360)
+    lattice_radix = np.concatenate([[1], np.cumprod(sizes)[:-1]]).astype(np.int64)
+    initial = np.asarray(scenario.initial_deg, dtype=np.int64)
+    visited = np.zeros(int(sizes.prod()), dtype=bool)
+
+    def lattice(codes: IntArray) -> IntArray:
+        angles = (codes[:, None] // radix) % 360
+        return np.asarray((((angles - initial) % 360) // spacing) @ lattice_radix)
+
+    start = np.array([int(initial @ radix)], dtype=np.int64)
+    visited[lattice(start)] = True
+    found, moves = [start], []
+    frontier = start
+    rows_per_chunk = max(1, CHUNK_ROWS // n_actions)
+    while frontier.size:
+        targets = np.empty((len(frontier), n_actions), dtype=np.int64)
+        for lo in range(0, len(frontier), rows_per_chunk):
+            codes = frontier[lo : lo + rows_per_chunk]
+            starts = np.repeat((codes[:, None] // radix) % 360, n_actions, axis=0)
+            joints = np.tile(action_joint, len(codes))
+            deltas = np.tile(action_delta, len(codes))
+            free = geometry.move_blockers(geo, starts, joints, deltas) == 0
+            # A turn that wraps past 0 or 360 changes the code by -/+ 360 * radix.
+            turned = starts[np.arange(len(starts)), joints] + deltas
+            wrap = (turned // 360) * 360 * radix[joints]
+            moved = np.repeat(codes, n_actions) + np.tile(code_step, len(codes)) - wrap
+            targets[lo : lo + len(codes)] = np.where(
+                free, moved, np.repeat(codes, n_actions)
+            ).reshape(-1, n_actions)
+        moves.append(targets)
+        candidates = np.unique(targets)
+        cells = lattice(candidates)
+        fresh = ~visited[cells]
+        visited[cells[fresh]] = True
+        frontier = candidates[fresh]
+        found.append(frontier)
+
+    codes = np.concatenate(found)
+    order = np.argsort(codes)
+    pose_codes = codes[order]
+    next_pose = np.searchsorted(pose_codes, np.concatenate(moves)[order]).astype(np.int64)
+    return pose_codes, next_pose, int(np.searchsorted(pose_codes, start[0]))
+
+
+def _sensation(scenario: Scenario, geo: ArmGeometry, angles: IntArray) -> BoolArray:
+    points = np.asarray(scenario.feedback_points, dtype=np.float64)
+    tolerance_abs = scenario.tolerance * scenario.total_length
+    sensation = np.empty(len(angles), dtype=bool)
+    for lo in range(0, len(angles), CHUNK_ROWS):
+        tips = geometry.joint_positions(angles[lo : lo + CHUNK_ROWS], geo.lengths)[:, 1:]
+        sensation[lo : lo + CHUNK_ROWS] = geometry.feedback(
+            tips, points, geo.lengths, tolerance_abs
+        )[0]
+    return sensation
+
+
+# -------------------------------------------------------------- minimisation
+
+
+def _refine(next_pose: IntArray, sensation: BoolArray) -> IntArray:
+    """Moore's partition refinement: the coarsest stable partition, as a class per pose.
+
+    Each round splits classes by the signature (class, class of each successor),
+    compressed column by column with ``np.unique`` so keys stay below ``P**2``.
+    """
+    classes = np.unique(sensation, return_inverse=True)[1].astype(np.int64).ravel()
+    count = int(classes.max()) + 1
+    while True:
+        keys = classes
+        width = count
+        for k in range(next_pose.shape[1]):
+            combined = keys * count + classes[next_pose[:, k]]
+            uniques, keys = np.unique(combined, return_inverse=True)
+            keys = keys.ravel()
+            width = len(uniques)
+        if width == count:
+            return classes
+        classes, count = keys, width
+
+
+def _canonical(
+    classes: IntArray, next_pose: IntArray, sensation: BoolArray, start_index: int
+) -> tuple[IntArray, IntArray, BoolArray]:
+    """Renumber classes breadth-first from the start class; the quotient machine."""
+    n_classes = int(classes.max()) + 1
+    representative = np.empty(n_classes, dtype=np.int64)
+    representative[classes] = np.arange(len(classes))
+    quotient_next = classes[next_pose[representative]]
+
+    number = np.full(n_classes, -1, dtype=np.int64)
+    frontier = classes[[start_index]]
+    number[frontier] = 0
+    assigned = 1
+    while frontier.size:
+        successors = quotient_next[frontier].ravel()
+        first = np.sort(np.unique(successors, return_index=True)[1])
+        candidates = successors[first]
+        frontier = candidates[number[candidates] < 0]
+        number[frontier] = np.arange(assigned, assigned + len(frontier))
+        assigned += len(frontier)
+
+    class_next = np.empty_like(quotient_next)
+    class_next[number] = number[quotient_next]
+    class_sensation = np.empty(n_classes, dtype=bool)
+    class_sensation[number] = sensation[representative]
+    return number[classes], class_next, class_sensation
+
+
+# --------------------------------------------------------------- equivalence
+
+
+def check_equivalence(
+    model: TransitionSystem,
+    labels: Mapping[int, bool],
+    truth: GroundTruth,
+    *,
+    start_state: int | None = None,
+) -> tuple[int, ...] | None:
+    """The shortest action sequence on which ``model`` and the truth disagree, or None.
+
+    ``labels[s]`` is the sensation the model predicts in state ``s``. From
+    ``start_state`` (default: ``model.current``) and the start class, the
+    product of model states and true classes is explored breadth-first over
+    ``truth.actions`` in order. The answer is the first sequence found (so the
+    shortest, ties broken by action order) after which the model's state has
+    no label or the wrong one, or whose last action has no successor or
+    several successors in the model. ``()`` means the start already disagrees;
+    None means the model is equivalent on everything reachable.
+    """
+    start = model.current if start_state is None else start_state
+    if start not in model:
+        raise ModelError(f"check_equivalence: unknown start state {start!r}")
+    class_next = truth.class_next.tolist()
+    class_sensation = truth.class_sensation.tolist()
+
+    def wrong(state: int, c: int) -> bool:
+        label = labels.get(state)
+        return label is None or bool(label) != class_sensation[c]
+
+    origin = (start, 0)
+    if wrong(*origin):
+        return ()
+    parent: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}
+    seen = {origin}
+    queue = deque([origin])
+
+    def path(pair: tuple[int, int], last: int) -> tuple[int, ...]:
+        sequence = [last]
+        while pair != origin:
+            pair, action = parent[pair]
+            sequence.append(action)
+        return tuple(reversed(sequence))
+
+    while queue:
+        pair = queue.popleft()
+        state, c = pair
+        for k, action in enumerate(truth.actions):
+            successors = model.successors(state, action)
+            if len(successors) != 1:
+                return path(pair, action)
+            following = (successors[0], class_next[c][k])
+            if following in seen:
+                continue
+            if wrong(*following):
+                return path(pair, action)
+            seen.add(following)
+            parent[following] = (pair, action)
+            queue.append(following)
+    return None
