@@ -19,6 +19,7 @@ so moving-versus-fixed link contacts reduce to the same arc-segment test.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Literal, Protocol
@@ -47,8 +48,11 @@ IntArray = NDArray[np.int64]
 
 
 def _trig_tables() -> tuple[FloatArray, FloatArray]:
-    radians = np.deg2rad(np.arange(360, dtype=np.float64))
-    cos, sin = np.cos(radians), np.sin(radians)
+    # libm (math) rather than numpy's SIMD kernels: the same table on every CPU,
+    # so recordings are byte-identical across machines.
+    radians = [math.radians(d) for d in range(360)]
+    cos = np.array([math.cos(r) for r in radians], dtype=np.float64)
+    sin = np.array([math.sin(r) for r in radians], dtype=np.float64)
     # Exact values where they exist, so poses on the axes compare exactly.
     cos[[90, 270]] = 0.0
     sin[[0, 180]] = 0.0
