@@ -1,0 +1,172 @@
+"""The JSON Schemas of a recording, as shipped in the package (``rsstp_sim/schemas/*.json``).
+
+A recording registers each schema's file byte for byte (:func:`schema_bytes`), so the
+files are part of the contract; ``schemas/README.md`` documents every field, the topics,
+the metadata record, the attachment and the version policy: a reader accepts any ``1.x``
+(ignoring fields it does not know) and refuses another major version
+(:func:`check_schema_version`).
+
+>>> TOPICS["/rsstp/step"]
+'rsstp.Step'
+>>> schema_json("rsstp.Step")["version"] == SCHEMA_VERSION
+True
+>>> parse_version("1.2")
+(1, 2)
+"""
+
+from __future__ import annotations
+
+import functools
+import json
+import re
+from collections.abc import Mapping
+from importlib import resources
+from typing import Any
+
+from jsonschema import Draft202012Validator
+from jsonschema.exceptions import best_match
+
+from rsstp_sim.recording.records import RecordFormatError
+
+__all__ = [
+    "ATTACHMENT_MEDIA_TYPE",
+    "ATTACHMENT_NAME",
+    "MESSAGE_ENCODING",
+    "METADATA_KEYS",
+    "METADATA_NAME",
+    "SCHEMA_ENCODING",
+    "SCHEMA_NAMES",
+    "SCHEMA_VERSION",
+    "STEP_NS",
+    "TOPICS",
+    "check_schema_version",
+    "log_time_ns",
+    "parse_version",
+    "schema_bytes",
+    "schema_json",
+    "validate",
+    "validator",
+]
+
+SCHEMA_VERSION = "1.0"
+"""The version (``major.minor``) of the schemas this package writes."""
+
+SCHEMA_NAMES = ("rsstp.Scenario", "rsstp.Step", "rsstp.Model", "rsstp.Event")
+"""The MCAP schema names, which are also the schemas' titles and file names."""
+
+TOPICS: dict[str, str] = {
+    "/rsstp/scenario": "rsstp.Scenario",
+    "/rsstp/step": "rsstp.Step",
+    "/rsstp/model": "rsstp.Model",
+    "/rsstp/event": "rsstp.Event",
+}
+"""Topic -> schema name."""
+
+MESSAGE_ENCODING = "json"
+SCHEMA_ENCODING = "jsonschema"
+
+STEP_NS = 1_000_000
+"""``log_time`` of step ``t`` is ``t * STEP_NS`` nanoseconds: time ranges are step ranges."""
+
+METADATA_NAME = "rsstp"
+METADATA_KEYS = (
+    "package",
+    "package_version",
+    "python",
+    "numpy",
+    "shapely",
+    "mcap",
+    "seed",
+    "strategy",
+    "strategy_params",
+    "scenario_sha256",
+)
+"""The keys of the ``rsstp`` metadata record (every value a string)."""
+
+ATTACHMENT_NAME = "scenario.toml"
+ATTACHMENT_MEDIA_TYPE = "application/toml"
+
+_VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
+
+
+def log_time_ns(step: int) -> int:
+    """The ``log_time`` (and ``publish_time``) of step ``step``, in nanoseconds."""
+    return step * STEP_NS
+
+
+def parse_version(text: object) -> tuple[int, int]:
+    """``"major.minor"`` -> ``(major, minor)``; anything else raises :class:`RecordFormatError`."""
+    match = _VERSION.fullmatch(text) if isinstance(text, str) else None
+    if match is None:
+        raise RecordFormatError(f'schema version: expected "major.minor", found {text!r}')
+    return int(match[1]), int(match[2])
+
+
+def schema_bytes(name: str) -> bytes:
+    """The packaged schema file's exact bytes (what a recording registers)."""
+    return _schema_bytes(_known(name))
+
+
+def schema_json(name: str) -> dict[str, Any]:
+    """The packaged schema, parsed (a fresh dict on every call)."""
+    parsed: dict[str, Any] = json.loads(schema_bytes(name))
+    return parsed
+
+
+def validator(name: str) -> Draft202012Validator:
+    """A (cached) draft 2020-12 validator for the packaged schema ``name``."""
+    return _validator(_known(name))
+
+
+def validate(name: str, instance: Mapping[str, Any]) -> None:
+    """Check a decoded message against schema ``name``, ranges included.
+
+    Raises :class:`RecordFormatError` naming the field path of the most relevant error.
+    """
+    error = best_match(validator(name).iter_errors(instance))
+    if error is not None:
+        path = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.absolute_path)
+        where = f"{path.removeprefix('.')}: " if path else ""
+        raise RecordFormatError(f"{name}: {where}{error.message}")
+
+
+def check_schema_version(name: str, data: bytes) -> tuple[int, int]:
+    """Check a schema found in a recording: title ``name`` and a ``1.x`` version.
+
+    Returns ``(major, minor)``. A later minor version is accepted (its new fields are
+    ignored); another major version, or a schema that is not ours, is refused.
+    """
+    try:
+        schema = json.loads(data)
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise RecordFormatError(f"{name}: the schema is not JSON: {exc}") from None
+    if not isinstance(schema, dict) or schema.get("title") != name:
+        found = schema.get("title") if isinstance(schema, dict) else schema
+        raise RecordFormatError(f"{name}: the schema's title: expected {name!r}, found {found!r}")
+    try:
+        major, minor = parse_version(schema.get("version"))
+    except RecordFormatError as exc:
+        raise RecordFormatError(f"{name}: {exc}") from None
+    supported, _ = parse_version(SCHEMA_VERSION)
+    if major != supported:
+        raise RecordFormatError(
+            f"{name}: schema version {major}.{minor} is not supported "
+            f"(this reader understands {supported}.x)"
+        )
+    return major, minor
+
+
+def _known(name: str) -> str:
+    if name not in SCHEMA_NAMES:
+        raise RecordFormatError(f"unknown schema {name!r} (known: {', '.join(SCHEMA_NAMES)})")
+    return name
+
+
+@functools.cache
+def _schema_bytes(name: str) -> bytes:
+    return resources.files("rsstp_sim").joinpath(f"schemas/{name}.json").read_bytes()
+
+
+@functools.cache
+def _validator(name: str) -> Draft202012Validator:
+    return Draft202012Validator(json.loads(_schema_bytes(name)))
