@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -82,6 +83,13 @@ def _non_negative(text: str) -> int:
     return value
 
 
+def _chunk_size(text: str) -> int:
+    value = _non_negative(text)
+    if value < 1024:
+        raise argparse.ArgumentTypeError(f"expected at least 1024 bytes, got {text!r}")
+    return value
+
+
 def _runner(args: argparse.Namespace) -> Runner:
     scenario = load_scenario(args.scenario)
     strategy = make_strategy(args.strategy, _parse_params(args.param))
@@ -134,6 +142,60 @@ def _cmd_graph(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_record(args: argparse.Namespace) -> int:
+    from rsstp_sim.recording.recorder import Recorder
+
+    scenario = load_scenario(args.scenario)
+    strategy = make_strategy(args.strategy, _parse_params(args.param))
+    recorder = Recorder(
+        args.output,
+        scenario,
+        strategy,
+        seed=args.seed,
+        chunk_size=args.chunk_size,
+        force=args.force,
+    )
+    received: list[int] = []
+
+    def stop(signum: int, _frame: object) -> None:
+        received.append(signum)
+        recorder.request_stop()
+
+    previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
+    show = _progress_printer(args.steps) if sys.stderr.isatty() else None
+    try:
+        result = recorder.run(args.steps, progress=show)
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+        if show is not None:
+            print(file=sys.stderr)
+    counts = ", ".join(f"{topic} {count}" for topic, count in result.messages.items())
+    if result.interrupted:
+        name = signal.Signals(received[0]).name if received else "a stop request"
+        print(
+            f"{PROG}: interrupted by {name}: kept {result.steps} steps in {result.path} "
+            f"(file finished)",
+            file=sys.stderr,
+        )
+        return 128 + received[0] if received else 1
+    print(f"recorded {result.steps} steps to {result.path} ({counts})")
+    return 0
+
+
+def _progress_printer(total: int) -> Callable[[int], None]:
+    def show(done: int) -> None:
+        percent = 100.0 * done / total if total else 100.0
+        print(
+            f"\rrecording: {done:,}/{total:,} steps ({percent:.0f}%)",
+            end="",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    return show
+
+
 def _build_parser() -> _Parser:
     parser = _Parser(prog=PROG, description="RSSTP simulator: scenarios, strategies, models.")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -155,6 +217,19 @@ def _build_parser() -> _Parser:
     p.add_argument("-o", "--output", required=True, help="output file: .svg, .png, .pdf or .dot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(func=_cmd_graph)
+
+    p = sub.add_parser("record", help="run a strategy and record every step to an MCAP file")
+    _add_run_arguments(p, steps_default=1000)
+    p.add_argument("-o", "--output", required=True, help="the .mcap file to write")
+    p.add_argument(
+        "--chunk-size",
+        type=_chunk_size,
+        default=1024 * 1024,
+        metavar="BYTES",
+        help="uncompressed bytes per MCAP chunk (default 1 MiB)",
+    )
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.set_defaults(func=_cmd_record)
     return parser
 
 

@@ -1,0 +1,421 @@
+"""The recorder: writes a run to MCAP as it happens (DESIGN.md section 4).
+
+A layer around :class:`~rsstp_sim.coupling.Runner`, the way a monitor wraps an
+environment: the world and the model do not know a file exists. The recorder
+observes each step's outcome, the model operations and the events through the
+runner's callbacks and writes:
+
+- ``/rsstp/scenario`` once, then ``/rsstp/step`` for step 0 (the reset) and
+  every step after, ``/rsstp/model`` at step 0 and whenever the model changes,
+  ``/rsstp/event`` for blocked moves, model operations, steps with no
+  transition and strategy notes;
+- a metadata record ``rsstp`` and the attachment ``scenario.toml``.
+
+``log_time`` of step ``t`` is ``t * 1_000_000`` ns; no wall-clock time is
+written, so the same scenario, strategy and seed give the same bytes.
+
+Crash safety: the file is written without a user-space buffer, so every chunk
+the writer completes is on disk at once; after a SIGKILL all complete chunks
+can be recovered by a sequential reader. :meth:`Recorder.request_stop` (what
+the CLI's SIGINT/SIGTERM handlers call) ends the run after the current step and
+the file is finished properly.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import platform
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from importlib import metadata
+from pathlib import Path
+
+import msgspec
+from mcap.writer import CompressionType, Writer
+
+from rsstp_sim.coupling import Event, Runner, StepOutcome
+from rsstp_sim.errors import RecordingError
+from rsstp_sim.recording import records
+from rsstp_sim.recording.schemas import (
+    ATTACHMENT_MEDIA_TYPE,
+    ATTACHMENT_NAME,
+    METADATA_KEYS,
+    METADATA_NAME,
+    SCHEMA_NAMES,
+    STEP_NS,
+    TOPICS,
+    schema_bytes,
+)
+from rsstp_sim.scenario import Scenario
+from rsstp_sim.strategies import Strategy
+from rsstp_sim.transition_system import Operation
+from rsstp_sim.world import Pose
+
+_json = msgspec.json.Encoder().encode
+"""The same encoder as ``records.encode``, so hand-assembled step bytes equal it."""
+
+__all__ = ["DEFAULT_CHUNK_SIZE", "RecordResult", "Recorder", "environment_versions", "record"]
+
+DEFAULT_CHUNK_SIZE = 1024 * 1024
+"""Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
+
+_VERSION_KEYS = ("package_version", "python", "numpy", "shapely", "mcap")
+
+
+def environment_versions() -> dict[str, str]:
+    """The versions a recording's metadata names: this package, Python and key libraries."""
+
+    def version(dist: str) -> str:
+        try:
+            return metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            return "unknown"
+
+    from rsstp_sim import __version__
+
+    return {
+        "package_version": __version__,
+        "python": platform.python_version(),
+        "numpy": version("numpy"),
+        "shapely": version("shapely"),
+        "mcap": version("mcap"),
+    }
+
+
+@dataclass(frozen=True, slots=True)
+class RecordResult:
+    """What a recording run wrote."""
+
+    path: Path
+    steps: int
+    messages: dict[str, int]
+    interrupted: bool
+
+
+class _UnbufferedFile:
+    """A write-through file for the MCAP writer: each completed chunk reaches the OS at once.
+
+    (The writer would wrap a raw file in a ``BufferedWriter``, which could keep
+    the tail of a chunk in memory when the process is killed.)
+    """
+
+    def __init__(self, raw: io.FileIO) -> None:
+        self._raw = raw
+
+    def write(self, data: bytes | bytearray | memoryview) -> int:
+        view = memoryview(data)
+        while view:
+            written = self._raw.write(view)
+            if written is None:  # pragma: no cover - only for non-blocking files
+                continue
+            view = view[written:]
+        return len(data)
+
+    def tell(self) -> int:
+        return self._raw.tell()
+
+    def flush(self) -> None:
+        return None
+
+    def close(self) -> None:
+        self._raw.close()
+
+
+def _open_output(path: Path, *, force: bool) -> io.FileIO:
+    """Open ``path`` for writing, refusing to overwrite without ``force``."""
+    parent = path.parent if str(path.parent) else Path(".")
+    if path.is_dir():
+        raise RecordingError(f"{path}: is a directory, not an output file")
+    if not parent.is_dir():
+        raise RecordingError(f"{path}: the output directory {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise RecordingError(f"{path}: the output directory {parent} is not writable")
+    if path.exists() and not force:
+        raise RecordingError(f"{path}: already exists (use --force to overwrite)")
+    try:
+        return io.FileIO(path, "wb" if force else "xb")
+    except FileExistsError:
+        raise RecordingError(f"{path}: already exists (use --force to overwrite)") from None
+    except OSError as exc:
+        raise RecordingError(f"{path}: cannot open for writing: {exc.strerror or exc}") from None
+
+
+class Recorder:
+    """Runs a strategy in a scenario and records every step to an MCAP file.
+
+    ``versions`` overrides the library versions written in the metadata (used
+    to reproduce a reference recording byte for byte on newer libraries).
+    """
+
+    def __init__(
+        self,
+        path: str | Path,
+        scenario: Scenario,
+        strategy: Strategy,
+        *,
+        seed: int,
+        chunk_size: int = DEFAULT_CHUNK_SIZE,
+        force: bool = False,
+        versions: Mapping[str, str] | None = None,
+    ) -> None:
+        if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1024:
+            raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
+        self.path = Path(path)
+        self._pending_events: list[records.EventRecord] = []
+        self._pending_models: list[records.ModelRecord] = []
+        self.runner = Runner(
+            scenario,
+            strategy,
+            seed=seed,
+            on_event=self._on_event,
+            on_model_change=self._on_model_change,
+        )
+        self._versions = dict(environment_versions())
+        if versions is not None:
+            self._versions.update({k: v for k, v in versions.items() if k in _VERSION_KEYS})
+        self._stop = False
+        self._pose_parts: dict[int, tuple[bytes, bytes]] = {}
+        self._counts = dict.fromkeys(TOPICS, 0)
+        self._raw = _open_output(self.path, force=force)
+        self._file = _UnbufferedFile(self._raw)
+        self._writer = Writer(
+            self._file,  # type: ignore[arg-type]
+            chunk_size=chunk_size,
+            compression=CompressionType.ZSTD,
+        )
+        self._closed = False
+        try:
+            self._write_header(scenario, strategy, seed)
+        except BaseException:
+            self._abort()
+            raise
+
+    # -- callbacks from the runner -------------------------------------------
+
+    def _on_event(self, event: Event) -> None:
+        # Steps with no transition are recorded from the step outcome (it has the
+        # state and the action); the runner's events add the strategy notes.
+        if event.kind == "note":
+            self._pending_events.append(records.note_event(event.step, event.text))
+
+    def _on_model_change(self, step: int, operations: Sequence[Operation]) -> None:
+        self._pending_models.append(
+            records.model_record(self.runner.model, step=step, operations=operations)
+        )
+        self._pending_events.extend(records.operation_events(step, operations))
+
+    # -- writing ----------------------------------------------------------------
+
+    def _write_header(self, scenario: Scenario, strategy: Strategy, seed: int) -> None:
+        writer = self._writer
+        writer.start(profile="", library=f"rsstp {self._versions['package_version']}")
+        self._channels: dict[str, int] = {}
+        schema_ids = {
+            name: writer.register_schema(name, "jsonschema", schema_bytes(name))
+            for name in SCHEMA_NAMES
+        }
+        for topic, name in TOPICS.items():
+            self._channels[topic] = writer.register_channel(topic, "json", schema_ids[name])
+        params = dict(strategy.params())
+        meta = {
+            "package": "rsstp",
+            **self._versions,
+            "seed": str(seed),
+            "strategy": strategy.name,
+            "strategy_params": json.dumps(params, sort_keys=True),
+            "scenario_sha256": scenario.sha256,
+        }
+        writer.add_metadata(METADATA_NAME, {key: meta[key] for key in METADATA_KEYS})
+        writer.add_attachment(
+            0, 0, ATTACHMENT_NAME, ATTACHMENT_MEDIA_TYPE, scenario.source.encode("utf-8")
+        )
+        record = records.scenario_record(
+            scenario, seed=seed, strategy_name=strategy.name, strategy_params=params
+        )
+        self._add("/rsstp/scenario", 0, records.encode(record))
+        if not self._pending_models:  # step 0 always has the initial model
+            self._pending_models.append(
+                records.model_record(self.runner.model, step=0, operations=())
+            )
+        self._write_step_zero()
+
+    def _add(self, topic: str, step: int, data: bytes) -> None:
+        log_time = step * STEP_NS
+        self._writer.add_message(self._channels[topic], log_time, data, log_time)
+        self._counts[topic] += 1
+
+    def _pose_json(self, pose: Pose) -> tuple[bytes, bytes]:
+        """The pose's truth fields as JSON fragments, around the per-step blocked fields."""
+        parts = self._pose_parts.get(pose.code)
+        if parts is None:
+            before = _json(
+                {
+                    "angles_deg": list(pose.angles_deg),
+                    "joint_positions": pose.joint_positions.tolist(),
+                }
+            )
+            after = _json({"distances": pose.distances.tolist()})
+            parts = (before[1:-1] + b",", b"," + after[1:-1])
+            self._pose_parts[pose.code] = parts
+        return parts
+
+    def _step_bytes(self, step: int, outcome: StepOutcome | None, pose: Pose) -> bytes:
+        """Encode one ``rsstp.Step`` message (the same bytes as ``records.encode``)."""
+        runner = self.runner
+        if outcome is None:
+            agent = {
+                "action": None,
+                "state_before": None,
+                "internal_state": runner.model.current,
+                "sensation": pose.sensation,
+                "feedback": pose.feedback,
+                "model_version": runner.model.version,
+                "no_transition": False,
+            }
+            blocked = b'"blocked":false,"blocked_by":null'
+        else:
+            agent = {
+                "action": outcome.action,
+                "state_before": outcome.state_before,
+                "internal_state": outcome.state_after,
+                "sensation": pose.sensation,
+                "feedback": pose.feedback,
+                "model_version": runner.model.version,
+                "no_transition": outcome.no_transition,
+            }
+            blocker = outcome.blocker
+            if blocker is None:
+                blocked = b'"blocked":false,"blocked_by":null'
+            else:
+                blocked = b'"blocked":true,"blocked_by":' + _json(
+                    {"kind": blocker.kind, "indices": list(blocker.indices)}
+                )
+        before, after = self._pose_json(pose)
+        return b"".join(
+            (
+                b'{"step":',
+                str(step).encode(),
+                b',"agent":',
+                _json(agent),
+                b',"truth":{',
+                before,
+                blocked,
+                after,
+                b"}}",
+            )
+        )
+
+    def _lead_events(self, outcome: StepOutcome) -> None:
+        """The world acted first, then the internal transition: their events lead the step's."""
+        lead = []
+        if outcome.blocker is not None:
+            lead.append(
+                records.blocked_event(outcome.step, action=outcome.action, blocker=outcome.blocker)
+            )
+        if outcome.no_transition:
+            lead.append(
+                records.no_transition_event(
+                    outcome.step, state=outcome.state_before, action=outcome.action
+                )
+            )
+        self._pending_events[:0] = lead
+
+    def _flush_pending(self, step: int) -> None:
+        for model in self._pending_models:
+            self._add("/rsstp/model", step, records.encode(model))
+        for event in self._pending_events:
+            self._add("/rsstp/event", event.step, records.encode(event))
+        self._pending_models.clear()
+        self._pending_events.clear()
+
+    def _write_step_zero(self) -> None:
+        self._add("/rsstp/step", 0, self._step_bytes(0, None, self.runner.world.current))
+        self._flush_pending(0)
+
+    # -- running ------------------------------------------------------------------
+
+    def request_stop(self) -> None:
+        """Ask the run to end after the current step (safe from a signal handler)."""
+        self._stop = True
+
+    def run(self, steps: int, *, progress: Callable[[int], None] | None = None) -> RecordResult:
+        """Take and record ``steps`` steps, then finish the file.
+
+        ``progress`` is called with the number of steps done every 4096 steps.
+        Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`.
+        """
+        if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
+            raise RecordingError(f"steps must be an integer >= 0, got {steps!r}")
+        runner = self.runner
+        world = runner.world
+        step = runner.step
+        add = self._writer.add_message
+        channel = self._channels["/rsstp/step"]
+        pending_models, pending_events = self._pending_models, self._pending_events
+        done = 0
+        try:
+            while done < steps and not self._stop:
+                outcome = step()
+                t = outcome.step
+                pose = world.current
+                data = self._step_bytes(t, outcome, pose)
+                add(channel, t * STEP_NS, data, t * STEP_NS)
+                if outcome.blocker is not None or outcome.no_transition:
+                    self._lead_events(outcome)
+                if pending_models or pending_events:
+                    self._flush_pending(t)
+                done += 1
+                if progress is not None and not done & 4095:
+                    progress(done)
+        except BaseException:
+            self._counts["/rsstp/step"] += done
+            self.close()
+            raise
+        self._counts["/rsstp/step"] += done
+        self.close()
+        return RecordResult(self.path, runner.step_index, dict(self._counts), self._stop)
+
+    def close(self) -> None:
+        """Finish the file (summary and indexes) and close it; idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        try:
+            self._writer.finish()
+        finally:
+            self._file.close()
+
+    def _abort(self) -> None:
+        self._closed = True
+        self._file.close()
+        self.path.unlink(missing_ok=True)
+
+    @property
+    def counts(self) -> Mapping[str, int]:
+        return dict(self._counts)
+
+
+def record(
+    path: str | Path,
+    scenario: Scenario,
+    strategy: Strategy,
+    *,
+    steps: int,
+    seed: int,
+    chunk_size: int = DEFAULT_CHUNK_SIZE,
+    force: bool = False,
+    versions: Mapping[str, str] | None = None,
+) -> RecordResult:
+    """Record ``steps`` steps of ``strategy`` in ``scenario`` to ``path`` (one call)."""
+    recorder = Recorder(
+        path,
+        scenario,
+        strategy,
+        seed=seed,
+        chunk_size=chunk_size,
+        force=force,
+        versions=versions,
+    )
+    return recorder.run(steps)
