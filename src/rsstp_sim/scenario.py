@@ -5,7 +5,7 @@ boundary; a bad file raises :class:`~rsstp_sim.errors.ScenarioError` whose
 message names the file, the key path and what was expected::
 
     [arm]
-    lengths = [3.0, 2.0, 1.0]      # > 0
+    lengths = [3.0, 2.0, 1.0]      # > 0, at most 7 links
     initial_deg = [330, 3, 357]     # integers, one per joint (taken modulo 360)
     step_deg = 5                    # integer in 1..359
     actions = [0, 1, 2, 3, 4, 5]    # optional subset of 0..2n-1 (default: all)
@@ -54,6 +54,8 @@ _SECTIONS: dict[str, frozenset[str]] = {
 }
 _TOP_LEVEL = frozenset({"name", "description", "arm", "obstacles", "feedback", "motion"})
 _OBSTACLE_KEYS = frozenset({"center", "radius"})
+MAX_JOINTS = 7
+"""Most links an arm may have: the world numbers poses as int64 ``sum(angle_i * 360**i)``."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -210,6 +212,8 @@ class _Validator:
             self.number(v, f"arm.lengths[{i}]", positive=True) for i, v in enumerate(lengths_raw)
         )
         n = len(lengths)
+        if n > MAX_JOINTS:
+            raise self.fail("arm.lengths", f"at most {MAX_JOINTS} links", f"{n} items")
         initial_raw = self.array(arm.get("initial_deg", _MISSING), "arm.initial_deg", length=n)
         initial = tuple(
             self.integer(v, f"arm.initial_deg[{i}]") % 360 for i, v in enumerate(initial_raw)
