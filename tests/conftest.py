@@ -1,0 +1,75 @@
+"""Shared fixtures: scenario TOML text from plain dicts, and scenario files in ``tmp_path``."""
+
+from __future__ import annotations
+
+import copy
+import json
+from collections.abc import Callable, Mapping
+from pathlib import Path
+
+import pytest
+
+ScenarioText = Callable[[Mapping[str, object]], str]
+WriteScenario = Callable[..., Path]
+
+VALID_SCENARIO: dict[str, object] = {
+    "name": "two-links",
+    "description": "two links, one obstacle out of the way",
+    "arm": {"lengths": [2.0, 1.0], "initial_deg": [0, 90], "step_deg": 5},
+    "obstacles": [{"center": [-2.0, -2.0], "radius": 0.5}],
+    "feedback": {"target_deg": [0, 90], "mode": "bool", "tolerance": 1e-6},
+    "motion": {"collision": "swept"},
+}
+"""A valid two-link scenario; tests copy it and break one key at a time."""
+
+
+def _toml_value(value: object) -> str:
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, int | float):
+        return repr(value)  # nan and inf are valid TOML floats
+    if isinstance(value, str):
+        return json.dumps(value)
+    if isinstance(value, list | tuple):
+        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
+    raise TypeError(f"no TOML form for {value!r}")
+
+
+def toml_text(data: Mapping[str, object]) -> str:
+    """TOML for ``data``: top-level values, then ``[tables]`` and ``[[arrays of tables]]``."""
+    lines: list[str] = []
+    tables: list[tuple[str, Mapping[str, object]]] = []
+    for key, value in data.items():
+        if isinstance(value, Mapping):
+            tables.append((f"[{key}]", value))
+        elif isinstance(value, list) and value and all(isinstance(v, Mapping) for v in value):
+            tables.extend((f"[[{key}]]", v) for v in value)
+        else:
+            lines.append(f"{key} = {_toml_value(value)}")
+    for header, table in tables:
+        lines += ["", header, *(f"{k} = {_toml_value(v)}" for k, v in table.items())]
+    return "\n".join(lines) + "\n"
+
+
+@pytest.fixture(scope="session")
+def scenario_text() -> ScenarioText:
+    """Turns a scenario dict (as in :data:`VALID_SCENARIO`) into TOML text."""
+    return toml_text
+
+
+@pytest.fixture
+def scenario_data() -> dict[str, object]:
+    """A fresh deep copy of :data:`VALID_SCENARIO`, free to mutate."""
+    return copy.deepcopy(VALID_SCENARIO)
+
+
+@pytest.fixture
+def write_scenario(tmp_path: Path) -> WriteScenario:
+    """Writes TOML text to a file in ``tmp_path`` and returns its path."""
+
+    def write(text: str, name: str = "scenario.toml") -> Path:
+        path = tmp_path / name
+        path.write_text(text, encoding="utf-8")
+        return path
+
+    return write
