@@ -7,6 +7,7 @@ them one step at a time with one seeded generator per run.
 """
 
 from rsstp_sim.coupling import Event, Runner, RunSummary, StepOutcome
+from rsstp_sim.env import ArmEnv, register_envs
 from rsstp_sim.errors import (
     ActionError,
     GraphvizMissing,
@@ -32,11 +33,14 @@ from rsstp_sim.strategies import (
 from rsstp_sim.transition_system import DeterminismReport, Operation, TransitionSystem
 from rsstp_sim.world import Pose, World
 
+register_envs()
+
 __version__ = "0.1.0"
 
 __all__ = [
     "ActionError",
     "AgentView",
+    "ArmEnv",
     "Blocker",
     "CompareKind",
     "CompareResult",

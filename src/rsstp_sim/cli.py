@@ -183,6 +183,17 @@ def _cmd_record(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_truth(args: argparse.Namespace) -> int:
+    from rsstp_sim.truth import compute_truth, format_truth
+
+    truth = compute_truth(load_scenario(args.scenario), max_poses=args.max_poses)
+    if args.json:
+        print(json.dumps(truth.to_json(), indent=2))
+    else:
+        print(format_truth(truth))
+    return 0
+
+
 def _progress_printer(total: int) -> Callable[[int], None]:
     def show(done: int) -> None:
         percent = 100.0 * done / total if total else 100.0
@@ -230,6 +241,17 @@ def _build_parser() -> _Parser:
     )
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(func=_cmd_record)
+
+    p = sub.add_parser("truth", help="the ground truth: reachable poses and the minimal model")
+    p.add_argument("scenario", help="a built-in scenario name or a scenario .toml file")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.add_argument(
+        "--max-poses",
+        type=_non_negative,
+        default=2_000_000,
+        help="refuse larger pose spaces (default 2,000,000)",
+    )
+    p.set_defaults(func=_cmd_truth)
     return parser
 
 

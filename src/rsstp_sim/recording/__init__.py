@@ -9,6 +9,13 @@ files, topics and version policy.
 
 from __future__ import annotations
 
+from rsstp_sim.recording.recorder import (
+    DEFAULT_CHUNK_SIZE,
+    Recorder,
+    RecordResult,
+    environment_versions,
+    record,
+)
 from rsstp_sim.recording.records import (
     RECORD_TYPES,
     AgentRecord,
@@ -51,6 +58,11 @@ from rsstp_sim.recording.schemas import (
 )
 
 __all__ = [
+    "DEFAULT_CHUNK_SIZE",
+    "RecordResult",
+    "Recorder",
+    "environment_versions",
+    "record",
     "RECORD_TYPES",
     "SCHEMA_NAMES",
     "SCHEMA_VERSION",

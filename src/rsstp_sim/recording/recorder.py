@@ -383,7 +383,7 @@ class Recorder:
             return
         self._closed = True
         try:
-            self._writer.finish()
+            self._writer.finish()  # type: ignore[no-untyped-call]
         finally:
             self._file.close()
 
