@@ -164,7 +164,10 @@ class Recorder:
             raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
         self.path = Path(path)
         self._pending_events: list[records.EventRecord] = []
-        self._pending_models: list[records.ModelRecord] = []
+        # (step, operations): the model message is built when the step is written,
+        # since the runner also reports changes made during its own reset, before
+        # ``self.runner`` exists.
+        self._pending_models: list[tuple[int, tuple[Operation, ...]]] = []
         self.runner = Runner(
             scenario,
             strategy,
@@ -201,9 +204,7 @@ class Recorder:
             self._pending_events.append(records.note_event(event.step, event.text))
 
     def _on_model_change(self, step: int, operations: Sequence[Operation]) -> None:
-        self._pending_models.append(
-            records.model_record(self.runner.model, step=step, operations=operations)
-        )
+        self._pending_models.append((step, tuple(operations)))
         self._pending_events.extend(records.operation_events(step, operations))
 
     # -- writing ----------------------------------------------------------------
@@ -236,9 +237,7 @@ class Recorder:
         )
         self._add("/rsstp/scenario", 0, records.encode(record))
         if not self._pending_models:  # step 0 always has the initial model
-            self._pending_models.append(
-                records.model_record(self.runner.model, step=0, operations=())
-            )
+            self._pending_models.append((0, ()))
         self._write_step_zero()
 
     def _add(self, topic: str, step: int, data: bytes) -> None:
@@ -323,8 +322,10 @@ class Recorder:
         self._pending_events[:0] = lead
 
     def _flush_pending(self, step: int) -> None:
-        for model in self._pending_models:
-            self._add("/rsstp/model", step, records.encode(model))
+        model = self.runner.model
+        for model_step, operations in self._pending_models:
+            record = records.model_record(model, step=model_step, operations=operations)
+            self._add("/rsstp/model", step, records.encode(record))
         for event in self._pending_events:
             self._add("/rsstp/event", event.step, records.encode(event))
         self._pending_models.clear()
