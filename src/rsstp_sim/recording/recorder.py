@@ -347,8 +347,7 @@ class Recorder:
         ``progress`` is called with the number of steps done every 4096 steps.
         Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`.
         """
-        if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
-            raise RecordingError(f"steps must be an integer >= 0, got {steps!r}")
+        _check_steps(steps)
         runner = self.runner
         world = runner.world
         step = runner.step
@@ -398,6 +397,11 @@ class Recorder:
         return dict(self._counts)
 
 
+def _check_steps(steps: object) -> None:
+    if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
+        raise RecordingError(f"steps must be an integer >= 0, got {steps!r}")
+
+
 def record(
     path: str | Path,
     scenario: Scenario,
@@ -410,6 +414,7 @@ def record(
     versions: Mapping[str, str] | None = None,
 ) -> RecordResult:
     """Record ``steps`` steps of ``strategy`` in ``scenario`` to ``path`` (one call)."""
+    _check_steps(steps)  # before the file exists: bad input must not leave a file behind
     recorder = Recorder(
         path,
         scenario,
