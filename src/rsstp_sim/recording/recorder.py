@@ -129,7 +129,8 @@ def _open_output(path: Path, *, force: bool) -> io.FileIO:
     if path.is_dir():
         raise RecordingError(f"{path}: is a directory, not an output file")
     if not parent.is_dir():
-        raise RecordingError(f"{path}: the output directory {parent} does not exist")
+        found = "is not a directory" if parent.exists() else "does not exist"
+        raise RecordingError(f"{path}: the output directory {parent} {found}")
     if not os.access(parent, os.W_OK | os.X_OK):
         raise RecordingError(f"{path}: the output directory {parent} is not writable")
     if path.exists() and not force:
