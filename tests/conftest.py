@@ -22,6 +22,20 @@ VALID_SCENARIO: dict[str, object] = {
 }
 """A valid two-link scenario; tests copy it and break one key at a time."""
 
+THIN_OBSTACLE_TOML = """
+[arm]
+lengths = [2.0]
+initial_deg = [0]
+step_deg = 90
+[[obstacles]]
+center = [1.4, 1.4]
+radius = 0.1
+[motion]
+collision = "{mode}"
+"""
+"""One link of length 2 at 0 degrees turning by 90; a thin disk on the diagonal in between.
+The end pose is free, the swept motion is not: ``.format(mode="swept"|"endpoint")``."""
+
 
 def _toml_value(value: object) -> str:
     if isinstance(value, bool):

@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 import shapely
 
+from conftest import THIN_OBSTACLE_TOML
 from rsstp_sim import geometry
 from rsstp_sim.coupling import Event, Runner
 from rsstp_sim.errors import ScenarioError
@@ -54,17 +55,7 @@ def test_defect_01_link_inside_obstacle_is_a_collision() -> None:
 
 def test_defect_02_large_step_cannot_pass_through_an_obstacle() -> None:
     # One link of length 2 turning 90 degrees from 0; a thin disk sits on the diagonal.
-    text = """
-    [arm]
-    lengths = [2.0]
-    initial_deg = [0]
-    step_deg = 90
-    [[obstacles]]
-    center = [1.4, 1.4]
-    radius = 0.1
-    [motion]
-    collision = "{mode}"
-    """
+    text = THIN_OBSTACLE_TOML
     swept = parse_scenario(text.format(mode="swept"))
     assert geometry.pose_blocker(swept, [90]) is None  # the end pose alone is fine
     world = World(swept)

@@ -11,6 +11,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import LineString, Point
 
+from conftest import THIN_OBSTACLE_TOML
 from rsstp_sim import geometry
 from rsstp_sim.geometry import ArmGeometry, Blocker
 from rsstp_sim.scenario import parse_scenario
@@ -282,17 +283,7 @@ def test_pose_blockers_batch_matches_single_poses() -> None:
 
 def test_move_blockers_swept_and_endpoint() -> None:
     # One link of length 2 at 0 degrees; a small disk on the diagonal at distance 1.98.
-    text = """
-    [arm]
-    lengths = [2.0]
-    initial_deg = [0]
-    step_deg = 90
-    [[obstacles]]
-    center = [1.4, 1.4]
-    radius = 0.1
-    [motion]
-    collision = "{mode}"
-    """
+    text = THIN_OBSTACLE_TOML
     swept = ArmGeometry.from_scenario(parse_scenario(text.format(mode="swept")))
     endpoint = ArmGeometry.from_scenario(parse_scenario(text.format(mode="endpoint")))
     poses, joints, deltas = [[0], [0], [90]], [0, 0, 0], [90, -90, 90]

@@ -11,6 +11,7 @@ import shapely
 from hypothesis import assume, event, example, given, settings
 from hypothesis import strategies as st
 
+from conftest import THIN_OBSTACLE_TOML
 from rsstp_sim import geometry
 from rsstp_sim.errors import ActionError
 from rsstp_sim.geometry import Blocker
@@ -258,17 +259,7 @@ def test_swept_blocks_at_least_what_endpoint_blocks(scenario: Scenario) -> None:
 
 
 def test_large_step_cannot_jump_over_a_thin_obstacle_unless_endpoint() -> None:
-    text = """
-    [arm]
-    lengths = [2.0]
-    initial_deg = [0]
-    step_deg = 90
-    [[obstacles]]
-    center = [1.4, 1.4]
-    radius = 0.1
-    [motion]
-    collision = "{mode}"
-    """
+    text = THIN_OBSTACLE_TOML
     swept = World(parse_scenario(text.format(mode="swept")))
     assert swept.move(0) == Blocker("obstacle", (0, 0))
     assert swept.angles_deg == (0,)
