@@ -1,0 +1,216 @@
+"""The summary audit: what happened in a run, in numbers.
+
+For a researcher this is the first look at a run: how the model grew (states and transitions
+after every change), how hard the strategy worked on it (splits, merges, adds and deletes), how
+the world answered (blocked moves, sensations seen), how often the model could not predict a
+move at all (steps with no transition), and when the memory started to contradict the model
+(the first contradiction, and the last state to become contradictory: a strategy that learns
+should stop producing new ones), with the final model's size and determinism.
+
+The operations are counted from the model messages (``operations`` of every ``/rsstp/model``
+message, the first included: a strategy may reshape the model at reset); a no-op
+(``changed: false``) is not counted. Blocked moves and steps with no transition come from the
+steps table, sensations from the memory (every entry ``0 .. T``, the reset's included, as in
+the live run summary). Contradictions come from the consistency audit.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+import pandas as pd
+
+from rsstp_replay.audits.compare import HasMemory
+from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
+from rsstp_replay.audits.determinism import HasModelVersions
+from rsstp_sim.errors import ModelError
+from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = ["AuditSource", "ModelSize", "SummaryFindings", "audit_summary"]
+
+
+class AuditSource(HasMemory, HasModelVersions, Protocol):
+    """What the audits read from a recording (:class:`rsstp_replay.recording.Recording` has it).
+
+    - ``memory()``: the agent's :class:`~rsstp_sim.memory.Memory`;
+    - ``model_versions()``: the ``/rsstp/model`` messages, in order;
+    - ``steps()``: one row per step (0 is the reset) with at least the boolean columns
+      ``blocked`` and ``no_transition``.
+    """
+
+    def steps(self) -> pd.DataFrame: ...
+
+
+@dataclass(frozen=True, slots=True)
+class ModelSize:
+    """The model's size from step ``step`` on (version ``version``)."""
+
+    version: int
+    step: int
+    states: int
+    transitions: int
+
+
+@dataclass(frozen=True, slots=True)
+class SummaryFindings:
+    """The numbers of a run (see the module docstring).
+
+    ``sizes`` has one entry per model version; ``first_contradiction_step`` is the first step at
+    which the memory contradicted any state, ``last_contradiction_step`` the latest step at
+    which a state became contradictory (the largest ``first_step`` of the consistency audit).
+    """
+
+    steps: int
+    sizes: tuple[ModelSize, ...]
+    splits: int
+    merges: int
+    adds: int
+    deletes: int
+    blocked: int
+    no_transition: int
+    sensations_true: int
+    sensations_false: int
+    contradictory_states: int
+    first_contradiction_step: int | None
+    last_contradiction_step: int | None
+    final_deterministic: bool
+
+    @property
+    def final_size(self) -> ModelSize:
+        """The final model's size."""
+        return self.sizes[-1]
+
+    @property
+    def operations(self) -> int:
+        """Every counted operation."""
+        return self.splits + self.merges + self.adds + self.deletes
+
+    def to_frame(self) -> pd.DataFrame:
+        """The model size over time: ``version``, ``step``, ``states``, ``transitions`` (int64),
+        one row per model version."""
+        return pd.DataFrame(
+            {
+                name: np.array([getattr(size, name) for size in self.sizes], dtype=np.int64)
+                for name in ("version", "step", "states", "transitions")
+            }
+        )
+
+    def to_text(self) -> str:
+        """Human readable, one fact per line."""
+        final = self.final_size
+        verdict = "deterministic" if self.final_deterministic else "nondeterministic"
+        if self.first_contradiction_step is None:
+            contradictions = "none"
+        else:
+            contradictions = (
+                f"{_plural(self.contradictory_states, 'contradictory state')}, first at step "
+                f"{self.first_contradiction_step}, last new one at step "
+                f"{self.last_contradiction_step}"
+            )
+        return "\n".join(
+            [
+                f"steps: {self.steps}",
+                f"final model: {_plural(final.states, 'state')}, "
+                f"{_plural(final.transitions, 'transition')}, {verdict} (version "
+                f"{final.version}, from step {final.step}; "
+                f"{_plural(len(self.sizes), 'model version')})",
+                f"operations: {_plural(self.splits, 'split')}, {_plural(self.merges, 'merge')}, "
+                f"{_plural(self.adds, 'add')}, {_plural(self.deletes, 'delete')}",
+                f"blocked moves: {self.blocked}",
+                f"steps with no transition in the model: {self.no_transition}",
+                f"sensations seen: true {self.sensations_true}, false {self.sensations_false}",
+                f"contradictions: {contradictions}",
+            ]
+        )
+
+    def to_json(self) -> dict[str, Any]:
+        """A JSON-ready dict (``sizes`` as a list of rows)."""
+        final = self.final_size
+        return {
+            "steps": self.steps,
+            "final_model": {
+                "version": final.version,
+                "step": final.step,
+                "states": final.states,
+                "transitions": final.transitions,
+                "deterministic": self.final_deterministic,
+            },
+            "operations": {
+                "split": self.splits,
+                "merge": self.merges,
+                "add": self.adds,
+                "delete": self.deletes,
+            },
+            "blocked": self.blocked,
+            "no_transition": self.no_transition,
+            "sensations": {"true": self.sensations_true, "false": self.sensations_false},
+            "contradictions": {
+                "states": self.contradictory_states,
+                "first_step": self.first_contradiction_step,
+                "last_step": self.last_contradiction_step,
+            },
+            "sizes": [
+                {
+                    "version": size.version,
+                    "step": size.step,
+                    "states": size.states,
+                    "transitions": size.transitions,
+                }
+                for size in self.sizes
+            ],
+        }
+
+
+def audit_summary(
+    source: AuditSource, *, consistency: ConsistencyFindings | None = None
+) -> SummaryFindings:
+    """Summarise a run (see the module docstring).
+
+    ``consistency`` is the consistency audit of ``source.memory()`` when already at hand (it is
+    computed otherwise). Raises :class:`~rsstp_sim.errors.ModelError` when the recording has no
+    model message.
+    """
+    memory = source.memory()
+    records: Sequence[ModelRecord] = source.model_versions()
+    if not records:
+        raise ModelError("summary: no model message (a recording has one at step 0)")
+    if consistency is None:
+        consistency = audit_consistency(memory)
+    steps = source.steps()
+    kinds = Counter(
+        operation.kind for record in records for operation in record.operations if operation.changed
+    )
+    sensations_true = int(np.count_nonzero(memory.sensations))
+    final = records[-1]
+    final_model = TransitionSystem.from_snapshot(final.snapshot(), version=final.version)
+    contradictions = consistency.contradictions
+    return SummaryFindings(
+        steps=memory.steps,
+        sizes=tuple(
+            ModelSize(record.version, record.step, len(record.states), len(record.transitions))
+            for record in records
+        ),
+        splits=kinds["split"],
+        merges=kinds["merge"],
+        adds=kinds["add"],
+        deletes=kinds["delete"],
+        blocked=int(steps["blocked"].sum()),
+        no_transition=int(steps["no_transition"].sum()),
+        sensations_true=sensations_true,
+        sensations_false=len(memory) - sensations_true,
+        contradictory_states=len(contradictions),
+        first_contradiction_step=consistency.first_contradiction_step,
+        last_contradiction_step=(
+            max(found.first_step for found in contradictions) if contradictions else None
+        ),
+        final_deterministic=final_model.is_deterministic(),
+    )
+
+
+def _plural(count: int, noun: str) -> str:
+    return f"{count} {noun}{'' if count == 1 else 's'}"
