@@ -1,0 +1,296 @@
+"""Step messages into columns: many messages per decoder call, numpy arrays preallocated.
+
+The messages of one chunk are joined into one JSON array and decoded by msgspec into typed
+structs (``gc=False``: no garbage-collector tracking for millions of small objects); their
+fields are then copied column by column into numpy arrays sized for the whole recording, and
+the structs are dropped before the next chunk. The structs check types and ranges while
+decoding (integers stay integers, angles in ``0..359``, feedback in ``[0, 1]``); shapes and
+the rules between fields are checked on the columns.
+"""
+
+from __future__ import annotations
+
+import re
+from itertools import chain
+from typing import Annotated, Any, Literal
+
+import msgspec
+import numpy as np
+import pandas as pd  # type: ignore[import-untyped,unused-ignore]
+
+__all__ = ["BadStep", "StepColumns", "blocker_label"]
+
+_Count = Annotated[int, msgspec.Meta(ge=0)]
+_Angle = Annotated[int, msgspec.Meta(ge=0, le=359)]
+_Closeness = Annotated[float, msgspec.Meta(ge=0.0, le=1.0)]
+
+
+class _Agent(msgspec.Struct, gc=False):
+    action: _Count | None
+    state_before: _Count | None
+    internal_state: _Count
+    sensation: bool
+    feedback: _Closeness
+    model_version: _Count
+    no_transition: bool
+
+
+class _BlockedBy(msgspec.Struct, gc=False, frozen=True):
+    kind: Literal["fold", "obstacle", "links"]
+    indices: Annotated[tuple[_Count, ...], msgspec.Meta(min_length=1, max_length=2)]
+
+
+class _Truth(msgspec.Struct, gc=False):
+    angles_deg: list[_Angle]
+    joint_positions: list[tuple[float, float]]
+    blocked: bool
+    blocked_by: _BlockedBy | None
+    distances: list[list[float]]
+
+
+class _Step(msgspec.Struct, gc=False):
+    step: _Count
+    agent: _Agent
+    truth: _Truth
+
+
+class _AgentStep(msgspec.Struct, gc=False):
+    """A step message without its ground truth (skipped by the parser, not built)."""
+
+    step: _Count
+    agent: _Agent
+
+
+_DECODERS: dict[bool, tuple[msgspec.json.Decoder[Any], msgspec.json.Decoder[Any]]] = {
+    True: (msgspec.json.Decoder(list[_Step]), msgspec.json.Decoder(_Step)),
+    False: (msgspec.json.Decoder(list[_AgentStep]), msgspec.json.Decoder(_AgentStep)),
+}
+_ARITY = {"fold": 1, "obstacle": 2, "links": 2}
+
+
+class BadStep(Exception):
+    """A step message breaks the contract: ``index`` in the last batch, or ``step``."""
+
+    def __init__(self, text: str, *, index: int | None = None, step: int | None = None) -> None:
+        super().__init__(text)
+        self.text = text
+        self.index = index
+        self.step = step
+
+
+def blocker_label(kind: str, indices: tuple[int, ...]) -> str:
+    """The ``blocked_by`` column's text: ``fold joint 1``, ``obstacle 1 link 2``, ``links 0 2``."""
+    if len(indices) != _ARITY[kind]:
+        raise BadStep(
+            f"truth.blocked_by: a {kind} blocker has {_ARITY[kind]} indices, found {list(indices)}"
+        )
+    if kind == "fold":
+        return f"fold joint {indices[0]}"
+    if kind == "obstacle":
+        return f"obstacle {indices[1]} link {indices[0]}"
+    return f"links {indices[0]} {indices[1]}"
+
+
+class StepColumns:
+    """The columns of ``n_rows`` step messages, filled batch by batch with :meth:`add`.
+
+    With ``truth=False`` only the agent's fields are decoded (what a memory needs).
+    """
+
+    def __init__(self, n_rows: int, *, n_joints: int, n_obstacles: int, truth: bool = True) -> None:
+        self.n_rows = n_rows
+        self.n_joints = n_joints
+        self.n_obstacles = n_obstacles
+        self.truth = truth
+        self.rows = 0
+        self.step = np.empty(n_rows, np.int64)
+        self.action = np.empty(n_rows, np.int64)
+        self.state_before = np.empty(n_rows, np.int64)
+        self.internal_state = np.empty(n_rows, np.int64)
+        self.sensation = np.empty(n_rows, np.bool_)
+        self.feedback = np.empty(n_rows, np.float64)
+        self.model_version = np.empty(n_rows, np.int64)
+        self.no_transition = np.empty(n_rows, np.bool_)
+        self.action_nulls: list[int] = []
+        self.state_before_nulls: list[int] = []
+        if truth:
+            self.blocked = np.empty(n_rows, np.bool_)
+            self.blocker = np.full(n_rows, -1, np.int16)
+            self.blocker_labels: dict[_BlockedBy, int] = {}
+            # One row per column, so each DataFrame column is a contiguous array.
+            self.angles_deg = np.empty((n_joints, n_rows), np.int64)
+            self.positions = np.empty((n_joints + 1, 2, n_rows), np.float64)
+            self.distances = np.empty((n_joints, n_obstacles, n_rows), np.float64)
+
+    # -- filling ----------------------------------------------------------------------------
+
+    def add(self, parts: list[memoryview]) -> None:
+        """Decode a batch of step messages (their JSON bytes) into the next rows."""
+        if not parts:
+            return
+        batch, one = _DECODERS[self.truth]
+        try:
+            rows: list[Any] = batch.decode(b"[" + b",".join(parts) + b"]")
+        except msgspec.DecodeError:
+            rows = []
+        if len(rows) != len(parts):  # find the culprit, one message at a time
+            for index, part in enumerate(parts):
+                try:
+                    one.decode(part)
+                except msgspec.DecodeError as exc:
+                    raise BadStep(_describe(exc), index=index) from None
+            raise BadStep("the messages do not decode one by one", index=0)
+        k = len(rows)
+        r = self.rows
+        if r + k > self.n_rows:
+            raise BadStep(f"more step messages than the {self.n_rows} counted", index=0)
+        s = slice(r, r + k)
+        self.step[s] = [x.step for x in rows]
+        agents = [x.agent for x in rows]
+        self.action[s] = _nullable([a.action for a in agents], r, self.action_nulls)
+        self.state_before[s] = _nullable(
+            [a.state_before for a in agents], r, self.state_before_nulls
+        )
+        self.internal_state[s] = [a.internal_state for a in agents]
+        self.sensation[s] = np.array([a.sensation for a in agents], np.bool_)
+        self.feedback[s] = [a.feedback for a in agents]
+        self.model_version[s] = [a.model_version for a in agents]
+        self.no_transition[s] = np.array([a.no_transition for a in agents], np.bool_)
+        if self.truth:
+            self._add_truth([x.truth for x in rows], r)
+        self.rows = r + k
+
+    def _add_truth(self, truths: list[_Truth], r: int) -> None:
+        k = len(truths)
+        n, m = self.n_joints, self.n_obstacles
+        s = slice(r, r + k)
+        angles = [t.angles_deg for t in truths]
+        _check_lengths(angles, n, "truth.angles_deg", "angles")
+        flat = np.fromiter(chain.from_iterable(angles), np.int64, k * n)
+        self.angles_deg[:, s] = flat.reshape(k, n).T
+        positions = [t.joint_positions for t in truths]
+        _check_lengths(positions, n + 1, "truth.joint_positions", "points")
+        flat = np.fromiter(chain.from_iterable(chain.from_iterable(positions)), np.float64)
+        self.positions[:, :, s] = flat.reshape(k, n + 1, 2).transpose(1, 2, 0)
+        distances = [t.distances for t in truths]
+        _check_lengths(distances, n, "truth.distances", "rows (one per tip)")
+        if m:
+            rows = [row for tip in distances for row in tip]
+            if set(map(len, rows)) != {m}:
+                bad = next(i for i, d in enumerate(distances) if any(len(x) != m for x in d))
+                raise BadStep(f"truth.distances: expected rows of {m} values", index=bad)
+            flat = np.fromiter(chain.from_iterable(rows), np.float64, k * n * m)
+            self.distances[:, :, s] = flat.reshape(k, n, m).transpose(1, 2, 0)
+        else:
+            filled = next((i for i, tips in enumerate(distances) if any(tips)), None)
+            if filled is not None:
+                raise BadStep("truth.distances: expected empty rows (no obstacles)", index=filled)
+        self.blocked[s] = np.array([t.blocked for t in truths], np.bool_)
+        labels = self.blocker_labels
+        for index, truth in enumerate(truths):
+            by = truth.blocked_by
+            if by is not None:
+                code = labels.get(by)
+                if code is None:
+                    try:
+                        blocker_label(by.kind, by.indices)
+                    except BadStep as exc:
+                        raise BadStep(exc.text, index=index) from None
+                    code = labels[by] = len(labels)
+                self.blocker[r + index] = code
+
+    # -- checks and results --------------------------------------------------------------------
+
+    def check(self, *, actions: tuple[int, ...]) -> None:
+        """The rules between fields and between messages; :class:`BadStep` names the step."""
+        if self.rows != self.n_rows:
+            raise BadStep(f"expected {self.n_rows} step messages, found {self.rows}")
+        steps = self.step
+        bad = np.flatnonzero(steps != np.arange(self.n_rows))
+        if bad.size:
+            t = int(bad[0])
+            raise BadStep(f"expected step {t} in this place, found step {steps[t]}", step=t)
+        nullable = (("action", self.action_nulls), ("state_before", self.state_before_nulls))
+        for name, nulls in nullable:
+            if self.n_rows and nulls[:1] != [0]:
+                raise BadStep(f"agent.{name}: expected null at step 0 (the reset)", step=0)
+            if len(nulls) > 1:
+                raise BadStep(f"agent.{name}: null after step 0", step=nulls[1])
+        unknown = np.flatnonzero(~np.isin(self.action[1:], np.array(actions, np.int64)))
+        if unknown.size:
+            t = int(unknown[0]) + 1
+            raise BadStep(
+                f"agent.action {self.action[t]} is not one of the scenario's actions "
+                f"{list(actions)}",
+                step=t,
+            )
+        stayed = np.flatnonzero(self.no_transition & (self.internal_state != self.state_before))
+        if stayed.size and self.n_rows > 1:
+            t = int(stayed[0])
+            raise BadStep("agent.no_transition is true but the internal state changed", step=t)
+        if self.truth:
+            mismatch = np.flatnonzero(self.blocked != (self.blocker >= 0))
+            if mismatch.size:
+                raise BadStep("truth.blocked and truth.blocked_by disagree", step=int(mismatch[0]))
+            if self.n_rows and self.blocked[0]:
+                raise BadStep("truth.blocked: expected false at step 0 (the reset)", step=0)
+
+    def frame(self) -> pd.DataFrame:
+        """The steps table (see :meth:`rsstp_replay.Recording.steps` for the columns)."""
+        n = self.n_rows
+        action_mask = np.zeros(n, np.bool_)
+        action_mask[self.action_nulls] = True
+        before_mask = np.zeros(n, np.bool_)
+        before_mask[self.state_before_nulls] = True
+        columns: dict[str, Any] = {
+            "step": self.step,
+            "action": pd.arrays.IntegerArray(self.action, action_mask),
+            "state_before": pd.arrays.IntegerArray(self.state_before, before_mask),
+            "internal_state": self.internal_state,
+            "sensation": self.sensation,
+            "feedback": self.feedback,
+            "model_version": self.model_version,
+            "no_transition": self.no_transition,
+        }
+        if self.truth:
+            labels = [blocker_label(by.kind, by.indices) for by in self.blocker_labels]
+            columns["blocked"] = self.blocked
+            columns["blocked_by"] = pd.Categorical.from_codes(
+                self.blocker, dtype=pd.CategoricalDtype(labels)
+            )
+            for j in range(self.n_joints):
+                columns[f"angle_deg_{j}"] = self.angles_deg[j]
+            for k in range(self.n_joints + 1):
+                columns[f"joint{k}_x"] = self.positions[k, 0]
+                columns[f"joint{k}_y"] = self.positions[k, 1]
+            for k in range(self.n_joints):
+                for j in range(self.n_obstacles):
+                    columns[f"dist_{k}_{j}"] = self.distances[k, j]
+        return pd.DataFrame(columns, copy=False)
+
+
+def _nullable(values: list[int | None], first: int, nulls: list[int]) -> list[int] | Any:
+    """``values`` with -1 for ``None``, noting the rows of the nulls (rare: step 0 only)."""
+    if None not in values:
+        return values
+    nulls.extend(first + i for i, v in enumerate(values) if v is None)
+    return [-1 if v is None else v for v in values]
+
+
+def _check_lengths(items: list[Any], expected: int, field: str, what: str) -> None:
+    if set(map(len, items)) != {expected}:
+        index, found = next((i, len(x)) for i, x in enumerate(items) if len(x) != expected)
+        raise BadStep(f"{field}: expected {expected} {what}, found {found}", index=index)
+
+
+_AT = re.compile(r"(?P<message>.*) - at `\$(?P<at>.*)`")
+
+
+def _describe(exc: msgspec.DecodeError) -> str:
+    """msgspec's message as ``field.path: problem``."""
+    text = str(exc)
+    located = _AT.fullmatch(text)
+    if located is None:
+        return text[:1].lower() + text[1:]
+    message = located["message"]
+    return f"{located['at'].lstrip('.')}: {message[:1].lower()}{message[1:]}"

@@ -1,0 +1,94 @@
+"""The chain of model messages: each snapshot must follow from the previous one.
+
+Every ``/rsstp/model`` message carries the whole model (a sparse snapshot) and the operations
+applied since the previous message. :func:`verify_chain` rebuilds each version from the
+previous snapshot with :meth:`TransitionSystem.apply` and checks that it gives the message's own
+snapshot, so a model at any step is known to be the one the run had.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from rsstp_replay.errors import CorruptRecording
+from rsstp_sim.errors import ModelError
+from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = ["build_model", "verify_chain"]
+
+
+def build_model(path: Path, record: ModelRecord) -> TransitionSystem:
+    """The model of one message, from its snapshot (its version included)."""
+    try:
+        return TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
+    except ModelError as exc:
+        raise CorruptRecording(f"{path}: {_name(record)}: invalid snapshot: {exc}") from None
+
+
+def verify_chain(path: Path, records: Sequence[ModelRecord]) -> None:
+    """Check the model messages in file order; :class:`CorruptRecording` names the version."""
+    if not records:
+        raise CorruptRecording(f"{path}: no /rsstp/model message (expected one at step 0)")
+    if records[0].step != 0:
+        raise CorruptRecording(
+            f"{path}: the first model message is at step {records[0].step}, expected step 0"
+        )
+    previous = records[0]
+    model = build_model(path, previous)
+    _check_flags(path, previous, model)
+    for record in records[1:]:
+        if record.step < previous.step:
+            raise CorruptRecording(
+                f"{path}: {_name(record)} comes after the model message of step "
+                f"{previous.step}: expected the steps in order"
+            )
+        for k, operation in enumerate(record.operations):
+            try:
+                model.apply(operation.to_operation())
+            except ModelError as exc:
+                raise CorruptRecording(
+                    f"{path}: {_name(record)}: operation {k} ({operation.kind} "
+                    f"{list(operation.args)}) does not apply to version {previous.version}: {exc}"
+                ) from None
+        expected = build_model(path, record)
+        difference = _difference(model, expected)
+        if difference:
+            raise CorruptRecording(
+                f"{path}: {_name(record)}: its operations applied to version "
+                f"{previous.version} do not give its snapshot ({difference})"
+            )
+        _check_flags(path, record, expected)
+        previous, model = record, expected
+
+
+def _difference(rebuilt: TransitionSystem, snapshot: TransitionSystem) -> str:
+    if rebuilt.version != snapshot.version:
+        return f"they make version {rebuilt.version}"
+    if rebuilt.states != snapshot.states:
+        return f"states {list(rebuilt.states)}, the snapshot has {list(snapshot.states)}"
+    if rebuilt.next_id != snapshot.next_id:
+        return f"next id {rebuilt.next_id}, the snapshot has {snapshot.next_id}"
+    if rebuilt.actions != snapshot.actions:
+        return f"actions {list(rebuilt.actions)}, the snapshot has {list(snapshot.actions)}"
+    made, found = set(rebuilt.transitions()), set(snapshot.transitions())
+    if made != found:
+        extra = sorted(made - found)[:3]
+        missing = sorted(found - made)[:3]
+        return f"transitions differ: rebuilt only {extra}, snapshot only {missing}"
+    return ""
+
+
+def _check_flags(path: Path, record: ModelRecord, model: TransitionSystem) -> None:
+    pairs = len(model.determinism_report().nondeterministic)
+    if record.nondeterministic_pairs != pairs or record.deterministic != (pairs == 0):
+        raise CorruptRecording(
+            f"{path}: {_name(record)}: says deterministic={record.deterministic} with "
+            f"{record.nondeterministic_pairs} nondeterministic pairs; its transitions have "
+            f"{pairs}"
+        )
+
+
+def _name(record: ModelRecord) -> str:
+    return f"model version {record.version} (step {record.step})"

@@ -1,0 +1,241 @@
+"""``rsstp-replay``: look into a recording: ``info``, ``table``, ``audit``, ``compare``.
+
+Bad input (a missing or damaged file, a file from another tool, a schema version this reader
+does not know, a step out of range) gets one line on stderr naming the file and the problem,
+and exit code 2; never a traceback. A file whose writer was killed is read up to its last
+complete chunk, with a one-line warning on stderr. ``audit --fail-on`` exits with 1 when such
+a finding exists.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import warnings
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import NoReturn
+
+from rsstp_replay.errors import ReplayError, StepOutOfRange, UnfinishedRecordingWarning
+from rsstp_replay.recording import Recording, open_recording
+from rsstp_sim.errors import RsstpError
+
+__all__ = ["main"]
+
+PROG = "rsstp-replay"
+_TABLE_FORMATS = (".parquet", ".csv")
+_FAIL_ON = ("contradiction", "nondeterministic")
+
+
+class UsageError(ReplayError):
+    """A command-line argument is invalid."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> NoReturn:
+        raise UsageError(message)
+
+
+def _open(path: str) -> Recording:
+    """Open a recording; an unfinished file's warning becomes one line on stderr."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", UnfinishedRecordingWarning)
+        recording = open_recording(path)
+    for warning in caught:
+        if issubclass(warning.category, UnfinishedRecordingWarning):
+            print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
+        else:  # pragma: no cover - not ours: pass it on
+            warnings.warn_explicit(
+                warning.message, warning.category, warning.filename, warning.lineno
+            )
+    return recording
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    with _open(args.file) as recording:
+        record = recording.scenario_record
+        scenario = recording.scenario
+        size = os.path.getsize(recording.path)
+        state = "finished" if recording.finished else "NOT finished (recovered from its chunks)"
+        print(f"file: {recording.path} ({size:,} bytes, {state})")
+        print(f"scenario: {record.name} ({record.description})")
+        lengths = ", ".join(f"{length:g}" for length in record.lengths)
+        print(
+            f"  joints: {record.n_joints} (lengths {lengths}; start {list(record.initial_deg)} "
+            f"deg; step {record.step_deg} deg; actions {list(record.actions)})"
+        )
+        obstacles = "; ".join(
+            f"centre ({o.center[0]:g}, {o.center[1]:g}) radius {o.radius:g}"
+            for o in record.obstacles
+        )
+        print(f"  obstacles: {len(record.obstacles)}" + (f": {obstacles}" if obstacles else ""))
+        print(
+            f"  feedback: {scenario.feedback_mode} (tolerance {record.feedback.tolerance:g}); "
+            f"collision: {record.collision}"
+        )
+        params = json.dumps(recording.strategy_params, sort_keys=True)
+        print(f"strategy: {recording.strategy} {params}; seed: {recording.seed}")
+        print(f"steps: 0 to {recording.n_steps} (the reset, then {recording.n_steps:,} steps)")
+        print("topics:")
+        width = max(map(len, recording.topic_counts))
+        for topic, count in recording.topic_counts.items():
+            print(f"  {topic:<{width}}  {count:>12,}")
+        model = recording.model_at(recording.n_steps)
+        kind = "deterministic" if model.is_deterministic() else "nondeterministic"
+        print(
+            f"model at the end: version {model.version}, {len(model)} states, "
+            f"{len(model.transitions())} transitions, {kind}"
+        )
+        schemas = ", ".join(f"{name} {v}" for name, v in recording.schema_versions.items())
+        print(f"schemas: {schemas}")
+        meta = recording.metadata
+        print(
+            f"written by: rsstp {meta['package_version']} (Python {meta['python']}, "
+            f"numpy {meta['numpy']}, mcap {meta['mcap']})"
+        )
+    return 0
+
+
+def _cmd_table(args: argparse.Namespace) -> int:
+    out = Path(args.output)
+    if out.suffix.lower() not in _TABLE_FORMATS:
+        raise UsageError(
+            f"{out}: unknown table format {out.suffix or '(no suffix)'!r}: expected "
+            f"{' or '.join(_TABLE_FORMATS)}"
+        )
+    if out.is_dir():
+        raise UsageError(f"{out}: is a directory, not an output file")
+    if out.exists() and not args.force:
+        raise UsageError(f"{out}: already exists (use --force to overwrite)")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        raise UsageError(f"{out}: the output directory {parent} does not exist")
+    with _open(args.file) as recording:
+        table = recording.steps()
+    partial = out.with_name(f".{out.name}.partial")
+    try:
+        if out.suffix.lower() == ".parquet":
+            import pyarrow as pa
+            import pyarrow.parquet as pq
+
+            pq.write_table(pa.Table.from_pandas(table, preserve_index=False), partial)
+        else:
+            table.to_csv(partial, index=False)
+        os.replace(partial, out)
+    except OSError as exc:
+        partial.unlink(missing_ok=True)
+        raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    print(f"wrote {len(table):,} rows and {len(table.columns)} columns to {out}")
+    return 0
+
+
+def _cmd_audit(args: argparse.Namespace) -> int:
+    from rsstp_replay.audits import run_audits
+
+    with _open(args.file) as recording:
+        report = run_audits(recording)
+    if args.json:
+        print(json.dumps(report.to_json(), indent=2))
+    else:
+        print(report.to_text(), end="" if report.to_text().endswith("\n") else "\n")
+    failed = [
+        reason
+        for reason, found in (
+            ("contradiction", report.has_contradiction),
+            ("nondeterministic", report.has_nondeterminism),
+        )
+        if reason in (args.fail_on or []) and found
+    ]
+    if failed:
+        found_text = {
+            "contradiction": "the memory contradicts an internal state",
+            "nondeterministic": "the final model is nondeterministic",
+        }
+        print(
+            f"{PROG}: audit failed: {'; '.join(found_text[reason] for reason in failed)}",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
+
+
+def _cmd_compare(args: argparse.Namespace) -> int:
+    from rsstp_replay.audits import compare
+
+    with _open(args.file) as recording:
+        for name, step in (("N", args.n), ("M", args.m)):
+            if not 0 <= step <= recording.n_steps:
+                raise StepOutOfRange(
+                    f"{recording.path}: compare {name} = {step} is out of range: the recording "
+                    f"has steps 0 to {recording.n_steps}"
+                )
+        if args.n == args.m:
+            raise UsageError(f"compare: N and M must differ (both are {args.n})")
+        findings = compare(recording, args.n, args.m)
+    if args.json:
+        print(json.dumps(findings.to_json(), indent=2))
+    else:
+        print(findings.to_text())
+    return 0
+
+
+def _integer(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+
+
+def _build_parser() -> _Parser:
+    parser = _Parser(prog=PROG, description="Read, export and audit RSSTP recordings (MCAP).")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("info", help="what a recording holds: scenario, strategy, steps, topics")
+    p.add_argument("file", help="the .mcap recording")
+    p.set_defaults(func=_cmd_info)
+
+    p = sub.add_parser("table", help="write the steps table (one row per step)")
+    p.add_argument("file", help="the .mcap recording")
+    p.add_argument("-o", "--output", required=True, help="the table: .parquet or .csv")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.set_defaults(func=_cmd_table)
+
+    p = sub.add_parser("audit", help="consistency, determinism and summary audits")
+    p.add_argument("file", help="the .mcap recording")
+    p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument(
+        "--fail-on",
+        action="append",
+        choices=_FAIL_ON,
+        help="exit with 1 when such a finding exists (repeatable)",
+    )
+    p.set_defaults(func=_cmd_audit)
+
+    p = sub.add_parser("compare", help="the thesis's compare of the sub-memories at N and M")
+    p.add_argument("file", help="the .mcap recording")
+    p.add_argument("n", type=_integer, metavar="N", help="first start step")
+    p.add_argument("m", type=_integer, metavar="M", help="second start step")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.set_defaults(func=_cmd_compare)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point; returns the exit code (0 ok, 1 an audit failed, 2 bad input)."""
+    parser = _build_parser()
+    try:
+        args = parser.parse_args(argv)
+        func: Callable[[argparse.Namespace], int] = args.func
+        return func(args)
+    except RsstpError as exc:
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"{PROG}: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,47 @@
+"""The replay side's exception hierarchy, and the warning for unfinished recordings.
+
+Every message is one line: the file, what was expected, what was found and where (byte
+offset, step) when it is known.
+"""
+
+from __future__ import annotations
+
+from rsstp_sim.errors import RsstpError
+
+__all__ = [
+    "CorruptRecording",
+    "ForeignRecording",
+    "NotARecording",
+    "ReplayError",
+    "StepOutOfRange",
+    "UnfinishedRecordingWarning",
+    "UnsupportedVersion",
+]
+
+
+class ReplayError(RsstpError):
+    """Root of every error the replay side raises on purpose."""
+
+
+class NotARecording(ReplayError):
+    """The path does not exist, is not a readable file, or is not an MCAP file at all."""
+
+
+class ForeignRecording(ReplayError):
+    """An MCAP file, but not one of ours: it has no ``/rsstp/*`` topic."""
+
+
+class UnsupportedVersion(ReplayError):
+    """A schema of the recording has a major version this reader does not know."""
+
+
+class CorruptRecording(ReplayError):
+    """Damaged bytes (CRC failure, undecodable record) or a message that breaks the contract."""
+
+
+class StepOutOfRange(ReplayError):
+    """A step index outside ``0 .. n_steps`` of the recording."""
+
+
+class UnfinishedRecordingWarning(UserWarning):
+    """The file has no footer (the writer was killed): only its complete chunks were read."""

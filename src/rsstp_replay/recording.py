@@ -1,0 +1,469 @@
+"""Reading a recording: the steps table, the memory, the model at any step, the events.
+
+>>> with open_recording("run.mcap") as recording:  # doctest: +SKIP
+...     table = recording.steps()          # one row per step, typed columns
+...     memory = recording.memory()        # the agent's memory, entry by entry
+...     model = recording.model_at(500)    # the model at the end of step 500
+
+The file is checked at the boundary: :func:`open_recording` reads its structure, the
+scenario, the metadata and the schemas (an unknown major version is refused); each table is
+checked while it is decoded (CRCs, types, ranges, the step sequence, the model chain). Every
+problem raises a :class:`~rsstp_replay.errors.ReplayError` whose one-line message names the
+file and where. A file whose writer was killed is read up to its last complete chunk, with an
+:class:`~rsstp_replay.errors.UnfinishedRecordingWarning`.
+"""
+
+from __future__ import annotations
+
+import bisect
+import gc
+import operator
+import os
+import warnings
+from collections.abc import Generator, Iterator
+from contextlib import closing, contextmanager
+from pathlib import Path
+from types import TracebackType
+from typing import Any, NamedTuple
+
+import msgspec
+import numpy as np
+import pandas as pd  # type: ignore[import-untyped,unused-ignore]
+
+from rsstp_replay._chunks import message_times
+from rsstp_replay._chunks import split_messages as _split
+from rsstp_replay._container import ChunkRef, Container, open_container
+from rsstp_replay._contract import (
+    check_schemas,
+    cut_time,
+    read_metadata,
+    rebuild_scenario,
+    rsstp_channels,
+)
+from rsstp_replay._decode import BadStep, StepColumns
+from rsstp_replay._models import build_model, verify_chain
+from rsstp_replay.errors import (
+    CorruptRecording,
+    ReplayError,
+    StepOutOfRange,
+    UnfinishedRecordingWarning,
+)
+from rsstp_sim.errors import MemoryRangeError
+from rsstp_sim.memory import Memory
+from rsstp_sim.recording.records import (
+    EventRecord,
+    ModelRecord,
+    RecordFormatError,
+    ScenarioRecord,
+    decode,
+)
+from rsstp_sim.recording.schemas import (
+    STEP_NS,
+    TOPICS,
+)
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = ["EVENT_KINDS", "Recording", "open_recording"]
+
+EVENT_KINDS = (
+    "blocked",
+    "no_transition",
+    "split",
+    "merge",
+    "add",
+    "delete",
+    "note",
+    "contradiction",
+)
+"""The categories of :meth:`Recording.events`' ``kind`` column (``rsstp.Event`` 1.x)."""
+
+_CACHED_CHUNKS = 4
+
+
+def open_recording(path: str | os.PathLike[str]) -> Recording:
+    """Open the recording at ``path`` (also a context manager).
+
+    Raises :class:`~rsstp_replay.errors.NotARecording`, :class:`~rsstp_replay.errors.
+    ForeignRecording`, :class:`~rsstp_replay.errors.UnsupportedVersion` or
+    :class:`~rsstp_replay.errors.CorruptRecording`; warns with
+    :class:`~rsstp_replay.errors.UnfinishedRecordingWarning` when the file was not finished.
+    """
+    recording = Recording(open_container(path))
+    if recording.recovered_steps is not None:
+        warnings.warn(
+            UnfinishedRecordingWarning(
+                f"{recording.path}: the file was not finished; recovered "
+                f"{recording.recovered_steps} steps from its complete chunks "
+                f"(read {recording._container.recovered_bytes} of "
+                f"{recording._container.size} bytes)"
+            ),
+            stacklevel=2,
+        )
+    return recording
+
+
+class Recording:
+    """One recorded run. Use :func:`open_recording`; the file is opened only during a call.
+
+    Properties: ``path``, ``finished`` (the file has its footer), ``n_steps`` (the last step
+    index; steps ``0 .. n_steps``, 0 being the reset), ``topic_counts`` (messages per topic),
+    ``seed``, ``strategy`` (its name), ``strategy_params``, ``recovered_steps`` (``None`` for a
+    finished file, else ``n_steps``: the steps read from the complete chunks), ``scenario``
+    (rebuilt from the ``scenario.toml`` attachment), ``scenario_record`` (the
+    ``/rsstp/scenario`` message), ``metadata`` (the ``rsstp`` metadata record) and
+    ``schema_versions`` (schema name -> ``"major.minor"`` found in the file).
+
+    An unfinished file is cut before its last recovered step: that step's model and event
+    messages may have been in the chunk that was lost, so ``n_steps`` is the step before it
+    (unless the scan reached the end of the data section).
+    """
+
+    def __init__(self, container: Container) -> None:
+        self._container = container
+        self._closed = False
+        path = container.path
+        if not container.finished and not container.chunks:
+            raise CorruptRecording(
+                f"{path}: the file was not finished and holds no complete chunk (read "
+                f"{container.recovered_bytes} of {container.size} bytes): nothing to recover"
+            )
+        self._channels = rsstp_channels(container)
+        self.schema_versions = check_schemas(container, self._channels)
+        self.metadata = read_metadata(container)
+        counts = container.counts if container.counts is not None else container.count_messages()
+        self._limit_ns: int | None = None
+        if not container.data_complete:
+            self._limit_ns = cut_time(container, self._channels["/rsstp/step"])
+            counts = dict(counts)
+            for channel, (log_time, at_time) in container.tail.items():
+                if log_time >= self._limit_ns:
+                    counts[channel] = counts.get(channel, 0) - at_time
+        self.topic_counts = {
+            channel.topic: counts.get(channel_id, 0)
+            for channel_id, channel in sorted(container.channels.items())
+        }
+        n_step_messages = counts.get(self._channels["/rsstp/step"], 0)
+        if n_step_messages == 0:
+            what = "no complete step" if not container.finished else "no step message"
+            raise CorruptRecording(f"{path}: {what} to read (expected step 0, the reset)")
+        self.n_steps = n_step_messages - 1
+        self.recovered_steps: int | None = None if container.finished else self.n_steps
+        self.scenario_record = self._read_scenario()
+        self.scenario = rebuild_scenario(container, self.scenario_record, self.metadata)
+        self._agent_cache: dict[int, StepColumns] = {}
+        self._agent: StepColumns | None = None
+        self._models: tuple[ModelRecord, ...] | None = None
+
+    # -- properties ------------------------------------------------------------------------
+
+    @property
+    def path(self) -> Path:
+        return self._container.path
+
+    @property
+    def finished(self) -> bool:
+        return self._container.finished
+
+    @property
+    def seed(self) -> int:
+        return self.scenario_record.seed
+
+    @property
+    def strategy(self) -> str:
+        return self.scenario_record.strategy.name
+
+    @property
+    def strategy_params(self) -> dict[str, Any]:
+        return dict(self.scenario_record.strategy.params)
+
+    def __repr__(self) -> str:
+        state = "finished" if self.finished else "unfinished"
+        return f"Recording({str(self.path)!r}, steps=0..{self.n_steps}, {state})"
+
+    def close(self) -> None:
+        """Drop the cached tables; later calls raise :class:`ReplayError`."""
+        self._closed = True
+        self._agent = None
+        self._agent_cache.clear()
+        self._models = None
+
+    def __enter__(self) -> Recording:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    # -- tables ----------------------------------------------------------------------------
+
+    def steps(self) -> pd.DataFrame:
+        """One row per step (``0 .. n_steps``), flat typed columns:
+
+        - ``step`` (int64); ``action`` and ``state_before`` (nullable Int64, ``<NA>`` at step 0);
+          ``internal_state`` (int64); ``sensation`` (bool); ``feedback`` (float64, closeness in
+          ``[0, 1]``); ``model_version`` (int64); ``no_transition`` (bool): the agent's view;
+        - ``blocked`` (bool) and ``blocked_by`` (categorical, missing when not blocked):
+          ``"fold joint J"``, ``"obstacle J link L"`` or ``"links I J"``;
+        - ``angle_deg_{j}`` (int64, joint ``j``'s relative angle in degrees);
+        - ``joint{k}_x``, ``joint{k}_y`` (float64, length units, world frame): point ``k`` of
+          the arm, ``k = 0`` the base, ``k = n`` the tip of the last link;
+        - ``dist_{k}_{j}`` (float64, length units): from the tip of link ``k`` (point ``k + 1``)
+          to obstacle ``j``'s surface.
+        """
+        return self._step_columns(truth=True).frame()
+
+    def memory(self) -> Memory:
+        """The agent's memory, entry by entry as the live run had it."""
+        columns = self._agent_columns()
+        try:
+            return Memory.from_arrays(
+                columns.action, columns.internal_state, columns.sensation, columns.feedback
+            )
+        except MemoryRangeError as exc:
+            raise CorruptRecording(f"{self.path}: the steps do not make a memory: {exc}") from None
+
+    def events(self) -> pd.DataFrame:
+        """One row per event: ``step`` (int64), ``kind`` (categorical, :data:`EVENT_KINDS`),
+        ``text`` (one line), ``data`` (its details as JSON text)."""
+        events = self._records("/rsstp/event")
+        return pd.DataFrame(
+            {
+                "step": np.array([e.step for e in events], np.int64),
+                "kind": pd.Categorical([e.kind for e in events], categories=EVENT_KINDS),
+                "text": pd.array([e.text for e in events], dtype="str"),
+                "data": pd.array(
+                    [msgspec.json.encode(e.data).decode() for e in events], dtype="str"
+                ),
+            }
+        )
+
+    # -- the model ---------------------------------------------------------------------------
+
+    def model_versions(self) -> tuple[ModelRecord, ...]:
+        """The ``/rsstp/model`` messages in order, the chain between them checked."""
+        self._check_open()
+        if self._models is None:
+            models = self._records("/rsstp/model")
+            verify_chain(self.path, models)
+            self._models = tuple(models)
+        return self._models
+
+    def model_at(self, step: int) -> TransitionSystem:
+        """The model at the end of step ``step``, after the strategy's refinement.
+
+        Its structure is the last model message at or before ``step``; its current state is
+        the internal state the next step starts from (``state_before`` of step ``step + 1``),
+        or, at the last step, that of the model message of this step, else the step's own.
+        """
+        step = self._check_step(step)
+        models = self.model_versions()
+        index = bisect.bisect_right([m.step for m in models], step) - 1
+        record = models[index]
+        model = build_model(self.path, record)
+        here = self._agent_row(step)
+        if here.model_version != record.version:
+            raise CorruptRecording(
+                f"{self.path}: step {step} says model version {here.model_version}, but the "
+                f"last model message at or before it (step {record.step}) is version "
+                f"{record.version}"
+            )
+        if step < self.n_steps:
+            current = self._agent_row(step + 1).state_before
+        elif record.step == step:
+            current = record.current
+        else:
+            current = here.internal_state
+        if current not in model:
+            raise CorruptRecording(
+                f"{self.path}: step {step}: the internal state {current} is not a state of "
+                f"model version {record.version}"
+            )
+        model.current = current
+        return model
+
+    # -- reading -----------------------------------------------------------------------------
+
+    def _check_open(self) -> None:
+        if self._closed:
+            raise ReplayError(f"{self.path}: the recording is closed")
+
+    def _check_step(self, step: int) -> int:
+        self._check_open()
+        if isinstance(step, bool):
+            raise StepOutOfRange(f"{self.path}: a step must be an integer, got {step!r}")
+        try:
+            index = operator.index(step)
+        except TypeError:
+            raise StepOutOfRange(f"{self.path}: a step must be an integer, got {step!r}") from None
+        if not 0 <= index <= self.n_steps:
+            raise StepOutOfRange(
+                f"{self.path}: step {index} is out of range: the recording has steps 0 to "
+                f"{self.n_steps}"
+            )
+        return index
+
+    def _chunks(
+        self, topic: str, *, step: int | None = None
+    ) -> Generator[tuple[ChunkRef, bytes, list[memoryview], list[int]], None, None]:
+        """The chunks with messages of ``topic`` (or only those around ``step``'s log time),
+        each with its records, those messages' bytes and (except for steps) log times."""
+        self._check_open()
+        channel = self._channels[topic]
+        limit = self._limit_ns
+        with self._container.open() as stream:
+            for ref in self._container.chunks:
+                if ref.channels is not None and channel not in ref.channels:
+                    continue
+                if step is not None and not ref.start_ns <= step * STEP_NS <= ref.end_ns:
+                    continue
+                if limit is not None and ref.start_ns >= limit:
+                    break
+                data = self._container.chunk_data(stream, ref)
+                parts: dict[int, list[memoryview]] = {channel: []}
+                times: dict[int, list[int]] | None = None
+                if topic != "/rsstp/step":
+                    times = {channel: []}
+                cut = limit if limit is not None and ref.end_ns >= limit else None
+                _split(self.path, data, parts, where=ref.offset, limit_ns=cut, times=times)
+                yield ref, data, parts[channel], [] if times is None else times[channel]
+
+    def _read_scenario(self) -> ScenarioRecord:
+        count = self.topic_counts.get("/rsstp/scenario", 0)
+        if count != 1:
+            raise CorruptRecording(
+                f"{self.path}: expected one /rsstp/scenario message, found {count}"
+            )
+        with closing(self._chunks("/rsstp/scenario")) as chunks:
+            for ref, _, parts, times in chunks:
+                if parts:
+                    record = self._decode_one("/rsstp/scenario", parts[0], times[0], ref)
+                    assert isinstance(record, ScenarioRecord)
+                    return record
+        raise CorruptRecording(f"{self.path}: the /rsstp/scenario message is missing")
+
+    def _records(self, topic: str) -> list[Any]:
+        """Every message of ``topic`` as its record, checked against its log time."""
+        found: list[Any] = []
+        for ref, _, parts, times in self._chunks(topic):
+            for part, log_time in zip(parts, times, strict=True):
+                record = self._decode_one(topic, part, log_time, ref)
+                assert isinstance(record, EventRecord | ModelRecord)
+                if record.step * STEP_NS != log_time:
+                    raise CorruptRecording(
+                        f"{self.path}: a {topic} message logged at step "
+                        f"{log_time / STEP_NS:g} says step {record.step} (chunk at byte "
+                        f"{ref.offset})"
+                    )
+                found.append(record)
+        expected = self.topic_counts.get(topic, 0)
+        if len(found) != expected:
+            raise CorruptRecording(
+                f"{self.path}: expected {expected} {topic} messages (the summary's count), "
+                f"found {len(found)}"
+            )
+        return found
+
+    def _decode_one(self, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
+        try:
+            return decode(TOPICS[topic], bytes(part))
+        except (RecordFormatError, msgspec.DecodeError) as exc:
+            raise CorruptRecording(
+                f"{self.path}: the {topic} message at step {log_time / STEP_NS:g} (chunk at "
+                f"byte {ref.offset}) is invalid: {exc}"
+            ) from None
+
+    def _decode_steps(
+        self, columns: StepColumns, ref: ChunkRef, data: bytes, parts: list[memoryview]
+    ) -> None:
+        try:
+            columns.add(parts)
+        except BadStep as exc:
+            times = message_times(data, self._channels["/rsstp/step"])
+            at = f"at step {times[exc.index] // STEP_NS} " if exc.index is not None else ""
+            raise CorruptRecording(
+                f"{self.path}: the step message {at}(chunk at byte {ref.offset}) is invalid: "
+                f"{exc.text}"
+            ) from None
+
+    def _step_columns(self, *, truth: bool) -> StepColumns:
+        """Decode and check every step message."""
+        record = self.scenario_record
+        columns = StepColumns(
+            self.n_steps + 1,
+            n_joints=record.n_joints,
+            n_obstacles=len(record.obstacles),
+            truth=truth,
+        )
+        with _gc_paused():
+            for ref, data, parts, _ in self._chunks("/rsstp/step"):
+                self._decode_steps(columns, ref, data, parts)
+        try:
+            columns.check(actions=record.actions)
+        except BadStep as exc:
+            raise CorruptRecording(f"{self.path}: step {exc.step}: {exc.text}") from None
+        return columns
+
+    def _agent_columns(self) -> StepColumns:
+        self._check_open()
+        if self._agent is None:
+            self._agent = self._step_columns(truth=False)
+        return self._agent
+
+    def _agent_row(self, step: int) -> _AgentRow:
+        """The agent's fields of ``step``: from the whole memory when it was read, else from
+        the chunk holding the step (the last few such chunks are kept)."""
+        if self._agent is not None:
+            found = _row(self._agent, step)
+            if found is None:  # pragma: no cover - the columns were checked
+                raise CorruptRecording(f"{self.path}: the message of step {step} is missing")
+            return found
+        for columns in self._agent_cache.values():
+            row = _row(columns, step)
+            if row is not None:
+                return row
+        n_joints = self.scenario_record.n_joints
+        with closing(self._chunks("/rsstp/step", step=step)) as chunks:
+            for ref, data, parts, _ in chunks:
+                columns = StepColumns(len(parts), n_joints=n_joints, n_obstacles=0, truth=False)
+                self._decode_steps(columns, ref, data, parts)
+                if len(self._agent_cache) >= _CACHED_CHUNKS:
+                    self._agent_cache.pop(next(iter(self._agent_cache)))
+                self._agent_cache[ref.offset] = columns
+                row = _row(columns, step)
+                if row is not None:
+                    return row
+        raise CorruptRecording(f"{self.path}: the message of step {step} is missing")
+
+
+class _AgentRow(NamedTuple):
+    state_before: int
+    internal_state: int
+    model_version: int
+
+
+def _row(columns: StepColumns, step: int) -> _AgentRow | None:
+    steps = columns.step[: columns.rows]
+    index = int(np.searchsorted(steps, step))
+    if index >= columns.rows or steps[index] != step:
+        return None
+    return _AgentRow(
+        int(columns.state_before[index]),
+        int(columns.internal_state[index]),
+        int(columns.model_version[index]),
+    )
+
+
+@contextmanager
+def _gc_paused() -> Iterator[None]:
+    """No garbage collection while millions of acyclic objects come and go."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()

@@ -1,0 +1,409 @@
+"""Bad input: real damaged files, through the API and through the command line.
+
+Each case is a file made from a real recording (cut bytes, flipped bytes, records copied into
+a new file with one thing changed) or a file that is not one of ours. The API must raise the
+named error with a one-line message naming the file and the problem; ``rsstp-replay`` must
+print one line on stderr, exit with 2 and never show a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import struct
+import subprocess
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import pytest
+from mcap.reader import make_reader
+from mcap.writer import CompressionType, Writer
+
+from rsstp_replay import (
+    CorruptRecording,
+    ForeignRecording,
+    NotARecording,
+    Recording,
+    ReplayError,
+    StepOutOfRange,
+    UnsupportedVersion,
+    open_recording,
+)
+from rsstp_sim import AgentView, StrategyBase, load_scenario
+from rsstp_sim.recording.recorder import record
+
+SRC = Path(__file__).resolve().parents[2] / "src"
+STEPS = 400
+CHUNK_SIZE = 8 * 1024
+CHUNK_DATA = 1 + 8 + 8 + 8 + 8 + 4 + 4 + len("zstd") + 8
+"""Bytes from a chunk record's opcode to its compressed data."""
+
+
+class Splitter(StrategyBase):
+    """Random actions; splits and adds now and then, so the model messages form a chain."""
+
+    name: ClassVar[str] = "test-splitter"
+
+    def choose_action(self, agent: AgentView) -> int:
+        return agent.actions[int(agent.rng.integers(len(agent.actions)))]
+
+    def refine(self, agent: AgentView) -> None:
+        if agent.step % 40 == 0 and len(agent.model) < 5:
+            agent.model.split(agent.model.current)
+        elif agent.step % 25 == 0:
+            agent.model.add(agent.model.current, agent.model.states[0], agent.actions[0])
+
+
+# ----------------------------------------------------------------------- making damage
+
+
+def rewrite(
+    source: Path,
+    target: Path,
+    *,
+    schema: Callable[[str, bytes], bytes] = lambda name, data: data,
+    message: Callable[[str, int, bytes], bytes | None] = lambda topic, log_time, data: data,
+    attachment: Callable[[bytes], bytes] = lambda data: data,
+) -> Path:
+    """Copy a recording record by record into a new finished file, changing what is asked
+    (``message`` returning None drops the message)."""
+    with open(source, "rb") as stream, open(target, "wb") as out:
+        reader = make_reader(stream)
+        summary = reader.get_summary()
+        assert summary is not None
+        writer = Writer(out, chunk_size=CHUNK_SIZE, compression=CompressionType.ZSTD)
+        writer.start(profile="", library="test rewrite")
+        schema_ids = {
+            sid: writer.register_schema(s.name, s.encoding, schema(s.name, s.data))
+            for sid, s in summary.schemas.items()
+        }
+        channel_ids = {
+            cid: writer.register_channel(c.topic, c.message_encoding, schema_ids[c.schema_id])
+            for cid, c in summary.channels.items()
+        }
+        for metadata in reader.iter_metadata():
+            writer.add_metadata(metadata.name, metadata.metadata)
+        for found in reader.iter_attachments():
+            writer.add_attachment(
+                found.log_time,
+                found.create_time,
+                found.name,
+                found.media_type,
+                attachment(found.data),
+            )
+        for _, channel, msg in reader.iter_messages(log_time_order=False):
+            data = message(channel.topic, msg.log_time, msg.data)
+            if data is not None:
+                writer.add_message(channel_ids[channel.id], msg.log_time, data, msg.publish_time)
+        writer.finish()
+    return target
+
+
+def flip(source: Path, target: Path, offset: int) -> Path:
+    data = bytearray(source.read_bytes())
+    data[offset] ^= 0xFF
+    target.write_bytes(bytes(data))
+    return target
+
+
+def chunk_offsets(path: Path) -> list[int]:
+    with open(path, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None
+    return sorted(index.chunk_start_offset for index in summary.chunk_indexes)
+
+
+def in_compressed_data(path: Path, chunk: int) -> int:
+    """A byte in the middle of the compressed data of the chunk at offset ``chunk``."""
+    data = path.read_bytes()
+    (length,) = struct.unpack_from("<Q", data, chunk + CHUNK_DATA - 8)
+    return chunk + CHUNK_DATA + length // 2
+
+
+def summary_start(path: Path) -> int:
+    data = path.read_bytes()
+    (start,) = struct.unpack_from("<Q", data, len(data) - 8 - 20)
+    return int(start)
+
+
+def foreign_mcap(target: Path) -> Path:
+    with open(target, "wb") as out:
+        writer = Writer(out)
+        writer.start(profile="", library="another tool")
+        schema = writer.register_schema("camera.Frame", "jsonschema", b'{"type": "object"}')
+        channel = writer.register_channel("/camera", "json", schema)
+        writer.add_message(channel, 0, b'{"pixels": []}', 0)
+        writer.finish()
+    return target
+
+
+def edit_json(topic: str, step: int, change: Callable[[dict[str, Any]], None]) -> Any:
+    """A ``message`` callback for :func:`rewrite` that edits one message of ``topic``."""
+
+    def edit(found: str, log_time: int, data: bytes) -> bytes:
+        if found != topic or log_time != step * 1_000_000:
+            return data
+        value = json.loads(data)
+        change(value)
+        return json.dumps(value, separators=(",", ":")).encode()
+
+    return edit
+
+
+# ---------------------------------------------------------------------------- the cases
+
+
+@dataclass(frozen=True)
+class Case:
+    """A damaged file, what the API raises (and how it is reached), what the CLI runs."""
+
+    error: type[ReplayError]
+    match: str
+    reach: Callable[[Recording], object] | None = None
+    """``None``: open_recording raises; else this raises on the opened recording."""
+    command: tuple[str, ...] = ("info",)
+
+
+CASES: dict[str, Case] = {
+    "missing": Case(NotARecording, r"missing\.mcap: no such file"),
+    "directory": Case(NotARecording, r"directory\.mcap: is a directory, not a recording"),
+    "empty": Case(NotARecording, r"empty\.mcap: the file is empty, not an MCAP recording"),
+    "text": Case(NotARecording, r"text\.mcap: not an MCAP file \(it does not start with"),
+    "foreign": Case(
+        ForeignRecording,
+        r"foreign\.mcap: an MCAP file, but not an rsstp recording: no /rsstp/\* topic "
+        r"\(its topics: /camera\)",
+    ),
+    "version2": Case(
+        UnsupportedVersion,
+        r"version2\.mcap: channel /rsstp/step: schema rsstp\.Step version 2\.0 is not "
+        r"supported \(this reader understands 1\.x\)",
+    ),
+    "in-magic": Case(CorruptRecording, r"in-magic\.mcap: truncated: the file ends at byte 5"),
+    "in-header": Case(
+        CorruptRecording,
+        r"in-header\.mcap: the file was not finished and holds no complete chunk "
+        r"\(read \d+ of 40 bytes\): nothing to recover",
+    ),
+    "chunk-flip": Case(
+        CorruptRecording,
+        r"chunk-flip\.mcap: the chunk at byte \d+ (fails its CRC check|does not decompress)",
+        reach=Recording.steps,
+        command=("table", "-o", "{tmp}/chunk-flip.parquet"),
+    ),
+    "first-chunk-flip": Case(
+        CorruptRecording,
+        r"first-chunk-flip\.mcap: the chunk at byte \d+ (fails its CRC check|does not decompress)",
+    ),
+    "summary-flip": Case(
+        CorruptRecording,
+        r"summary-flip\.mcap: the summary section \(bytes \d+ to \d+\) fails its CRC check: "
+        r"expected 0x[0-9a-f]{8}, computed 0x[0-9a-f]{8}",
+    ),
+    "bad-step": Case(
+        CorruptRecording,
+        r"bad-step\.mcap: the step message at step 17 \(chunk at byte \d+\) is invalid: "
+        r"agent\.action: expected `int \| null`, got `float`",
+        reach=Recording.memory,
+        command=("compare", "1", "2"),
+    ),
+    "step-gap": Case(
+        CorruptRecording,
+        r"step-gap\.mcap: step 50: expected step 50 in this place, found step 51",
+        reach=Recording.steps,
+        command=("table", "-o", "{tmp}/step-gap.csv"),
+    ),
+    "broken-chain": Case(
+        CorruptRecording,
+        r"broken-chain\.mcap: model version \d+ \(step \d+\): its operations applied to "
+        r"version \d+ do not give its snapshot \(transitions differ",
+        reach=Recording.model_versions,
+        command=("audit",),
+    ),
+    "other-scenario": Case(
+        CorruptRecording,
+        r"other-scenario\.mcap: the /rsstp/scenario message's sha256 is [0-9a-f]{64}, but the "
+        r"scenario\.toml attachment hashes to [0-9a-f]{64}",
+    ),
+    "step-out-of-range": Case(
+        StepOutOfRange,
+        r"step-out-of-range\.mcap: (step|compare M =) 401 is out of range: the recording "
+        r"has steps 0 to 400",
+        reach=lambda recording: recording.model_at(STEPS + 1),
+        command=("compare", "0", "401"),
+    ),
+}
+
+
+@pytest.fixture(scope="module")
+def original(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("original") / "run.mcap"
+    record(
+        path, load_scenario("three-joint"), Splitter(), steps=STEPS, seed=5, chunk_size=CHUNK_SIZE
+    )
+    return path
+
+
+@pytest.fixture(scope="module")
+def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[str, Path]:
+    """One file per case of :data:`CASES`, in one directory."""
+    folder = tmp_path_factory.mktemp("damaged")
+    files = {name: folder / f"{name}.mcap" for name in CASES}
+    files["directory"].mkdir()
+    files["empty"].write_bytes(b"")
+    files["text"].write_text("step,action\n0,\n", encoding="utf-8")
+    foreign_mcap(files["foreign"])
+
+    def version2(name: str, data: bytes) -> bytes:
+        return (
+            data.replace(b'"version": "1.0"', b'"version": "2.0"') if name == "rsstp.Step" else data
+        )
+
+    rewrite(original, files["version2"], schema=version2)
+    raw = original.read_bytes()
+    files["in-magic"].write_bytes(raw[:5])
+    files["in-header"].write_bytes(raw[:40])
+    offsets = chunk_offsets(original)
+    flip(original, files["chunk-flip"], in_compressed_data(original, offsets[len(offsets) // 2]))
+    flip(original, files["first-chunk-flip"], in_compressed_data(original, offsets[0]))
+    flip(original, files["summary-flip"], summary_start(original) + 40)
+
+    def set_action(step: dict[str, Any]) -> None:
+        step["agent"]["action"] = 1.5
+
+    rewrite(original, files["bad-step"], message=edit_json("/rsstp/step", 17, set_action))
+
+    def drop_step_50(topic: str, log_time: int, data: bytes) -> bytes | None:
+        return None if topic == "/rsstp/step" and log_time == 50_000_000 else data
+
+    rewrite(original, files["step-gap"], message=drop_step_50)
+    with open_recording(original) as recording:
+        changed = recording.model_versions()[2]
+
+    def drop_transition(model: dict[str, Any]) -> None:
+        model["transitions"] = model["transitions"][1:]
+        model["deterministic"], model["nondeterministic_pairs"] = _determinism(model)
+
+    rewrite(
+        original,
+        files["broken-chain"],
+        message=edit_json("/rsstp/model", changed.step, drop_transition),
+    )
+    rewrite(original, files["other-scenario"], attachment=lambda data: data + b"\n# edited\n")
+    files["step-out-of-range"].write_bytes(raw)
+    return files
+
+
+def _determinism(model: dict[str, Any]) -> tuple[bool, int]:
+    pairs: dict[tuple[int, int], int] = {}
+    for s, a, _ in model["transitions"]:
+        pairs[(s, a)] = pairs.get((s, a), 0) + 1
+    count = sum(1 for n in pairs.values() if n > 1)
+    return count == 0, count
+
+
+# ---------------------------------------------------------------------------- the API
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_api_raises_a_one_line_error(name: str, damaged: dict[str, Path]) -> None:
+    case = CASES[name]
+    with pytest.raises(case.error, match=case.match) as caught:
+        if case.reach is None:
+            open_recording(damaged[name])
+        else:
+            with open_recording(damaged[name]) as recording:
+                case.reach(recording)
+    assert "\n" not in str(caught.value)
+    assert str(damaged[name]) in str(caught.value)
+
+
+def test_a_later_minor_version_with_new_fields_is_read(original: Path, tmp_path: Path) -> None:
+    def minor(name: str, data: bytes) -> bytes:
+        return data.replace(b'"version": "1.0"', b'"version": "1.3"')
+
+    def extra_fields(topic: str, log_time: int, data: bytes) -> bytes:
+        value = json.loads(data)
+        value["added_in_1_3"] = {"anything": [1, 2]}
+        if topic == "/rsstp/step":
+            value["agent"]["confidence"] = 0.5
+            value["truth"]["velocity"] = [0.0, 0.0]
+        return json.dumps(value, separators=(",", ":")).encode()
+
+    newer = rewrite(original, tmp_path / "newer.mcap", schema=minor, message=extra_fields)
+    with open_recording(newer) as recording, open_recording(original) as before:
+        assert recording.schema_versions["rsstp.Step"] == "1.3"
+        assert recording.memory() == before.memory()
+        assert recording.steps().equals(before.steps())
+        assert recording.events().equals(before.events())
+        assert recording.model_at(STEPS) == before.model_at(STEPS)
+
+
+def test_a_bit_flip_in_a_chunk_spares_the_chunks_before_it(damaged: dict[str, Path]) -> None:
+    recording = open_recording(damaged["chunk-flip"])
+    assert recording.model_at(0).version >= 0  # the first chunks read fine
+    with pytest.raises(CorruptRecording, match="chunk at byte"):
+        recording.memory()
+
+
+def test_an_event_of_an_unknown_kind_is_refused(original: Path, tmp_path: Path) -> None:
+    with open_recording(original) as recording:
+        step = int(recording.events()["step"].iloc[0])
+
+    def explode(event: dict[str, Any]) -> None:
+        event["kind"] = "explosion"
+
+    bad = rewrite(
+        original, tmp_path / "bad-event.mcap", message=edit_json("/rsstp/event", step, explode)
+    )
+    with open_recording(bad) as recording:
+        with pytest.raises(
+            CorruptRecording,
+            match=rf"bad-event\.mcap: the /rsstp/event message at step {step} \(chunk at byte "
+            r"\d+\) is invalid: rsstp\.Event: kind: invalid enum value 'explosion'",
+        ):
+            recording.events()
+
+
+# ------------------------------------------------------------------------ the command line
+
+
+@pytest.fixture(scope="module")
+def cli_runs(damaged: dict[str, Path]) -> dict[str, subprocess.CompletedProcess[str]]:
+    """``python -m rsstp_replay`` on every damaged file, all at once (they take a while)."""
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    folder = damaged["text"].parent
+    processes = {}
+    for name, case in CASES.items():
+        command, *options = case.command
+        argv = [command, str(damaged[name]), *(o.format(tmp=folder) for o in options)]
+        processes[name] = subprocess.Popen(
+            [sys.executable, "-m", "rsstp_replay", *argv],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+    runs = {}
+    for name, process in processes.items():
+        stdout, stderr = process.communicate(timeout=120)
+        runs[name] = subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
+    return runs
+
+
+@pytest.mark.parametrize("name", list(CASES))
+def test_cli_prints_one_line_and_exits_with_2(
+    name: str, cli_runs: dict[str, subprocess.CompletedProcess[str]], damaged: dict[str, Path]
+) -> None:
+    run = cli_runs[name]
+    assert "Traceback" not in run.stderr
+    assert run.returncode == 2, run.stderr
+    lines = run.stderr.splitlines()
+    assert len(lines) == 1, run.stderr
+    assert lines[0].startswith("rsstp-replay: error: ")
+    assert str(damaged[name]) in lines[0]
+    assert re.search(CASES[name].match, lines[0]), lines[0]

@@ -1,0 +1,389 @@
+"""Reading recordings: real MCAP files written by the recorder, checked against live runs.
+
+The steps table and the events are checked against the messages read back independently (the
+``mcap`` reader and the record types); the memory and the model at every step against a live
+run with the same scenario, strategy and seed; unfinished files (cut bytes, a killed writer)
+are read up to their last complete chunk, with a warning.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+import pandas as pd
+import pytest
+from mcap.reader import make_reader
+
+from rsstp_replay import (
+    EVENT_KINDS,
+    ReplayError,
+    StepOutOfRange,
+    UnfinishedRecordingWarning,
+    open_recording,
+)
+from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, make_strategy
+from rsstp_sim.recording import records
+from rsstp_sim.recording.recorder import record
+from rsstp_sim.transition_system import TransitionSystem
+
+SRC = Path(__file__).resolve().parents[2] / "src"
+STEPS = 2000
+SEED = 7
+CHUNK_SIZE = 16 * 1024  # about 20 steps per chunk: many chunks in a small file
+
+
+class Refiner(StrategyBase):
+    """Random actions, and a model that changes: splits, adds, deletes, one merge, notes and
+    re-localisations (setting the current state, which no operation logs)."""
+
+    name: ClassVar[str] = "test-refiner"
+
+    def choose_action(self, agent: AgentView) -> int:
+        return agent.actions[int(agent.rng.integers(len(agent.actions)))]
+
+    def refine(self, agent: AgentView) -> None:
+        model, t = agent.model, agent.step
+        if t % 97 == 0 and len(model) < 8:
+            model.split(model.current)
+        if t % 13 == 0:
+            for a in agent.actions:
+                successors = model.successors(model.current, a)
+                if len(successors) > 1:
+                    model.delete(model.current, successors[-1], a)
+                    break
+        if t % 29 == 0:
+            target = model.states[int(agent.rng.integers(len(model)))]
+            model.add(model.current, target, agent.actions[t % len(agent.actions)])
+        if t == 600 and len(model) > 2:
+            model.merge(model.states[0], model.states[-1])
+        if t % 31 == 0:
+            model.current = model.states[t % len(model)]
+        if t % 250 == 0:
+            agent.note(f"step {t}: {len(model)} states")
+
+
+def steps_of(path: Path) -> list[records.StepRecord]:
+    """The step messages, read independently with the ``mcap`` reader and the record types."""
+    return [
+        record for record in _decoded(path, "/rsstp/step") if isinstance(record, records.StepRecord)
+    ]
+
+
+def _decoded(path: Path, topic: str) -> Iterator[records.MessageRecord]:
+    with open(path, "rb") as stream:
+        for _, channel, message in make_reader(stream).iter_messages(topics=[topic]):
+            yield records.decode(_SCHEMAS[channel.topic], message.data)
+
+
+_SCHEMAS = {
+    "/rsstp/scenario": "rsstp.Scenario",
+    "/rsstp/step": "rsstp.Step",
+    "/rsstp/model": "rsstp.Model",
+    "/rsstp/event": "rsstp.Event",
+}
+
+
+@pytest.fixture(scope="module")
+def random_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Any]:
+    """A recording of the random strategy, and what the recorder said it wrote."""
+    path = tmp_path_factory.mktemp("random") / "run.mcap"
+    result = record(
+        path,
+        load_scenario("three-joint"),
+        make_strategy("random"),
+        steps=STEPS,
+        seed=SEED,
+        chunk_size=CHUNK_SIZE,
+    )
+    return path, result
+
+
+@dataclass(frozen=True)
+class LiveRun:
+    """A recording, and the live run it was made from: its memory, its model after every
+    step (0 = the reset)."""
+
+    path: Path
+    memory: Memory
+    models: list[TransitionSystem]
+
+    def memory_until(self, step: int) -> Memory:
+        live = self.memory
+        end = step + 1
+        return Memory.from_arrays(
+            live.actions[:end],
+            live.internal_states[:end],
+            live.sensations[:end],
+            live.feedback[:end],
+        )
+
+
+@pytest.fixture(scope="module")
+def refined_run(tmp_path_factory: pytest.TempPathFactory) -> LiveRun:
+    """A recording of :class:`Refiner`, and its live run."""
+    path = tmp_path_factory.mktemp("refined") / "run.mcap"
+    scenario = load_scenario("three-joint")
+    record(path, scenario, Refiner(), steps=STEPS, seed=SEED, chunk_size=CHUNK_SIZE)
+    runner = Runner(scenario, Refiner(), seed=SEED)
+    models = [runner.model.copy()]
+    for _ in range(STEPS):
+        runner.step()
+        models.append(runner.model.copy())
+    return LiveRun(path, runner.memory, models)
+
+
+# ----------------------------------------------------------------------------- opening
+
+
+def test_open_reads_the_scenario_metadata_and_counts(random_run: tuple[Path, Any]) -> None:
+    path, result = random_run
+    with open_recording(path) as recording:
+        assert recording.path == path
+        assert recording.finished
+        assert recording.recovered_steps is None
+        assert recording.n_steps == STEPS
+        assert recording.topic_counts == result.messages
+        assert recording.seed == SEED
+        assert recording.strategy == "random"
+        assert recording.strategy_params == {}
+        assert recording.scenario == load_scenario("three-joint")
+        assert recording.scenario_record.name == "three-joint"
+        assert recording.metadata["seed"] == str(SEED)
+        assert recording.metadata["scenario_sha256"] == recording.scenario.sha256
+        assert recording.schema_versions == {
+            "rsstp.Scenario": "1.0",
+            "rsstp.Step": "1.0",
+            "rsstp.Model": "1.0",
+            "rsstp.Event": "1.0",
+        }
+        assert "steps=0..2000" in repr(recording)
+
+
+def test_a_closed_recording_refuses_to_read(random_run: tuple[Path, Any]) -> None:
+    path, _ = random_run
+    with open_recording(path) as recording:
+        pass
+    with pytest.raises(ReplayError, match=r"run\.mcap: the recording is closed"):
+        recording.memory()
+    with pytest.raises(ReplayError, match="closed"):
+        recording.model_at(0)
+
+
+# -------------------------------------------------------------------------- the tables
+
+
+def test_steps_table_has_flat_typed_columns(random_run: tuple[Path, Any]) -> None:
+    path, _ = random_run
+    table = open_recording(path).steps()
+    assert len(table) == STEPS + 1
+    dtypes = {name: str(dtype) for name, dtype in table.dtypes.items()}
+    assert dtypes == {
+        "step": "int64",
+        "action": "Int64",
+        "state_before": "Int64",
+        "internal_state": "int64",
+        "sensation": "bool",
+        "feedback": "float64",
+        "model_version": "int64",
+        "no_transition": "bool",
+        "blocked": "bool",
+        "blocked_by": "category",
+        **{f"angle_deg_{j}": "int64" for j in range(3)},
+        **{f"joint{k}_{axis}": "float64" for k in range(4) for axis in "xy"},
+        **{f"dist_{k}_{j}": "float64" for k in range(3) for j in range(2)},
+    }
+    assert table["action"].isna().tolist() == [True] + [False] * STEPS
+    assert table["state_before"].isna().sum() == 1
+    assert table["blocked"].any()  # the random walk meets the obstacles
+
+
+def test_steps_table_equals_the_step_messages(random_run: tuple[Path, Any]) -> None:
+    path, _ = random_run
+    table = open_recording(path).steps()
+    messages = steps_of(path)
+    assert len(messages) == len(table)
+    for row, message in zip(table.itertuples(index=False), messages, strict=True):
+        agent, truth = message.agent, message.truth
+        assert row.step == message.step
+        assert (None if pd.isna(row.action) else row.action) == agent.action
+        assert (None if pd.isna(row.state_before) else row.state_before) == agent.state_before
+        assert (row.internal_state, row.sensation, row.feedback) == (
+            agent.internal_state,
+            agent.sensation,
+            agent.feedback,
+        )
+        assert (row.model_version, row.no_transition) == (agent.model_version, agent.no_transition)
+        assert row.blocked == truth.blocked
+        by = truth.blocked_by
+        if by is None:
+            assert pd.isna(row.blocked_by)
+        else:
+            expected = {
+                "fold": lambda i: f"fold joint {i[0]}",
+                "obstacle": lambda i: f"obstacle {i[1]} link {i[0]}",
+                "links": lambda i: f"links {i[0]} {i[1]}",
+            }[by.kind](by.indices)
+            assert row.blocked_by == expected
+        values = row._asdict()
+        assert [values[f"angle_deg_{j}"] for j in range(3)] == list(truth.angles_deg)
+        for k, (x, y) in enumerate(truth.joint_positions):
+            assert (values[f"joint{k}_x"], values[f"joint{k}_y"]) == (x, y)  # exactly
+        for k, tip in enumerate(truth.distances):
+            assert [values[f"dist_{k}_{j}"] for j in range(2)] == list(tip)
+
+
+def test_events_table_equals_the_event_messages(refined_run: LiveRun) -> None:
+    path = refined_run.path
+    events = open_recording(path).events()
+    messages = list(_decoded(path, "/rsstp/event"))
+    assert {str(name): str(dtype) for name, dtype in events.dtypes.items()} == {
+        "step": "int64",
+        "kind": "category",
+        "text": "str",
+        "data": "str",
+    }
+    assert list(events["kind"].cat.categories) == list(EVENT_KINDS)
+    assert len(events) == len(messages) > 0
+    for row, message in zip(events.itertuples(index=False), messages, strict=True):
+        assert isinstance(message, records.EventRecord)
+        assert (row.step, row.kind, row.text) == (message.step, message.kind, message.text)
+        assert json.loads(row.data) == message.data
+    assert {"split", "merge", "add", "delete", "note", "blocked"} <= set(events["kind"])
+
+
+# ------------------------------------------------------------------ memory and the model
+
+
+def test_memory_equals_the_live_run(random_run: tuple[Path, Any]) -> None:
+    path, _ = random_run
+    runner = Runner(load_scenario("three-joint"), make_strategy("random"), seed=SEED)
+    runner.run(STEPS)
+    memory = open_recording(path).memory()
+    assert memory == runner.memory
+    for t in (0, 1, STEPS // 2, STEPS):
+        assert memory[t] == runner.memory[t]
+
+
+def test_memory_of_a_refining_strategy_equals_the_live_run(refined_run: LiveRun) -> None:
+    assert open_recording(refined_run.path).memory() == refined_run.memory
+
+
+def _same_model(replayed: TransitionSystem, live: TransitionSystem) -> bool:
+    return (
+        replayed == live
+        and replayed.version == live.version
+        and replayed.next_id == live.next_id
+        and replayed.states == live.states
+    )
+
+
+def test_model_at_every_step_equals_the_live_model(refined_run: LiveRun) -> None:
+    live = refined_run.models
+    recording = open_recording(refined_run.path)
+    versions = recording.model_versions()
+    assert len(versions) > 20  # the model changed many times
+    assert {op.kind for v in versions for op in v.operations} == {"split", "merge", "add", "delete"}
+    assert versions[-1].version == live[-1].version
+    for step in range(STEPS + 1):  # chunk by chunk, before the whole memory is read
+        assert _same_model(recording.model_at(step), live[step]), f"step {step}"
+    recording.memory()  # now from the cached columns
+    for step in (0, 1, 600, 601, STEPS - 1, STEPS):
+        assert _same_model(recording.model_at(step), live[step]), f"step {step}"
+
+
+def test_model_at_refuses_steps_out_of_range(random_run: tuple[Path, Any]) -> None:
+    path, _ = random_run
+    recording = open_recording(path)
+    with pytest.raises(StepOutOfRange, match=r"run\.mcap: step 2001 is out of range: .* 0 to 2000"):
+        recording.model_at(STEPS + 1)
+    with pytest.raises(StepOutOfRange, match="step -1 is out of range"):
+        recording.model_at(-1)
+    with pytest.raises(StepOutOfRange, match="must be an integer, got 2.5"):
+        recording.model_at(2.5)  # type: ignore[arg-type]
+    assert recording.model_at(np.int64(STEPS)).current == 0
+
+
+def test_a_recording_of_the_reset_alone(tmp_path: Path) -> None:
+    path = tmp_path / "reset.mcap"
+    record(path, load_scenario("one-joint-10"), make_strategy("random"), steps=0, seed=0)
+    recording = open_recording(path)
+    assert recording.n_steps == 0
+    assert len(recording.steps()) == 1
+    assert len(recording.memory()) == 1
+    assert recording.model_at(0) == TransitionSystem.universal(recording.scenario.actions)
+    assert len(recording.events()) == 0
+
+
+# ---------------------------------------------------------------- unfinished recordings
+
+
+def _chunk_offsets(path: Path) -> list[int]:
+    with open(path, "rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None
+    return sorted(index.chunk_start_offset for index in summary.chunk_indexes)
+
+
+@pytest.mark.parametrize("where", ["mid-chunk", "chunk-boundary"])
+def test_a_truncated_recording_is_read_up_to_its_last_complete_chunk(
+    refined_run: LiveRun, tmp_path: Path, where: str
+) -> None:
+    path, live = refined_run.path, refined_run.models
+    offsets = _chunk_offsets(path)
+    cut_at = offsets[len(offsets) // 2] + (200 if where == "mid-chunk" else 0)
+    cut = tmp_path / "cut.mcap"
+    cut.write_bytes(path.read_bytes()[:cut_at])
+    with pytest.warns(
+        UnfinishedRecordingWarning,
+        match=r"cut\.mcap: the file was not finished; recovered \d+ steps from its complete chunks",
+    ):
+        recording = open_recording(cut)
+    assert not recording.finished
+    n = recording.n_steps
+    assert recording.recovered_steps == n
+    assert STEPS // 4 < n < STEPS
+    assert recording.memory() == refined_run.memory_until(n)
+    table = recording.steps()
+    assert table["step"].tolist() == list(range(n + 1))
+    for step in (0, n // 2, n - 1, n):
+        assert _same_model(recording.model_at(step), live[step]), f"step {step}"
+    assert recording.events()["step"].max() <= n
+    full = open_recording(path)
+    assert recording.topic_counts["/rsstp/step"] == n + 1
+    assert recording.topic_counts["/rsstp/model"] == sum(
+        1 for m in full.model_versions() if m.step <= n
+    )
+
+
+def test_a_killed_writer_leaves_a_readable_recording(tmp_path: Path) -> None:
+    path = tmp_path / "killed.mcap"
+    env = {**os.environ, "PYTHONPATH": str(SRC)}
+    command = [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--steps", "10000000"]
+    command += ["--seed", "3", "--chunk-size", "4096", "-o", str(path)]
+    process = subprocess.Popen(command, env=env, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 30
+        while (not path.exists() or path.stat().st_size < 60_000) and time.monotonic() < deadline:
+            time.sleep(0.02)
+    finally:
+        process.send_signal(signal.SIGKILL)
+        process.wait()
+    assert process.returncode == -signal.SIGKILL
+    with pytest.warns(UnfinishedRecordingWarning, match="killed.mcap: the file was not finished"):
+        recording = open_recording(path)
+    n = recording.n_steps
+    assert n > 0
+    runner = Runner(load_scenario("three-joint"), make_strategy("random"), seed=3)
+    runner.run(n)
+    assert recording.memory() == runner.memory
+    assert recording.model_at(n) == runner.model
