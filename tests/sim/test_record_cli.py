@@ -1,0 +1,403 @@
+"""``rsstp-sim record`` in a real subprocess: bad input, the happy path, and crash safety.
+
+Crash safety: a long recording with small chunks is stopped once the file has grown past a
+few chunks. SIGINT and SIGTERM end the run after the current step with a finished file (exit
+code 128 + signal); after SIGKILL the file has no summary, and a sequential reader recovers
+the steps of every complete chunk, in order, without gaps.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import os
+import re
+import select
+import signal
+import struct
+import subprocess
+import sys
+import time
+from collections.abc import Sequence
+from pathlib import Path
+
+import pytest
+from mcap.exceptions import McapError
+from mcap.reader import make_reader
+from mcap.records import Channel, Chunk, DataEnd, Footer, Message
+from mcap.stream_reader import StreamReader, breakup_chunk
+
+from rsstp_sim import RandomStrategy, load_scenario
+from rsstp_sim.recording import records, schemas
+from rsstp_sim.recording.recorder import record
+
+SRC = Path(__file__).resolve().parents[2] / "src"
+TIMEOUT_S = 60
+CHUNK_SIZE = 65536
+MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def cli_env(**extra: str) -> dict[str, str]:
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))
+    env.update(extra)
+    return env
+
+
+def rsstp_record(*args: str | Path, **env: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", "rsstp_sim", "record", *map(str, args)],
+        env=cli_env(**env),
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+        check=False,
+    )
+
+
+def assert_one_line_error(done: subprocess.CompletedProcess[str], pattern: str) -> None:
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr
+    assert done.stdout == ""
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("rsstp-sim: error: ")
+    assert re.search(pattern, lines[0]), lines[0]
+
+
+def step_counts(path: Path) -> dict[str, int]:
+    with path.open("rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.statistics is not None
+    counts = summary.statistics.channel_message_counts
+    return {c.topic: counts.get(c.id, 0) for c in summary.channels.values()}
+
+
+# -------------------------------------------------------------------- bad input
+
+
+def test_existing_output_without_force(tmp_path: Path) -> None:
+    out = tmp_path / "out.mcap"
+    out.write_bytes(b"keep me")
+    done = rsstp_record("three-joint", "--steps", "10", "-o", out)
+    assert_one_line_error(done, re.escape(f"{out}: already exists") + r".*--force")
+    assert out.read_bytes() == b"keep me"
+
+
+def test_existing_output_with_force(tmp_path: Path) -> None:
+    out = tmp_path / "out.mcap"
+    out.write_bytes(b"keep me")
+    done = rsstp_record("three-joint", "--steps", "10", "-o", out, "--force")
+    assert done.returncode == 0, done.stderr
+    assert step_counts(out)["/rsstp/step"] == 11
+
+
+def test_unwritable_output_directory(tmp_path: Path) -> None:
+    directory = tmp_path / "read-only"
+    directory.mkdir()
+    directory.chmod(0o500)
+    try:
+        if os.access(directory, os.W_OK):
+            pytest.skip("running as a user (root) who can write to a 0o500 directory")
+        done = rsstp_record("three-joint", "--steps", "10", "-o", directory / "out.mcap")
+        assert_one_line_error(done, r"read-only is not writable")
+    finally:
+        directory.chmod(0o700)
+
+
+BAD_ARGUMENTS: dict[str, tuple[list[str], str, str]] = {
+    # case: (arguments before -o, output path in the case's directory, the error's pattern)
+    "missing-directory": (
+        ["three-joint"],
+        "missing/out.mcap",
+        r"output directory .*missing does not exist",
+    ),
+    "parent-is-a-file": (
+        ["three-joint"],
+        "a-file/out.mcap",
+        r"output directory .*a-file is not a directory",
+    ),
+    "output-is-a-directory": (["three-joint", "--force"], ".", r": is a directory"),
+    "chunk-size-too-small": (
+        ["three-joint", "--chunk-size", "100"],
+        "out.mcap",
+        r"argument --chunk-size: expected at least 1024 bytes, got '100'",
+    ),
+    "chunk-size-not-a-number": (
+        ["three-joint", "--chunk-size", "1k"],
+        "out.mcap",
+        r"argument --chunk-size: expected an integer >= 0, got '1k'",
+    ),
+    "negative-steps": (
+        ["three-joint", "--steps", "-3"],
+        "out.mcap",
+        r"argument --steps: expected an integer >= 0, got '-3'",
+    ),
+    "unknown-scenario": (
+        ["no-such-scenario"],
+        "out.mcap",
+        r"no-such-scenario: no such scenario file, and not a built-in scenario",
+    ),
+    "unknown-strategy": (
+        ["three-joint", "--strategy", "telepathy"],
+        "out.mcap",
+        r"unknown strategy 'telepathy'",
+    ),
+    "script-action-not-in-scenario": (
+        ["three-joint", "--strategy", "script", "--param", "actions=[77]"],
+        "out.mcap",
+        r"script: actions \[77\] are not among the scenario's actions",
+    ),
+    "param-without-value": (
+        ["three-joint", "--param", "oops"],
+        "out.mcap",
+        r"--param expects key=value, got 'oops'",
+    ),
+}
+
+
+@pytest.fixture(scope="module")
+def bad_runs(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> dict[str, tuple[Path, subprocess.CompletedProcess[str]]]:
+    """Every case of :data:`BAD_ARGUMENTS`, run at once (each in its own directory)."""
+    started = {}
+    for case, (args, where, _) in BAD_ARGUMENTS.items():
+        directory = tmp_path_factory.mktemp(case)
+        (directory / "a-file").write_text("a file")
+        command = [sys.executable, "-m", "rsstp_sim", "record", *args, "-o", str(directory / where)]
+        proc = subprocess.Popen(
+            command, env=cli_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        )
+        started[case] = (directory, proc)
+    runs = {}
+    for case, (directory, proc) in started.items():
+        try:
+            stdout, stderr = proc.communicate(timeout=TIMEOUT_S)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+                proc.communicate()
+        runs[case] = (
+            directory,
+            subprocess.CompletedProcess(proc.args, proc.returncode, stdout, stderr),
+        )
+    return runs
+
+
+@pytest.mark.parametrize("case", BAD_ARGUMENTS)
+def test_bad_arguments_one_line_and_no_file(
+    bad_runs: dict[str, tuple[Path, subprocess.CompletedProcess[str]]], case: str
+) -> None:
+    directory, done = bad_runs[case]
+    assert_one_line_error(done, BAD_ARGUMENTS[case][2])
+    assert [p.name for p in directory.iterdir()] == ["a-file"]
+    assert (directory / "a-file").read_text() == "a file"
+
+
+# ------------------------------------------------------------------- happy path
+
+
+def test_record_prints_a_summary_line_and_no_progress(tmp_path: Path) -> None:
+    out = tmp_path / "out.mcap"
+    done = rsstp_record("two-joint-30", "--steps", "5000", "--seed", "3", "-o", out)
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""  # stderr is a pipe, not a TTY: no progress
+    counts = step_counts(out)
+    assert counts["/rsstp/step"] == 5001
+    expected = ", ".join(f"{topic} {count}" for topic, count in counts.items())
+    assert done.stdout == f"recorded 5000 steps to {out} ({expected})\n"
+
+
+def test_progress_on_a_tty(tmp_path: Path) -> None:
+    out = tmp_path / "out.mcap"
+    leader, follower = os.openpty()
+    try:
+        proc = subprocess.Popen(
+            [sys.executable, "-m", "rsstp_sim", "record", "one-joint-10", "--steps", "9000"]
+            + ["-o", str(out)],
+            env=cli_env(),
+            stdout=subprocess.PIPE,
+            stderr=follower,
+        )
+        os.close(follower)
+        follower = -1
+        shown = bytearray()
+        deadline = time.monotonic() + TIMEOUT_S
+        while time.monotonic() < deadline:
+            ready, _, _ = select.select([leader], [], [], 0.1)
+            if ready:
+                try:
+                    chunk = os.read(leader, 4096)
+                except OSError:  # the child closed the terminal
+                    break
+                if not chunk:
+                    break
+                shown += chunk
+            elif proc.poll() is not None:
+                break
+        stdout, _ = proc.communicate(timeout=TIMEOUT_S)
+    finally:
+        if follower >= 0:
+            os.close(follower)
+        os.close(leader)
+    assert proc.returncode == 0
+    text = shown.decode()
+    assert "recording: 4,096/9,000 steps (46%)" in text
+    assert "recording: 8,192/9,000 steps (91%)" in text
+    assert stdout.decode().startswith("recorded 9000 steps to ")
+
+
+def test_same_bytes_across_processes_and_hash_seeds(tmp_path: Path) -> None:
+    paths = [tmp_path / f"run{i}.mcap" for i in range(2)]
+    for path, hash_seed in zip(paths, ("1", "2"), strict=True):
+        done = rsstp_record(
+            "three-joint", "--steps", "1000", "--seed", "5", "-o", path, PYTHONHASHSEED=hash_seed
+        )
+        assert done.returncode == 0, done.stderr
+    in_process = tmp_path / "in-process.mcap"
+    record(in_process, load_scenario("three-joint"), RandomStrategy(), steps=1000, seed=5)
+    assert paths[0].read_bytes() == paths[1].read_bytes() == in_process.read_bytes()
+
+
+# ----------------------------------------------------------------- crash safety
+
+
+def start_long_recording(out: Path) -> subprocess.Popen[str]:
+    return subprocess.Popen(
+        [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--strategy", "random"]
+        + ["--steps", "2000000", "--seed", "1", "-o", str(out), "--chunk-size", str(CHUNK_SIZE)],
+        env=cli_env(),
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+
+
+def wait_for_chunks(proc: subprocess.Popen[str], out: Path, *, min_bytes: int) -> None:
+    """Poll until ``out`` is bigger than ``min_bytes`` (several complete chunks)."""
+    deadline = time.monotonic() + TIMEOUT_S
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            pytest.fail(f"the recording ended early: {proc.returncode} {proc.communicate()}")
+        if out.exists() and out.stat().st_size > min_bytes:
+            return
+        time.sleep(0.02)
+    pytest.fail(f"{out} did not grow past {min_bytes} bytes in {TIMEOUT_S} s")
+
+
+def stop_recording(out: Path, sig: signal.Signals) -> subprocess.CompletedProcess[str]:
+    proc = start_long_recording(out)
+    try:
+        wait_for_chunks(proc, out, min_bytes=3 * CHUNK_SIZE)
+        proc.send_signal(sig)
+        stdout, stderr = proc.communicate(timeout=TIMEOUT_S)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    return subprocess.CompletedProcess(proc.args, proc.returncode, stdout, stderr)
+
+
+def step_numbers(messages: Sequence[tuple[str, bytes]]) -> list[int]:
+    steps = []
+    for topic, data in messages:
+        if topic == "/rsstp/step":
+            schemas.validate("rsstp.Step", json.loads(data))
+            steps.append(records.decode("rsstp.Step", data).step)  # type: ignore[union-attr]
+    return steps
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+def test_sigint_and_sigterm_finish_the_file(tmp_path: Path, sig: signal.Signals) -> None:
+    out = tmp_path / "long.mcap"
+    done = stop_recording(out, sig)
+    assert done.returncode == 128 + sig.value
+    assert "Traceback" not in done.stderr
+    assert done.stdout == ""
+    match = re.fullmatch(
+        rf"rsstp-sim: interrupted by {sig.name}: kept (\d+) steps in {re.escape(str(out))} "
+        r"\(file finished\)\n",
+        done.stderr,
+    )
+    assert match, done.stderr
+    kept = int(match[1])
+    assert kept > 0
+    assert step_counts(out)["/rsstp/step"] == kept + 1
+    with out.open("rb") as stream:
+        messages = [
+            (channel.topic, m.data)
+            for _, channel, m in make_reader(stream).iter_messages(log_time_order=False)
+        ]
+    assert step_numbers(messages) == list(range(kept + 1))
+
+
+def read_sequentially(data: bytes) -> tuple[list[tuple[str, bytes]], list[int], int, bool]:
+    """Read a (possibly truncated) MCAP file record by record, as a non-seeking reader does.
+
+    Returns the messages (topic, data) of the complete chunks, the number of step messages
+    in each complete chunk, the offset just after the last complete record, and whether a
+    footer was found.
+    """
+    stream = io.BytesIO(data)
+    reader = StreamReader(stream, skip_magic=False, emit_chunks=True, validate_crcs=True)
+    topics: dict[int, str] = {}
+    messages: list[tuple[str, bytes]] = []
+    steps_per_chunk: list[int] = []
+    end = 0
+    footer = False
+    try:
+        for rec in reader.records:
+            if isinstance(rec, Chunk):
+                inner = breakup_chunk(rec, validate_crc=True)
+                for item in inner:
+                    if isinstance(item, Channel):
+                        topics[item.id] = item.topic
+                chunk_messages = [
+                    (topics[m.channel_id], m.data) for m in inner if isinstance(m, Message)
+                ]
+                messages += chunk_messages
+                steps_per_chunk.append(sum(t == "/rsstp/step" for t, _ in chunk_messages))
+            footer = footer or isinstance(rec, Footer | DataEnd)
+            end = stream.tell()
+    except (McapError, struct.error):  # the truncated tail
+        pass
+    return messages, steps_per_chunk, end, footer
+
+
+def test_sigkill_keeps_every_complete_chunk(tmp_path: Path) -> None:
+    out = tmp_path / "killed.mcap"
+    proc = start_long_recording(out)
+    try:
+        wait_for_chunks(proc, out, min_bytes=4 * CHUNK_SIZE)
+        # Stopped first, so that the kill cannot land inside a write() (which would leave a
+        # partial record): the file is then exactly what the process had handed to the OS.
+        proc.send_signal(signal.SIGSTOP)
+        _, status = os.waitpid(proc.pid, os.WUNTRACED)
+        assert os.WIFSTOPPED(status)
+        proc.kill()
+        proc.communicate(timeout=TIMEOUT_S)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert proc.returncode == -signal.SIGKILL
+    data = out.read_bytes()
+
+    # Not finished: no footer, no summary for a seeking reader.
+    assert not data.endswith(MCAP_MAGIC)
+    with out.open("rb") as stream, pytest.raises((McapError, struct.error)):
+        make_reader(stream).get_summary()
+
+    messages, steps_per_chunk, end, footer = read_sequentially(data)
+    assert not footer
+    assert len(steps_per_chunk) >= 3  # waited for a few chunks
+    steps = step_numbers(messages)  # every one schema-valid
+    assert steps == list(range(len(steps)))  # 0..K in order, no gaps
+    assert len(steps) == sum(steps_per_chunk)  # all steps of all complete chunks
+    for topic, payload in messages:
+        schemas.validate(schemas.TOPICS[topic], json.loads(payload))
+    # Each chunk reaches the OS whole, with its message indexes, in one write: the file ends
+    # on a record boundary. (That no completed chunk waits in a user-space buffer is checked
+    # in-process by test_recorder.py::test_completed_chunks_are_on_disk_during_the_run.)
+    assert end == len(data), f"{len(data) - end} bytes of a partial record at the end"
