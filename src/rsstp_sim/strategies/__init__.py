@@ -8,12 +8,16 @@ from typing import Any
 from rsstp_sim.errors import StrategyError
 from rsstp_sim.strategies._base import AgentView, Strategy, StrategyBase
 from rsstp_sim.strategies.random_walk import RandomStrategy
+from rsstp_sim.strategies.roulette import RouletteStrategy
 from rsstp_sim.strategies.script import ScriptStrategy
+from rsstp_sim.strategies.splitter import SplitterStrategy
 
 __all__ = [
     "AgentView",
     "RandomStrategy",
+    "RouletteStrategy",
     "ScriptStrategy",
+    "SplitterStrategy",
     "Strategy",
     "StrategyBase",
     "builtin_strategies",
@@ -22,7 +26,9 @@ __all__ = [
 
 _BUILTIN: dict[str, Callable[..., Strategy]] = {
     "random": RandomStrategy,
+    "roulette": RouletteStrategy,
     "script": ScriptStrategy,
+    "splitter": SplitterStrategy,
 }
 
 
