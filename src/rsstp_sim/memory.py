@@ -14,13 +14,15 @@ import enum
 import operator
 from collections.abc import Iterator
 from dataclasses import dataclass
-from typing import Any, SupportsIndex
+from typing import TYPE_CHECKING, Any, SupportsIndex
 
 import numpy as np
 import numpy.typing as npt
-import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_sim.errors import MemoryRangeError
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["CompareKind", "CompareResult", "Memory", "MemoryEntry", "NO_ACTION"]
 
@@ -285,6 +287,8 @@ class Memory:
     # -- conversion ----------------------------------------------------------------------------
 
     def to_dataframe(self) -> pd.DataFrame:
+        import pandas as pd  # a simulation never needs it: imported on first use (~0.2 s)
+
         """One row per entry: ``step`` (int64), ``action`` (nullable Int64, ``<NA>`` at step 0),
         ``internal_state`` (int64), ``sensation`` (bool), ``feedback`` (float64)."""
         size = self._length

@@ -177,6 +177,8 @@ class World:
             self._prefetch(self._code)
             moves = self._moves[self._code]
         try:
+            if action.__class__ is bool:  # True would pass for action 1
+                raise KeyError(action)
             code, blocker = moves[action]
         except KeyError:
             raise ActionError(

@@ -436,3 +436,10 @@ def test_pose_data_is_read_only() -> None:
         world.distances[0, 0] = 0.0
     with pytest.raises(dataclasses.FrozenInstanceError):
         world.current.sensation = False  # type: ignore[misc]
+
+
+def test_a_bool_is_not_an_action() -> None:
+    world = World(load_scenario("thesis-algo"))
+    with pytest.raises(ActionError, match="action True is not one of the scenario's actions"):
+        world.move(True)
+    assert world.angles_deg == (95,)
