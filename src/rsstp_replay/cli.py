@@ -26,7 +26,7 @@ __all__ = ["main"]
 
 PROG = "rsstp-replay"
 _TABLE_FORMATS = (".parquet", ".csv")
-_FAIL_ON = ("contradiction", "nondeterministic")
+_FAIL_ON = ("contradiction", "nondeterministic", "aliasing", "redundancy", "not-equivalent")
 
 
 class UsageError(ReplayError):
@@ -132,31 +132,42 @@ def _cmd_table(args: argparse.Namespace) -> int:
 
 
 def _cmd_audit(args: argparse.Namespace) -> int:
-    from rsstp_replay.audits import run_audits
+    from rsstp_replay.audits import audit_truth, run_audits
 
+    fail_on = set(args.fail_on or [])
+    needs_truth = fail_on & {"aliasing", "redundancy", "not-equivalent"}
+    if needs_truth and not args.truth:
+        raise UsageError(f"--fail-on {sorted(needs_truth)[0]} needs --truth")
     with _open(args.file) as recording:
         report = run_audits(recording)
+        truth = audit_truth(recording) if args.truth else None
     if args.json:
-        print(json.dumps(report.to_json(), indent=2))
+        document = report.to_json()
+        if truth is not None:
+            document["truth"] = truth.to_json()
+        print(json.dumps(document, indent=2))
     else:
-        print(report.to_text(), end="" if report.to_text().endswith("\n") else "\n")
-    failed = [
-        reason
-        for reason, found in (
-            ("contradiction", report.has_contradiction),
-            ("nondeterministic", report.has_nondeterminism),
-        )
-        if reason in (args.fail_on or []) and found
-    ]
-    if failed:
-        found_text = {
-            "contradiction": "the memory contradicts an internal state",
-            "nondeterministic": "the final model is nondeterministic",
+        text = report.to_text()
+        print(text, end="" if text.endswith("\n") else "\n")
+        if truth is not None:
+            print("\n== truth ==")
+            print(truth.to_text(), end="")
+    findings = {
+        "contradiction": (report.has_contradiction, "the memory contradicts an internal state"),
+        "nondeterministic": (report.has_nondeterminism, "the final model is nondeterministic"),
+    }
+    if truth is not None:
+        findings |= {
+            "aliasing": (bool(truth.aliased), "an internal state stood for several true classes"),
+            "redundancy": (bool(truth.redundant), "a true class was split over several states"),
+            "not-equivalent": (
+                not truth.final_equivalent,
+                "the final model is not equivalent to the truth",
+            ),
         }
-        print(
-            f"{PROG}: audit failed: {'; '.join(found_text[reason] for reason in failed)}",
-            file=sys.stderr,
-        )
+    failed = [text for reason, (found, text) in findings.items() if reason in fail_on and found]
+    if failed:
+        print(f"{PROG}: audit failed: {'; '.join(failed)}", file=sys.stderr)
         return 1
     return 0
 
@@ -205,6 +216,12 @@ def _build_parser() -> _Parser:
     p = sub.add_parser("audit", help="consistency, determinism and summary audits")
     p.add_argument("file", help="the .mcap recording")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
+    p.add_argument(
+        "--truth",
+        action="store_true",
+        help="also compare the internal states with the ground truth (aliasing, redundancy, "
+        "equivalence of the final model)",
+    )
     p.add_argument(
         "--fail-on",
         action="append",

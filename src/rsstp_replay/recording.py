@@ -62,6 +62,7 @@ from rsstp_sim.recording.schemas import (
     TOPICS,
 )
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.truth import GroundTruth, compute_truth
 
 __all__ = ["EVENT_KINDS", "Recording", "open_recording"]
 
@@ -121,6 +122,7 @@ class Recording:
     def __init__(self, container: Container) -> None:
         self._container = container
         self._closed = False
+        self._ground_truth: GroundTruth | None = None
         path = container.path
         if not container.finished and not container.chunks:
             raise CorruptRecording(
@@ -200,7 +202,7 @@ class Recording:
 
     # -- tables ----------------------------------------------------------------------------
 
-    def steps(self) -> pd.DataFrame:
+    def steps(self, *, truth: bool = False) -> pd.DataFrame:
         """One row per step (``0 .. n_steps``), flat typed columns:
 
         - ``step`` (int64); ``action`` and ``state_before`` (nullable Int64, ``<NA>`` at step 0);
@@ -212,9 +214,22 @@ class Recording:
         - ``joint{k}_x``, ``joint{k}_y`` (float64, length units, world frame): point ``k`` of
           the arm, ``k = 0`` the base, ``k = n`` the tip of the last link;
         - ``dist_{k}_{j}`` (float64, length units): from the tip of link ``k`` (point ``k + 1``)
-          to obstacle ``j``'s surface.
+          to obstacle ``j``'s surface;
+        - with ``truth=True``, also ``true_class`` (int64): the state of the minimal correct
+          model (the ground truth of :mod:`rsstp_sim.truth`) that the step's pose belongs to.
         """
-        return self._step_columns(truth=True).frame()
+        frame = self._step_columns(truth=True).frame()
+        if truth:
+            from rsstp_replay.audits.truth import step_true_classes
+
+            frame["true_class"] = step_true_classes(frame, self.ground_truth())
+        return frame
+
+    def ground_truth(self) -> GroundTruth:
+        """The scenario's ground truth (computed once per recording; may take seconds)."""
+        if self._ground_truth is None:
+            self._ground_truth = compute_truth(self.scenario)
+        return self._ground_truth
 
     def memory(self) -> Memory:
         """The agent's memory, entry by entry as the live run had it."""

@@ -33,7 +33,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
+from numpy.typing import ArrayLike, NDArray
 
 from rsstp_sim import geometry
 from rsstp_sim.errors import ModelError, RsstpError
@@ -156,6 +156,24 @@ class GroundTruth:
                 f"is not reachable from the start pose"
             )
         return index
+
+    def classes_of(self, angles_deg: ArrayLike) -> NDArray[np.int64]:
+        """Classes of many poses at once: ``angles_deg`` has shape ``(B, n)``.
+
+        Raises :class:`TruthError` naming the first pose that is not reachable.
+        """
+        angles = np.asarray(angles_deg, dtype=np.int64).reshape(-1, self.n_joints) % 360
+        codes = angles @ (360 ** np.arange(self.n_joints, dtype=np.int64))
+        index = np.searchsorted(self.pose_codes, codes)
+        index = np.minimum(index, len(self.pose_codes) - 1)
+        unreachable = self.pose_codes[index] != codes
+        if unreachable.any():
+            first = int(np.argmax(unreachable))
+            raise TruthError(
+                f"{self.scenario_name}: the pose {angles[first].tolist()} is not reachable "
+                f"from the start"
+            )
+        return np.asarray(self.true_class[index], dtype=np.int64)
 
     def class_of(self, angles_deg: Sequence[int]) -> int:
         """Class (minimal machine state) of the pose with these joint angles."""
@@ -385,11 +403,13 @@ def check_equivalence(
     truth: GroundTruth,
     *,
     start_state: int | None = None,
+    start_class: int = 0,
 ) -> tuple[int, ...] | None:
     """The shortest action sequence on which ``model`` and the truth disagree, or None.
 
     ``labels[s]`` is the sensation the model predicts in state ``s``. From
-    ``start_state`` (default: ``model.current``) and the start class, the
+    ``start_state`` (default: ``model.current``) and ``start_class`` (default:
+    the start pose's class, 0), the
     product of model states and true classes is explored breadth-first over
     ``truth.actions`` in order. The answer is the first sequence found (so the
     shortest, ties broken by action order) after which the model's state has
@@ -407,7 +427,11 @@ def check_equivalence(
         label = labels.get(state)
         return label is None or bool(label) != class_sensation[c]
 
-    origin = (start, 0)
+    if not 0 <= start_class < truth.n_classes:
+        raise ModelError(
+            f"check_equivalence: start class {start_class!r} is not in 0..{truth.n_classes - 1}"
+        )
+    origin = (start, start_class)
     if wrong(*origin):
         return ()
     parent: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}
