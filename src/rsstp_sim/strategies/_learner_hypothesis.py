@@ -1,0 +1,336 @@
+"""The learner's hypothesis: a Moore machine kept in the agent's transition system.
+
+The model (:class:`~rsstp_sim.transition_system.TransitionSystem`) is always complete and
+deterministic: every (state, action) has exactly one successor. A successor is either
+*confirmed* (the learner took that action from that state and identified where it led) or a
+*conjecture* (inherited from the state that was split to create this one, as the thesis's
+split copies a row and a column). The confirmed successors are mirrored in dense arrays indexed
+by state id, so that following many candidate states at once is one numpy indexing per step.
+
+Every change goes through the model's ``split``, ``merge``, ``add`` and ``delete``, so a
+recording shows the learning operation by operation.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Callable
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = ["FAR", "Hypothesis"]
+
+IntArray = NDArray[np.int64]
+BoolArray = NDArray[np.bool_]
+
+FAR = np.iinfo(np.int64).max // 4
+"""The distance to the landmark of a state with no confirmed path to it."""
+
+
+class Hypothesis:
+    """Labels, confirmed successors and the landmark, over the model's state ids.
+
+    ``labels[s]`` is the sensation state ``s`` predicts; ``landmark`` is the one state
+    predicting ``True``. ``access[s]`` is the action word that led from the landmark to the
+    world state ``s`` was created for: a fact of the trajectory, which defines ``s``.
+    ``next[s, k]`` is the confirmed successor of ``s`` by ``actions[k]``, or -1.
+    """
+
+    def __init__(self, model: TransitionSystem, actions: tuple[int, ...], landmark: int) -> None:
+        self.model = model
+        self.actions = actions
+        self.column = {a: k for k, a in enumerate(actions)}
+        capacity = max(64, 2 * model.next_id)
+        self.next: IntArray = np.full((capacity, len(actions)), -1, dtype=np.int64)
+        self.label: BoolArray = np.zeros(capacity, dtype=bool)
+        self.alive: BoolArray = np.zeros(capacity, dtype=bool)
+        self.labels: dict[int, bool] = {}
+        self.access: dict[int, tuple[int, ...]] = {}
+        for s in model.states:
+            self.alive[s] = True
+            self.labels[s] = s == landmark
+            self.label[s] = s == landmark
+            self.access[s] = ()
+        self.landmark = landmark
+        self.unconfirmed = len(model.states) * len(actions)
+        self._distance: IntArray | None = None
+        self._toward: IntArray | None = None
+
+    # ----------------------------------------------------------------- queries
+
+    @property
+    def version(self) -> int:
+        """Changes whenever the model does."""
+        return self.model.version
+
+    def states(self) -> list[int]:
+        return [int(s) for s in np.flatnonzero(self.alive)]
+
+    def confirmed(self, s: int, action: int) -> int:
+        """The confirmed successor of ``s`` by ``action``, or -1."""
+        return int(self.next[s, self.column[action]])
+
+    def target(self, s: int, action: int) -> int:
+        """The model's successor (confirmed or conjectured) of ``s`` by ``action``."""
+        return self.model.successors(s, action)[0]
+
+    def with_label(self, sensation: bool) -> list[int]:
+        """The states predicting ``sensation``, by id."""
+        return [int(s) for s in np.flatnonzero(self.alive & (self.label == sensation))]
+
+    def consistent(self, word: tuple[int, ...], outputs: tuple[bool, ...]) -> list[int]:
+        """The states from which ``word`` yields ``outputs`` (first: the state's own label)."""
+        start = np.flatnonzero(self.alive & (self.label == outputs[0]))
+        position = start.copy()
+        for action, sensation in zip(word, outputs[1:], strict=True):
+            moved = self.next[position, self.column[action]]
+            keep = moved >= 0
+            keep[keep] = self.label[moved[keep]] == sensation
+            start, position = start[keep], moved[keep]
+        return [int(s) for s in start]
+
+    def is_complete(self) -> bool:
+        return self.unconfirmed == 0
+
+    def _guide(self) -> tuple[IntArray, IntArray]:
+        """Distances to the landmark over confirmed transitions, and the first step's column."""
+        if self._distance is None or self._toward is None:
+            n = len(self.label)
+            distance = np.full(n, FAR, dtype=np.int64)
+            toward = np.full(n, -1, dtype=np.int64)
+            sources, columns = np.nonzero(self.next >= 0)
+            incoming: dict[int, list[tuple[int, int]]] = {}
+            for s, k in zip(sources.tolist(), columns.tolist(), strict=True):
+                incoming.setdefault(int(self.next[s, k]), []).append((s, k))
+            distance[self.landmark] = 0
+            queue = deque([self.landmark])
+            while queue:
+                t = queue.popleft()
+                for s, k in incoming.get(t, ()):
+                    if distance[s] == FAR:
+                        distance[s] = distance[t] + 1
+                        toward[s] = k
+                        queue.append(s)
+            self._distance, self._toward = distance, toward
+        return self._distance, self._toward
+
+    @property
+    def distance(self) -> IntArray:
+        """``distance[s]``: confirmed steps from ``s`` to the landmark (:data:`FAR`: none)."""
+        return self._guide()[0]
+
+    @property
+    def toward(self) -> IntArray:
+        """``toward[s]``: the column of the first action of a shortest path to the landmark."""
+        return self._guide()[1]
+
+    def path(self, source: int, goal: int) -> list[int] | None:
+        """A shortest confirmed action word from ``source`` to ``goal``."""
+        found = self._search(source, lambda s: s == goal)
+        return None if found is None else found[0]
+
+    def nearest(self, source: int, wanted: set[int]) -> tuple[list[int], int] | None:
+        """A shortest confirmed word from ``source`` to one of ``wanted``, and that state."""
+        return self._search(source, wanted.__contains__)
+
+    def _search(self, source: int, is_goal: Callable[[int], bool]) -> tuple[list[int], int] | None:
+        parent: dict[int, tuple[int, int]] = {}
+        seen = {source}
+        queue = deque([source])
+        while queue:
+            s = queue.popleft()
+            if is_goal(s):
+                word: list[int] = []
+                t = s
+                while t != source:
+                    t, action = parent[t]
+                    word.append(action)
+                word.reverse()
+                return word, s
+            for k, t in enumerate(self.next[s].tolist()):
+                if t >= 0 and t not in seen:
+                    seen.add(t)
+                    parent[t] = (s, self.actions[k])
+                    queue.append(t)
+        return None
+
+    def around(self, source: int, radius: int) -> set[int]:
+        """The states within ``radius`` confirmed transitions of ``source``, either way."""
+        sources, columns = np.nonzero(self.next >= 0)
+        targets = self.next[sources, columns]
+        near = {source}
+        frontier = {source}
+        for _ in range(radius):
+            touched = np.isin(sources, list(frontier)) | np.isin(targets, list(frontier))
+            frontier = {int(v) for v in np.concatenate([sources[touched], targets[touched]])}
+            frontier -= near
+            near |= frontier
+        return near
+
+    def reachable(self) -> set[int]:
+        """The states reachable from the landmark over confirmed transitions."""
+        seen = {self.landmark}
+        queue = deque([self.landmark])
+        while queue:
+            s = queue.popleft()
+            for t in self.next[s].tolist():
+                if t >= 0 and t not in seen:
+                    seen.add(t)
+                    queue.append(t)
+        return seen
+
+    def separating_word(self, a: int, b: int) -> list[int] | None:
+        """A shortest confirmed word after which ``a`` and ``b`` predict different sensations."""
+        if self.label[a] != self.label[b]:
+            return []
+        parent: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}
+        start = (a, b)
+        seen = {start}
+        queue = deque([start])
+        while queue:
+            pair = queue.popleft()
+            row_a, row_b = self.next[pair[0]], self.next[pair[1]]
+            for k, action in enumerate(self.actions):
+                s, t = int(row_a[k]), int(row_b[k])
+                if s < 0 or t < 0 or (s, t) in seen:
+                    continue
+                parent[(s, t)] = (pair, action)
+                if self.label[s] != self.label[t]:
+                    word = [action]
+                    back = pair
+                    while back != start:
+                        back, previous = parent[back]
+                        word.append(previous)
+                    return word[::-1]
+                seen.add((s, t))
+                queue.append((s, t))
+        return None
+
+    # ----------------------------------------------------------------- changes
+
+    def _changed(self) -> None:
+        self._distance = None
+        self._toward = None
+
+    def confirm(self, s: int, action: int, t: int) -> None:
+        """Make ``s -action-> t`` the confirmed successor (replacing the model's conjecture)."""
+        k = self.column[action]
+        if self.next[s, k] < 0:
+            self.unconfirmed -= 1
+        self.next[s, k] = t
+        old = self.target(s, action)
+        if old != t:
+            self.model.delete(s, old, action)
+            self.model.add(s, t, action)
+        self._changed()
+
+    def unconfirm(self, s: int, action: int) -> None:
+        """Withdraw a confirmed successor; the model keeps it as a conjecture."""
+        k = self.column[action]
+        if self.next[s, k] >= 0:
+            self.unconfirmed += 1
+            self.next[s, k] = -1
+            self._changed()
+
+    def create(self, s: int, action: int, sensation: bool, access: tuple[int, ...]) -> int:
+        """A new state for the world state ``s -action->`` leads to, by splitting the guess.
+
+        The model's conjectured successor ``t`` of ``s`` by ``action`` turned out to stand for
+        two world states: ``split(t)`` (the thesis's split), then the copied transitions that
+        would make the model nondeterministic are deleted. The new state keeps copies of
+        ``t``'s transitions as its conjectures (a self-loop of ``t`` becomes its own).
+        """
+        model = self.model
+        t = self.target(s, action)
+        incoming = [(u, a) for u, a, v in model.transitions() if v == t]
+        new = model.split(t)
+        for u, a in incoming:
+            if u == t:
+                # t -a-> t was copied as t -a-> new, new -a-> t and new -a-> new.
+                model.delete(new, t, a)
+                if (u, a) == (s, action):
+                    model.delete(t, t, a)
+                else:
+                    model.delete(t, new, a)
+            elif (u, a) == (s, action):
+                model.delete(u, t, a)
+            else:
+                model.delete(u, new, a)
+        self._grow(new)
+        self.alive[new] = True
+        self.label[new] = sensation
+        self.labels[new] = sensation
+        self.access[new] = access
+        self.next[new] = -1
+        self.unconfirmed += len(self.actions)
+        k = self.column[action]
+        if self.next[s, k] < 0:
+            self.unconfirmed -= 1
+        self.next[s, k] = new
+        self._changed()
+        return new
+
+    def merge(self, keep: int, gone: int) -> None:
+        """``gone`` is the same world state as ``keep``: the model's merge, then the arrays."""
+        self.model.merge(keep, gone)
+        self.unconfirmed -= int(np.count_nonzero(self.next[gone] < 0))
+        self.next[gone] = -1
+        self.next[self.next == gone] = keep
+        self.alive[gone] = False
+        del self.labels[gone]
+        del self.access[gone]
+        if self.landmark == gone:
+            self.landmark = keep
+        self._changed()
+
+    def discard(self, gone: int) -> None:
+        """Drop a state no confirmed path reaches: its transitions go, then it merges away."""
+        model = self.model
+        for action in self.actions:
+            for t in model.successors(gone, action):
+                model.delete(gone, t, action)
+        self.merge(self.landmark, gone)
+
+    def _grow(self, s: int) -> None:
+        capacity = len(self.label)
+        if s < capacity:
+            return
+        size = max(2 * capacity, s + 1)
+        grown = np.full((size, len(self.actions)), -1, dtype=np.int64)
+        grown[:capacity] = self.next
+        self.next = grown
+        self.label = np.concatenate([self.label, np.zeros(size - capacity, dtype=bool)])
+        self.alive = np.concatenate([self.alive, np.zeros(size - capacity, dtype=bool)])
+
+    def minimise(self) -> list[tuple[int, int]]:
+        """Merge the states the complete hypothesis cannot tell apart (Moore's refinement).
+
+        Returns the merges done, as ``(kept, gone)``; the oldest state of a class is kept.
+        """
+        states = np.flatnonzero(self.alive)
+        block = self.label[states].astype(np.int64)
+        index = np.full(len(self.label), -1, dtype=np.int64)
+        index[states] = np.arange(len(states))
+        successors = index[self.next[states]]
+        count = len(np.unique(block))
+        while True:
+            signature = np.concatenate([block[:, None], block[successors]], axis=1)
+            _, refined = np.unique(signature, axis=0, return_inverse=True)
+            refined = refined.ravel().astype(np.int64)
+            refined_count = int(refined.max()) + 1
+            block = refined
+            if refined_count == count:
+                break
+            count = refined_count
+        merges: list[tuple[int, int]] = []
+        first: dict[int, int] = {}
+        for s, b in zip(states.tolist(), block.tolist(), strict=True):
+            keep = first.setdefault(b, s)
+            if keep != s:
+                merges.append((keep, s))
+        for keep, gone in merges:
+            self.merge(keep, gone)
+        return merges
