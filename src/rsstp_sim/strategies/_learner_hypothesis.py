@@ -170,6 +170,29 @@ class Hypothesis:
             near |= frontier
         return near
 
+    def inverses(self) -> dict[int, int]:
+        """Actions that undo others, as far as the confirmed transitions show.
+
+        ``b`` undoes ``a`` when, of the confirmed ``s -a-> t`` (``t != s``) with a confirmed
+        ``t -b->``, most have ``t -b-> s``: learned from the agent's own experience, used to
+        guess, never to conclude.
+        """
+        states = np.flatnonzero(self.alive)
+        inverse: dict[int, int] = {}
+        for ka, a in enumerate(self.actions):
+            t = self.next[states, ka]
+            moved = (t >= 0) & (t != states)
+            sources, targets = states[moved], t[moved]
+            best, best_count = -1, 0
+            for kb in range(len(self.actions)):
+                back = self.next[targets, kb]
+                count = int(np.count_nonzero(back == sources))
+                if count > best_count and 2 * count >= np.count_nonzero(back >= 0):
+                    best, best_count = kb, count
+            if best >= 0:
+                inverse[a] = self.actions[best]
+        return inverse
+
     def reachable(self) -> set[int]:
         """The states reachable from the landmark over confirmed transitions."""
         seen = {self.landmark}

@@ -1,0 +1,257 @@
+"""Identification: which state does a (state, action) pair lead to? Rule candidates out.
+
+Following a candidate's confirmed path to the landmark from the world state being identified,
+the candidates predicting a different sensation on the way are ruled out. No reset is needed:
+reaching the landmark tells the agent where it is.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Generator
+
+import numpy as np
+
+from rsstp_sim.strategies._base import AgentView
+from rsstp_sim.strategies._learner_hypothesis import FAR
+from rsstp_sim.strategies._learner_walk import Plan, Walker
+
+__all__ = ["Identifier", "Trace"]
+
+Trace = tuple[tuple[int, ...], tuple[bool, ...]]
+"""A test: its actions, and the sensations before the first and after each action."""
+
+
+class Identifier(Walker):
+    """Identifies the targets of (state, action) pairs; keeps the tests made as evidence.
+
+    ``traces[(q, a)]``: the tests made from the world state ``q -a->`` led to. ``deferred``:
+    pairs whose candidates nothing can tell apart yet, with those candidates, the word from
+    the landmark that led there and its sensation. ``made_by[s]``: the action that led to the
+    world state ``s`` was created for.
+    """
+
+    def __init__(self, agent: AgentView, *, doubts: int) -> None:
+        super().__init__(agent)
+        self.doubts = doubts
+        self.made_by: dict[int, int] = {}
+        self.traces: dict[tuple[int, int], list[Trace]] = {}
+        self.deferred: dict[tuple[int, int], tuple[frozenset[int], tuple[int, ...], bool]] = {}
+
+    def confirm(self, q: int, a: int, t: int) -> None:
+        self.deferred.pop((q, a), None)
+        self.h.confirm(q, a, t)
+
+    def new(self, q: int, a: int, label: bool, access: tuple[int, ...], *, here: bool) -> int:
+        """A new state for ``q -a->``; ``here``: the agent is at it now."""
+        self.deferred.pop((q, a), None)
+        new = self.h.create(q, a, label, access)
+        self.made_by[new] = a
+        self.count("new_states")
+        if here:
+            self.belief = new
+            if self.beliefs:
+                self.beliefs[-1] = new
+        return new
+
+    def identify(
+        self,
+        q: int,
+        a: int,
+        label: bool,
+        access: tuple[int, ...],
+        *,
+        here: bool,
+        exclude: frozenset[int] = frozenset(),
+        route: tuple[int, ...] | None = None,
+    ) -> Plan:
+        """Which state does ``q -a->`` lead to? Rule candidates out until one or none is left.
+
+        Tests, in order: the paths to the landmark of the candidates confirmed transitions
+        point at (:meth:`predict`); then the way back (the action undoing ``a``, then ``q``'s
+        path to the landmark), which reaches the landmark if the state is new; then the paths
+        of the candidates the way back could not rule out, if there are at most ``doubts`` of
+        them (else the state is taken as new: a later merge undoes that if it was not).
+        ``here``: the agent is at that world state now. ``exclude``: states already ruled
+        out. ``route``: reach the world state again from the landmark by this word (else by a
+        confirmed path to ``q``).
+        """
+        h = self.h
+        candidates = set(h.with_label(label)) - exclude
+        undo = h.inverses().get(a)
+        ranked = self.predict(q, a, candidates, undo)
+        tried: set[int] = set()
+        separate: list[int] | None = None
+        returned = came_back = False
+        while True:
+            if not candidates:
+                self.new(q, a, label, access, here=here)
+                return
+            distance = h.distance
+            script: list[int] = []
+            first: int | None = None
+            follow = True
+            if separate is not None:
+                script, separate = separate, None
+            else:
+                first = next(
+                    (c for c in ranked if c in candidates and c not in tried and distance[c] < FAR),
+                    None,
+                )
+                if first is None and undo is not None and not returned:
+                    way_back = h.path(q, h.landmark)
+                    if way_back is not None:
+                        script, follow, returned = [undo, *way_back], False, True
+                if first is None and not script:
+                    untried = [c for c in candidates if c not in tried and distance[c] < FAR]
+                    if came_back:
+                        # The way back reached the landmark: a candidate whose confirmed
+                        # transition by ``undo`` leads elsewhere is not it.
+                        column = h.column[undo] if undo is not None else 0
+                        untried = [c for c in untried if h.next[c, column] < 0]
+                        if len(untried) > self.doubts or tried - set(ranked):
+                            self.count("tentative")
+                            self.new(q, a, label, access, here=False)
+                            return
+                    if not untried:  # nothing can tell these candidates apart yet
+                        self.count("deferred")
+                        self.deferred[(q, a)] = (frozenset(candidates), access, label)
+                        return
+                    first = min(untried, key=lambda c: (distance[c], c))
+                if first is not None:
+                    tried.add(first)
+            if not here:
+                arrived = yield from self.return_to(q, a, route)
+                if arrived is None:
+                    return
+                if arrived:
+                    self.confirm(q, a, h.landmark)
+                    return
+                if arrived != label:  # q stands for two world states: start afresh
+                    self.count("restarts")
+                    yield from self.identify(q, a, arrived, tuple(self.word), here=True)
+                    return
+            self.count("sessions")
+            start = self.agent.step
+            survivors, candidates, at_landmark = yield from self.session(
+                candidates, first, script, follow=follow
+            )
+            self.record(q, a, label, start)
+            here = False
+            if not follow:  # the way back
+                came_back = at_landmark
+                ranked = sorted(survivors) + ranked
+                continue
+            if at_landmark and survivors:
+                ordered = sorted(survivors)
+                word = None if len(ordered) == 1 else h.separating_word(ordered[0], ordered[1])
+                if word is None:
+                    self.confirm(q, a, ordered[0])
+                    return
+                separate = word
+
+    def predict(self, q: int, a: int, candidates: set[int], undo: int | None) -> list[int]:
+        """Candidates for ``q -a->`` that confirmed transitions point at, most votes first.
+
+        Two votes for ``c`` when ``c -undo-> q``; one for the far corner ``y`` of each square
+        ``p -b-> q``, ``p -a-> r -b-> y`` (actions that commute, as two joints' turns do).
+        """
+        h = self.h
+        votes: dict[int, int] = {}
+        if undo is not None:
+            k = h.column[undo]
+            for c in candidates:
+                if h.next[c, k] == q:
+                    votes[c] = votes.get(c, 0) + 2
+        column = h.column[a]
+        sources, columns = np.nonzero(h.next == q)
+        for p, kb in zip(sources.tolist(), columns.tolist(), strict=True):
+            r = int(h.next[p, column])
+            if r >= 0:
+                y = int(h.next[r, kb])
+                if y in candidates:
+                    votes[y] = votes.get(y, 0) + 1
+        return sorted(votes, key=lambda c: (-votes[c], c))
+
+    def session(
+        self, candidates: set[int], first: int | None, script: list[int], *, follow: bool = True
+    ) -> Generator[int, bool, tuple[set[int], set[int], bool]]:
+        """One test from the world state being identified: follow paths to the landmark.
+
+        Plays ``script`` first; then (if ``follow``) follows ``first``'s path to the landmark,
+        and the nearest remaining candidate's when ``first`` is ruled out. Returns the
+        candidates that reached the landmark with the world (if it was reached), the
+        candidates not ruled out, and whether the landmark was reached.
+        """
+        h = self.h
+        ids = np.asarray(sorted(candidates), dtype=np.int64)
+        position = ids.copy()
+        tracked = np.ones(len(ids), dtype=bool)
+        chosen = first
+        script = list(script)
+        at_landmark = False
+        while len(ids) or script:
+            if script:
+                action = script.pop(0)
+            elif not follow:
+                break
+            else:
+                distance = h.distance[position]
+                index = -1
+                if chosen is not None:
+                    where = np.flatnonzero((ids == chosen) & tracked)
+                    if len(where) and distance[where[0]] < FAR:
+                        index = int(where[0])
+                if index < 0:
+                    usable = np.flatnonzero(tracked & (distance < FAR))
+                    if not len(usable):
+                        break
+                    index = int(usable[np.argmin(distance[usable])])
+                    chosen = int(ids[index])
+                action = h.actions[int(h.toward[position[index]])]
+            sensation = yield from self.move(action)
+            moved = h.next[position, h.column[action]]
+            tracked &= moved >= 0
+            position = np.where(tracked, moved, position)
+            keep = ~tracked | (h.label[position] == sensation)
+            ids, position, tracked = ids[keep], position[keep], tracked[keep]
+            if sensation:
+                at_landmark = True
+                break
+        survivors = {int(s) for s in ids[tracked]} if at_landmark else set()
+        return survivors, {int(s) for s in ids}, at_landmark
+
+    def record(self, q: int, a: int, label: bool, start: int) -> None:
+        """Keep the test from ``q -a->`` made since step ``start``: actions and sensations."""
+        memory = self.agent.memory
+        actions = tuple(int(v) for v in memory.actions[start + 1 :].tolist())
+        sensations = tuple(bool(v) for v in memory.sensations[start + 1 :].tolist())
+        self.traces.setdefault((q, a), []).append((actions, (label, *sensations)))
+
+    def return_to(
+        self, q: int, a: int, route: tuple[int, ...] | None
+    ) -> Generator[int, bool, bool | None]:
+        """Go back to the world state ``q -a->`` led to; the sensation there, or None."""
+        h = self.h
+        self.phase = "return"
+        if self.belief is None:
+            yield from self.home()
+        assert self.belief is not None
+        if route is not None:
+            yield from self.navigate(h.landmark)
+            self.phase = "return"
+            sensation = False
+            for action in route:
+                sensation = yield from self.move(action)
+            self.phase = "test"
+            return sensation
+        word = h.path(self.belief, q)
+        if word is None:
+            yield from self.navigate(h.landmark)
+            word = h.path(h.landmark, q)
+            if word is None:
+                return None
+        self.phase = "return"
+        for action in word:
+            yield from self.move(action, check=True)
+        self.phase = "test"
+        return (yield from self.move(a))

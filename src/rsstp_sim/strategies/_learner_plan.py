@@ -1,0 +1,322 @@
+"""The learner's plan: explore, analyse counterexamples, verify, minimise, then walk the model."""
+
+from __future__ import annotations
+
+from collections.abc import Generator
+
+import numpy as np
+
+from rsstp_sim.strategies._base import AgentView
+from rsstp_sim.strategies._learner_hypothesis import FAR
+from rsstp_sim.strategies._learner_identify import Identifier
+from rsstp_sim.strategies._learner_walk import Plan, Refuted
+
+__all__ = ["Learning"]
+
+
+class Learning(Identifier):
+    """One run of the learner; :meth:`plan` is the generator the strategy drives.
+
+    ``found``: the landmark has been seen (``first_landmark``: the step it was first seen).
+    ``done``: every transition is confirmed, tested and the hypothesis is minimal.
+    """
+
+    def __init__(self, agent: AgentView, *, doubts: int) -> None:
+        super().__init__(agent, doubts=doubts)
+        self.start_sensation = bool(agent.memory.sensations[0])
+        self.found = False
+        self.first_landmark = 0
+        self.done = False
+        self._checked: set[tuple[int, int]] = set()
+        self._checked_version = -1
+
+    def plan(self) -> Plan:
+        agent = self.agent
+        while not self.start_sensation:  # search for the landmark
+            self.count("steps_search")
+            if (yield self.random_action()):
+                self.first_landmark = agent.step
+                break
+        self.found = True
+        agent.note(f"landmark found: state {self.h.landmark} is where the sensation is true")
+        self.at_landmark()
+        pending: Refuted | None = None
+        while True:
+            try:
+                if pending is not None:
+                    refuted, pending = pending, None
+                    self.phase = "analyse"
+                    yield from self.analyse(refuted)
+                elif self.belief is None:
+                    yield from self.home()
+                else:
+                    yield from self.advance()
+            except Refuted as refuted:
+                self.count("counterexamples")
+                if self.done:
+                    agent.note("the model was refuted: learning resumes")
+                self.done = False
+                pending = refuted
+
+    def advance(self) -> Plan:
+        """One exploration, or the end game: forced deferrals, clean-up, minimisation,
+        verification; then done, and a random walk that checks every prediction."""
+        h = self.h
+        goal = self.goal()
+        if goal is not None:
+            word, pair = goal
+            self.phase = "navigate"
+            for action in word:
+                yield from self.move(action, check=True)
+            if pair is not None:
+                yield from self.explore(*pair)
+            return
+        if self.deferred:
+            (q, a), (_, access, label) = min(self.deferred.items())
+            self.count("forced")
+            self.new(q, a, label, access, here=False)
+            return
+        reachable = h.reachable()
+        garbage = [s for s in h.states() if s not in reachable]
+        if garbage:
+            for s in garbage:
+                h.discard(s)
+                self.forget(s, None)
+            self.count("discarded", len(garbage))
+            return
+        if not h.is_complete():  # pragma: no cover - every unconfirmed pair is a goal
+            raise AssertionError("incomplete hypothesis with nothing to explore")
+        merges = h.minimise()
+        if merges:
+            for keep, gone in merges:
+                self.forget(gone, keep)
+            self.count("merges", len(merges))
+            self.agent.note(f"minimised: {len(merges)} merges, {len(h.labels)} states")
+            if self.belief not in h.labels:
+                self.belief = None
+            return
+        suspect = self.suspect()
+        if suspect is not None:
+            yield from self.reverify(*suspect)
+            return
+        if not self.done:
+            self.done = True
+            self.agent.note(f"done: {len(h.labels)} states, every transition confirmed")
+        self.phase = "wander"
+        while True:
+            yield from self.move(self.random_action(), check=True)
+
+    def goal(self) -> tuple[list[int], tuple[int, int] | None] | None:
+        """A path to the next pair to explore, with the pair (None: go to the landmark first).
+
+        The states with no confirmed path to the landmark come first, oldest first: until
+        they have one, they cannot be told apart from the states identified next. The action
+        tried first from a state is the one undoing the action that created it.
+        """
+        h = self.h
+        belief = self.belief
+        assert belief is not None
+        distance = h.distance
+        rows, columns = np.nonzero(h.alive[:, None] & (h.next < 0))
+        open_pairs: dict[int, list[int]] = {}
+        for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
+            a = h.actions[k]
+            deferred = self.deferred.get((s, a))
+            if deferred is not None and not any(
+                u not in h.labels or distance[u] < FAR for u in deferred[0]
+            ):
+                continue
+            open_pairs.setdefault(s, []).append(a)
+        if not open_pairs:
+            return None
+        inverse = h.inverses()
+
+        def first(s: int) -> int:
+            actions = open_pairs[s]
+            made_by = self.made_by.get(s)
+            if made_by is None:
+                return actions[0]
+            undo = inverse.get(made_by)
+            if undo is not None:
+                return undo if undo in actions else actions[0]
+            # Not known yet: an action that undoes no other one, and not the same one.
+            taken = set(inverse.values())
+            likely = [b for b in actions if b not in taken and b != made_by]
+            return likely[0] if likely else actions[0]
+
+        outside = [s for s in open_pairs if distance[s] == FAR]
+        if outside:
+            oldest = min(outside)
+            word = h.path(belief, oldest)
+            if word is not None:
+                return word, (oldest, first(oldest))
+        found = h.nearest(belief, set(open_pairs))
+        if found is not None:
+            word, s = found
+            return word, (s, first(s))
+        if belief != h.landmark and distance[belief] < FAR:
+            word = h.path(belief, h.landmark)
+            if word is not None:
+                return word, None
+        self.belief = None  # nothing reachable from here: find the landmark again
+        return [], None
+
+    def explore(self, q: int, a: int) -> Plan:
+        """Take ``a`` from ``q`` (located there) and identify the state it leads to."""
+        self.phase = "test"
+        sensation = yield from self.move(a)
+        if sensation:
+            self.confirm(q, a, self.h.landmark)
+            return
+        yield from self.identify(q, a, sensation, tuple(self.word), here=True)
+
+    def forget(self, gone: int, keep: int | None) -> None:
+        """State ``gone`` merged into ``keep`` (or discarded): move or drop what names it."""
+        self.made_by.pop(gone, None)
+        for a in self.h.actions:
+            traces = self.traces.pop((gone, a), None)
+            if traces and keep is not None:
+                self.traces.setdefault((keep, a), []).extend(traces)
+        self._checked.clear()
+
+    # ------------------------------------------------------------- verification
+
+    def suspect(self) -> tuple[int, int] | None:
+        """The nearest confirmed transition whose tests do not single out its target.
+
+        Checked without moving: each test kept for ``q -a->`` is replayed from every state of
+        the complete hypothesis; the transition is verified when its target is the only state
+        agreeing with all of them. A transition to the landmark needs no test.
+        """
+        h = self.h
+        assert self.belief is not None
+        if self._checked_version != h.version:
+            self._checked.clear()
+            self._checked_version = h.version
+        doubtful: dict[int, list[int]] = {}
+        for s in h.states():
+            for k, a in enumerate(h.actions):
+                t = int(h.next[s, k])
+                if t == h.landmark or (s, a) in self._checked:
+                    continue
+                agreeing: set[int] | None = None
+                for word, outputs in self.traces.get((s, a), ()):
+                    found = set(h.consistent(word, outputs))
+                    agreeing = found if agreeing is None else agreeing & found
+                if agreeing != {t}:
+                    doubtful.setdefault(s, []).append(a)
+        if not doubtful:
+            return None
+        nearest = h.nearest(self.belief, set(doubtful))
+        if nearest is None:
+            return None
+        return nearest[1], doubtful[nearest[1]][0]
+
+    def reverify(self, q: int, a: int) -> Plan:
+        """Take ``q -a->`` again and identify where it leads with the complete hypothesis."""
+        h = self.h
+        self.count("reverified")
+        yield from self.navigate(q)
+        self.phase = "verify"
+        before = h.confirmed(q, a)
+        sensation = yield from self.move(a)
+        self.belief = None
+        self.traces.pop((q, a), None)
+        if sensation:
+            self.confirm(q, a, h.landmark)
+        else:
+            yield from self.identify(q, a, sensation, tuple(self.word), here=True)
+        if h.confirmed(q, a) != before:
+            self.count("corrected")
+            self.agent.note(f"verification: state {q} by action {a} leads elsewhere")
+        self._checked.add((q, a))
+        self._checked_version = h.version
+
+    # ---------------------------------------------------------- counterexamples
+
+    def analyse(self, refuted: Refuted) -> Plan:
+        """Find the wrong transition behind a counterexample, then identify its target anew.
+
+        ``refuted.word`` led from the landmark along confirmed transitions to a wrong
+        prediction. With ``q_i`` the state after ``i`` actions and ``access[q]`` the word that
+        defines ``q``, playing from the landmark ``access[q_i]`` then the rest of the word
+        ends with the observed sensation for ``i = 0`` and with the predicted one for the
+        last ``i``: a binary search (Rivest and Schapire's, the landmark as the reset) finds
+        ``i`` where it changes, and ``q_i -word[i]->`` is wrong.
+        """
+        h = self.h
+        word, trace = refuted.word, refuted.trace
+        states = [h.landmark]
+        for action in word:
+            t = h.confirmed(states[-1], action)
+            if t < 0:
+                return
+            states.append(t)
+        observed = trace[-1]
+        if h.labels[states[-1]] == observed:
+            return
+        low, high = 0, len(word)
+        low_trace = list(trace)
+        while high - low > 1:
+            middle = (low + high) // 2
+            prefix = h.access[states[middle]]
+            outputs = yield from self.query(prefix + word[middle:])
+            if outputs[-1] == observed:
+                low, low_trace = middle, outputs[len(prefix) :]
+            else:
+                high = middle
+        q, a, wrong = states[low], word[low], states[low + 1]
+        label = low_trace[0]
+        # The states the sensations after q -a-> rule out, besides the wrong one.
+        excluded = {wrong}
+        ids = np.asarray([s for s in h.with_label(label) if s != wrong], dtype=np.int64)
+        position = ids.copy()
+        for action, sensation in zip(word[low + 1 :], low_trace[1:], strict=True):
+            moved = h.next[position, h.column[action]]
+            known = moved >= 0
+            mismatch = known.copy()
+            mismatch[known] = h.label[moved[known]] != sensation
+            excluded.update(int(s) for s in ids[mismatch])
+            keep = known & ~mismatch
+            ids, position = ids[keep], moved[keep]
+        self.agent.note(
+            f"counterexample of length {len(word)}: state {q} by action {a} "
+            f"does not lead to state {wrong}"
+        )
+        h.unconfirm(q, a)
+        self.traces.pop((q, a), None)
+        access = h.access[q] + (a,)
+        self.phase = "test"
+        yield from self.identify(
+            q, a, label, access, here=False, exclude=frozenset(excluded), route=access
+        )
+
+    def query(self, word: tuple[int, ...]) -> Generator[int, bool, list[bool]]:
+        """From the landmark, play ``word``; the sensations after each action."""
+        yield from self.navigate(self.h.landmark)
+        self.phase = "analyse"
+        outputs: list[bool] = []
+        for action in word:
+            outputs.append((yield from self.move(action)))
+        return outputs
+
+    # ------------------------------------------------------------------ results
+
+    def start_state(self) -> int | None:
+        """The state the run started in: the only one from which the steps before the
+        landmark was first seen replay through the model; None if several or none do."""
+        h = self.h
+        if not self.found:
+            return self.agent.model.current
+        memory = self.agent.memory
+        first = self.first_landmark
+        actions = memory.actions[1 : first + 1].tolist()
+        sensations = memory.sensations[: first + 1].tolist()
+        candidates = np.asarray(h.with_label(sensations[0]), dtype=np.int64)
+        position = candidates.copy()
+        for action, sensation in zip(actions, sensations[1:], strict=True):
+            position = h.next[position, h.column[action]]
+            keep = position >= 0
+            keep[keep] = h.label[position[keep]] == sensation
+            candidates, position = candidates[keep], position[keep]
+        return int(candidates[0]) if len(candidates) == 1 else None

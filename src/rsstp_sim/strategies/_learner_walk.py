@@ -1,0 +1,180 @@
+"""Where the learner believes it is, and how it finds the landmark again when it does not know.
+
+The learner's plan is a generator: it yields an action and receives the sensation that
+followed. :meth:`Walker.move` wraps one such step and keeps the belief (the internal state the
+agent is at, or None) up to date along confirmed transitions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Generator
+
+import numpy as np
+
+from rsstp_sim.strategies._base import AgentView
+from rsstp_sim.strategies._learner_hypothesis import FAR, Hypothesis
+
+__all__ = ["LONGEST_RUN", "Plan", "Refuted", "Walker"]
+
+LONGEST_RUN = 16
+"""The longest run of one action in a random search."""
+
+Plan = Generator[int, bool, None]
+"""A plan: yields the next action, receives the sensation that followed it."""
+
+
+class Refuted(Exception):
+    """The hypothesis predicted a wrong sensation on a confirmed path from the landmark.
+
+    ``word`` is the action word walked from the landmark, ``trace`` the sensation after each
+    of its actions (the last one the mispredicted).
+    """
+
+    def __init__(self, word: tuple[int, ...], trace: tuple[bool, ...]) -> None:
+        super().__init__(f"counterexample of length {len(word)}")
+        self.word = word
+        self.trace = trace
+
+
+class Walker:
+    """The agent walking its hypothesis.
+
+    Since the landmark was last seen the agent took ``word`` and sensed ``trace``;
+    ``beliefs[i]`` is the state it believed it was at after ``word[i]`` (-1: unknown), and
+    ``belief`` is where it believes it is now (None: lost). ``stats`` counts steps per
+    ``phase`` and events.
+    """
+
+    def __init__(self, agent: AgentView) -> None:
+        self.agent = agent
+        self.h = Hypothesis(agent.model, agent.actions, landmark=agent.model.current)
+        self.word: list[int] = []
+        self.trace: list[bool] = []
+        self.beliefs: list[int] = []
+        self.belief: int | None = None
+        self.phase = "search"
+        self.stats: dict[str, int] = {}
+        self._run_action = 0
+        self._run_left = 0
+
+    def count(self, key: str, n: int = 1) -> None:
+        self.stats[key] = self.stats.get(key, 0) + n
+
+    def move(self, action: int, *, check: bool = False) -> Generator[int, bool, bool]:
+        """Take ``action``; follow the belief. With ``check``, a wrong prediction of a
+        confirmed transition raises :class:`Refuted` (else the agent is just lost)."""
+        sensation = yield action
+        self.count(f"steps_{self.phase}")
+        self.word.append(action)
+        self.trace.append(sensation)
+        h = self.h
+        belief = self.belief
+        if belief is not None:
+            t = h.confirmed(belief, action)
+            if t >= 0 and h.labels[t] == sensation:
+                self.belief = t
+            else:
+                self.belief = None
+                if t >= 0 and check:
+                    refuted = Refuted(tuple(self.word), tuple(self.trace))
+                    if sensation:
+                        self.at_landmark()
+                    raise refuted
+        if sensation:
+            self.at_landmark()
+        else:
+            self.beliefs.append(-1 if self.belief is None else self.belief)
+        return sensation
+
+    def at_landmark(self) -> None:
+        """The sensation is true: the agent is at the landmark, whatever it believed."""
+        self.belief = self.h.landmark
+        self.word.clear()
+        self.trace.clear()
+        self.beliefs.clear()
+
+    def random_action(self) -> int:
+        """Runs of one action of random lengths (P(length >= n) = 1/n, at most
+        :data:`LONGEST_RUN`): a search that goes round a ring faster than single steps."""
+        rng = self.agent.rng
+        if self._run_left <= 0:
+            actions = self.agent.actions
+            self._run_action = actions[int(rng.integers(len(actions)))]
+            self._run_left = min(LONGEST_RUN, int(1.0 / (1.0 - float(rng.random()))))
+        self._run_left -= 1
+        return self._run_action
+
+    def navigate(self, goal: int) -> Plan:
+        """Walk a confirmed path to ``goal`` (finding the landmark first when lost)."""
+        h = self.h
+        self.phase = "navigate"
+        if self.belief is None:
+            yield from self.home()
+        assert self.belief is not None
+        word = h.path(self.belief, goal)
+        if word is None:
+            self.belief = None
+            yield from self.home()
+            word = h.path(h.landmark, goal) or []
+        for action in word:
+            yield from self.move(action, check=True)
+
+    def home(self) -> Plan:
+        """Lost: retrace, then follow candidates' paths to the landmark; else search.
+
+        Undo the actions since the last known state (:meth:`retrace`), then take the states
+        around it as candidates for where the agent is, most likely first, and follow the
+        first one's path to the landmark; a candidate predicting a different sensation is
+        ruled out. When none is left, every state is a candidate again, after a random run.
+        """
+        h = self.h
+        phase, self.phase = self.phase, "home"
+        near = yield from self.retrace()
+        if near is None:
+            self.phase = phase
+            return
+        sensation = self.trace[-1] if self.trace else True
+        ids = np.asarray([s for s in near if h.labels[s] == sensation], dtype=np.int64)
+        widened = not len(ids)
+        if widened:
+            ids = np.asarray(h.with_label(sensation), dtype=np.int64)
+        while True:
+            usable = np.flatnonzero(h.distance[ids] < FAR)
+            if len(usable) and self._run_left <= 0:
+                action = h.actions[int(h.toward[ids[usable[0]]])]
+            else:
+                action = self.random_action()
+            sensation = yield from self.move(action)
+            if sensation:
+                self.phase = phase
+                return
+            moved = h.next[ids, h.column[action]]
+            keep = moved >= 0
+            keep[keep] = h.label[moved[keep]] == sensation
+            ids = moved[keep]
+            if not len(ids):
+                if widened and self._run_left <= 0:
+                    self.random_action()  # start a run
+                    self._run_left += 1
+                widened = True
+                ids = np.asarray(h.with_label(sensation), dtype=np.int64)
+
+    def retrace(self) -> Generator[int, bool, list[int] | None]:
+        """Undo the actions since the last known state; the states the agent is likely at.
+
+        None when the landmark was seen on the way. The answer is the last known state
+        (with a path to the landmark) first, then the states within two steps of it: a blocked
+        move on the way out makes the undoing miss. Empty when an action has no known undo.
+        """
+        h = self.h
+        known = [i for i, b in enumerate(self.beliefs) if b >= 0 and h.distance[b] < FAR]
+        last = known[-1] if known else -1
+        state = self.beliefs[last] if known else h.landmark
+        back = self.word[last + 1 :]
+        inverse = h.inverses()
+        if any(a not in inverse for a in back):
+            return []
+        for action in reversed(back):
+            if (yield from self.move(inverse[action])):
+                return None
+        return [state, *sorted(h.around(state, 2) - {state})]

@@ -1,0 +1,283 @@
+"""The ``learner`` strategy: the minimal model from one trajectory, from actions and sensations."""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rsstp_sim.coupling import Runner
+from rsstp_sim.memory import Memory
+from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
+from rsstp_sim.strategies import AgentView
+from rsstp_sim.strategies.learner import LearnerStrategy
+from rsstp_sim.transition_system import Operation, TransitionSystem
+from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
+from rsstp_sim.world import World
+
+LEARNER_SOURCES = sorted(
+    (Path(__file__).parents[2] / "src" / "rsstp_sim" / "strategies").glob("*learner*.py")
+)
+
+
+def learn(scenario: Scenario, budget: int, *, seed: int = 0) -> tuple[LearnerStrategy, Runner]:
+    """Run the learner until it is done or ``budget`` steps are spent."""
+    learner = LearnerStrategy()
+    runner = Runner(scenario, learner, seed=seed)
+    while not learner.done and runner.step_index < budget:
+        runner.step()
+    return learner, runner
+
+
+def assert_minimal_and_equivalent(
+    learner: LearnerStrategy, model: TransitionSystem, truth: GroundTruth
+) -> None:
+    start = learner.start_state
+    assert start is not None
+    assert check_equivalence(model, learner.labels(), truth, start_state=start) is None
+    assert len(model) == truth.n_classes
+    assert model.determinism_report().complete
+
+
+def one_joint(step: int, initial: int, target: int, actions: list[int]) -> Scenario:
+    return parse_scenario(
+        f'name = "cycle"\n[arm]\nlengths = [1.0]\ninitial_deg = [{initial}]\n'
+        f"step_deg = {step}\nactions = {actions}\n[feedback]\ntarget_deg = [{target}]\n"
+    )
+
+
+# ------------------------------------------------------------------ targets
+
+
+@pytest.mark.parametrize("name", ["thesis-roulette", "one-joint-10"])
+def test_learns_the_one_joint_cycles_within_four_n_squared_steps(name: str) -> None:
+    scenario = load_scenario(name)
+    truth = compute_truth(scenario)
+    learner, runner = learn(scenario, 4 * truth.n_classes**2)
+    assert learner.done
+    assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
+def test_learns_two_joint_30_within_50000_steps() -> None:
+    scenario = load_scenario("two-joint-30")
+    truth = compute_truth(scenario)
+    learner, runner = learn(scenario, 50_000)
+    assert learner.done
+    assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    step=st.sampled_from([30, 45, 60, 90, 120]),
+    initial=st.integers(0, 359),
+    target=st.integers(0, 359),
+    actions=st.sampled_from([[0], [1], [0, 1]]),
+    on_lattice=st.booleans(),
+    seed=st.integers(0, 2**16),
+)
+def test_learns_small_cycles_within_four_n_squared_steps(
+    step: int, initial: int, target: int, actions: list[int], on_lattice: bool, seed: int
+) -> None:
+    if on_lattice:  # else the target is usually never reached: a one-state world
+        target = (initial + step * (target % (360 // step))) % 360
+    scenario = one_joint(step, initial, target, actions)
+    truth = compute_truth(scenario)
+    learner, runner = learn(scenario, 4 * truth.n_classes**2, seed=seed)
+    if truth.n_sensed == 0:  # nothing is ever sensed: the first model is already right
+        assert check_equivalence(runner.model, learner.labels(), truth) is None
+        return
+    assert learner.done
+    assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
+def test_the_start_state_is_found_when_the_landmark_is_not_the_start() -> None:
+    scenario = one_joint(30, 0, 150, [0, 1])
+    truth = compute_truth(scenario)
+    learner, runner = learn(scenario, 4 * truth.n_classes**2, seed=3)
+    assert learner.done
+    assert learner.start_state is not None
+    assert not learner.labels()[learner.start_state]
+    assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
+# ------------------------------------------------------------------ the model it keeps
+
+
+def test_every_model_change_is_a_logged_operation_that_replays_to_the_final_model() -> None:
+    scenario = load_scenario("two-joint-30")
+    learner = LearnerStrategy()
+    logged: list[Operation] = []
+    runner = Runner(
+        scenario, learner, seed=0, on_model_change=lambda _step, ops: logged.extend(ops)
+    )
+    while not learner.done:
+        runner.step()
+    replay = learner.initial_model(scenario.actions)
+    for op in logged:
+        replay.apply(op)
+    replay.current = runner.model.current
+    assert replay == runner.model
+    assert runner.model.version == len(logged)
+    assert {op.kind for op in logged} >= {"split", "add", "delete"}
+
+
+def test_a_redundant_state_is_merged_away() -> None:
+    # Strict doubts: every state the way back cannot place is taken as new, then merged.
+    scenario = load_scenario("one-joint-10")
+    truth = compute_truth(scenario)
+    learner = LearnerStrategy(doubts=0)
+    logged: list[Operation] = []
+    runner = Runner(scenario, learner, seed=0, on_model_change=lambda _s, ops: logged.extend(ops))
+    while not learner.done and runner.step_index < 4 * truth.n_classes**2:
+        runner.step()
+    assert any(op.kind == "merge" for op in logged)
+    assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
+def test_labels_name_every_state_and_the_internal_state_is_the_belief() -> None:
+    scenario = load_scenario("one-joint-10")
+    learner, runner = learn(scenario, 5184)
+    assert set(learner.labels()) == set(runner.model.states)
+    sensed = [s for s, label in learner.labels().items() if label]
+    assert len(sensed) == 1
+    # Walking the finished model, the internal state always predicts the sensation.
+    for _ in range(200):
+        runner.step()
+        entry = runner.memory[-1]
+        assert learner.labels()[runner.model.current] == entry.sensation
+
+
+def test_once_done_the_model_no_longer_changes() -> None:
+    scenario = load_scenario("one-joint-10")
+    learner, runner = learn(scenario, 5184)
+    version = runner.model.version
+    runner.run(2_000)
+    assert learner.done
+    assert runner.model.version == version
+
+
+def test_same_seed_same_run_and_the_seed_matters() -> None:
+    scenario = one_joint(30, 0, 150, [0, 1])
+
+    def trajectory(seed: int) -> tuple[list[int], dict[str, object]]:
+        learner, runner = learn(scenario, 600, seed=seed)
+        return runner.memory.actions.tolist(), runner.model.snapshot()
+
+    assert trajectory(5) == trajectory(5)
+    assert len({str(trajectory(seed)[0]) for seed in range(4)}) > 1
+
+
+def test_notes_are_few() -> None:
+    scenario = load_scenario("two-joint-30")
+    learner = LearnerStrategy()
+    notes: list[str] = []
+    runner = Runner(scenario, learner, seed=0, on_event=lambda e: notes.append(e.text))
+    while not learner.done:
+        runner.step()
+    assert 2 <= len(notes) <= 20
+
+
+def test_params() -> None:
+    assert LearnerStrategy.name == "learner"
+    assert LearnerStrategy(doubts=2).params() == {"doubts": 2}
+
+
+# ------------------------------------------------------------------ no ground truth
+
+
+def test_the_learner_modules_import_nothing_of_the_world() -> None:
+    assert len(LEARNER_SOURCES) >= 2
+    allowed = {
+        "rsstp_sim.errors",
+        "rsstp_sim.memory",
+        "rsstp_sim.transition_system",
+        "rsstp_sim.strategies._base",
+    }
+    for path in LEARNER_SOURCES:
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Import):
+                modules = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                modules = [node.module or ""]
+            else:
+                continue
+            for module in modules:
+                if module.startswith("rsstp"):
+                    assert module in allowed or module.startswith(
+                        "rsstp_sim.strategies._learner_"
+                    ), f"{path.name} imports {module}"
+                assert not module.startswith(("rsstp_sim.world", "rsstp_sim.truth"))
+                assert not module.startswith("rsstp_sim.geometry")
+
+
+class _Ring:
+    """A world that is no arm: ``n`` places on a ring, sensed at one; action 0 turns one way."""
+
+    def __init__(self, n: int, sensed: int, start: int) -> None:
+        self.n, self.sensed, self.place = n, sensed, start
+
+    def move(self, action: int) -> bool:
+        self.place = (self.place + (1 if action == 0 else -1)) % self.n
+        return self.place == self.sensed
+
+
+def drive(
+    learner: LearnerStrategy, move: Callable[[int], bool], first: bool, steps: int, seed: int
+) -> AgentView:
+    """The runner's step, with the AgentView as all the learner gets; ``move`` is the world."""
+    actions = (0, 1)
+    model = learner.initial_model(actions)
+    memory = Memory()
+    memory.reset(model.current, first, float(first))
+    agent = AgentView(memory, model, actions, np.random.default_rng(seed), lambda _text: None)
+    learner.reset(agent)
+    for _ in range(steps):
+        if learner.done:
+            break
+        action = learner.choose_action(agent)
+        sensation = move(action)
+        (after,) = model.successors(model.current, action)
+        model.current = after
+        memory.append(action, after, sensation, float(sensation))
+        learner.refine(agent)
+    return agent
+
+
+def test_learns_a_world_it_only_sees_through_the_agent_view() -> None:
+    learner = LearnerStrategy()
+    ring = _Ring(25, sensed=7, start=3)
+    agent = drive(learner, ring.move, False, 4 * 25**2, seed=1)
+    assert learner.done
+    model, labels = agent.model, learner.labels()
+    assert len(model) == 25 and model.determinism_report().complete
+    # From the start state, action 0 reaches the sensed state after 4 steps, then every 25.
+    state = learner.start_state
+    assert state is not None
+    seen = []
+    for _ in range(60):
+        (state,) = model.successors(state, 0)
+        seen.append(labels[state])
+    assert [i + 1 for i, sensed in enumerate(seen) if sensed] == [4, 29, 54]
+
+
+def test_an_agent_view_alone_gives_the_same_run_as_the_runner() -> None:
+    scenario = load_scenario("one-joint-10")
+    by_runner, runner = learn(scenario, 5184, seed=7)
+    world = World(scenario)
+    first = world.reset().sensation
+
+    def move(action: int) -> bool:
+        world.move(action)
+        return world.sensation
+
+    alone = LearnerStrategy()
+    agent = drive(alone, move, first, 5184, seed=7)
+    assert agent.memory.actions.tolist() == runner.memory.actions.tolist()
+    assert agent.model == runner.model
+    assert alone.labels() == by_runner.labels()
