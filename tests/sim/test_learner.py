@@ -281,3 +281,28 @@ def test_an_agent_view_alone_gives_the_same_run_as_the_runner() -> None:
     assert agent.memory.actions.tolist() == runner.memory.actions.tolist()
     assert agent.model == runner.model
     assert alone.labels() == by_runner.labels()
+
+
+@pytest.mark.parametrize("name", ["one-joint-10", "two-joint-30"])
+def test_a_wrong_transition_is_refuted_found_and_repaired(name: str) -> None:
+    # White box: once done, redirect a confirmed transition to a wrong state. Walking the
+    # model, the learner meets the wrong prediction, finds the transition by its analysis
+    # (the landmark as the reset) and learns on to the right model.
+    scenario = load_scenario(name)
+    truth = compute_truth(scenario)
+    learner, runner = learn(scenario, 50_000)
+    learning = learner._learning
+    assert learning is not None and learner.done
+    h = learning.h
+    pairs = [(s, a) for s in h.states() for a in scenario.actions if h.confirmed(s, a) != s]
+    q, a = max(pairs, key=lambda pair: int(h.distance[h.confirmed(*pair)]))
+    right = h.confirmed(q, a)
+    wrong = next(s for s in h.states() if s not in (right, h.landmark))
+    h.confirm(q, a, wrong)
+    while runner.step_index < 200_000 and (
+        learner.done is True and learning.stats.get("counterexamples", 0) == 0 or not learner.done
+    ):
+        runner.step()
+    assert learning.stats.get("counterexamples", 0) >= 1
+    assert learner.done
+    assert_minimal_and_equivalent(learner, runner.model, truth)

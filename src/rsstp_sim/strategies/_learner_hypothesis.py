@@ -81,12 +81,29 @@ class Hypothesis:
         """The states predicting ``sensation``, by id."""
         return [int(s) for s in np.flatnonzero(self.alive & (self.label == sensation))]
 
-    def consistent(self, word: tuple[int, ...], outputs: tuple[bool, ...]) -> list[int]:
-        """The states from which ``word`` yields ``outputs`` (first: the state's own label)."""
+    def step(
+        self, start: IntArray, position: IntArray, action: int, via: tuple[int, int]
+    ) -> IntArray:
+        """Where each candidate ``start[i]``, now at ``position[i]``, goes by ``action``.
+
+        Candidate ``c`` stands for the hypothesis "``via`` leads to ``c``": from the first
+        state of ``via`` by its action it goes back to ``c`` itself, whatever the model says.
+        -1 where the successor is not confirmed.
+        """
+        moved: IntArray = self.next[position, self.column[action]]
+        if action == via[1]:
+            moved = np.where(position == via[0], start, moved).astype(np.int64)
+        return moved
+
+    def consistent(
+        self, word: tuple[int, ...], outputs: tuple[bool, ...], via: tuple[int, int]
+    ) -> list[int]:
+        """The states ``c`` from which ``word`` yields ``outputs`` (the first: ``c``'s own
+        label), if ``via`` leads to ``c`` (see :meth:`step`)."""
         start = np.flatnonzero(self.alive & (self.label == outputs[0]))
         position = start.copy()
         for action, sensation in zip(word, outputs[1:], strict=True):
-            moved = self.next[position, self.column[action]]
+            moved = self.step(start, position, action, via)
             keep = moved >= 0
             keep[keep] = self.label[moved[keep]] == sensation
             start, position = start[keep], moved[keep]

@@ -8,6 +8,7 @@ reaching the landmark tells the agent where it is.
 from __future__ import annotations
 
 from collections.abc import Generator
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -15,19 +16,29 @@ from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR
 from rsstp_sim.strategies._learner_walk import Plan, Walker
 
-__all__ = ["Identifier", "Trace"]
+__all__ = ["Deferral", "Identifier", "Trace"]
 
 Trace = tuple[tuple[int, ...], tuple[bool, ...]]
 """A test: its actions, and the sensations before the first and after each action."""
+
+
+@dataclass(frozen=True, slots=True)
+class Deferral:
+    """An identification put off: the candidates nothing could tell apart, the word from the
+    landmark that led to the world state, its sensation, and the model version then."""
+
+    candidates: frozenset[int]
+    access: tuple[int, ...]
+    label: bool
+    version: int
 
 
 class Identifier(Walker):
     """Identifies the targets of (state, action) pairs; keeps the tests made as evidence.
 
     ``traces[(q, a)]``: the tests made from the world state ``q -a->`` led to. ``deferred``:
-    pairs whose candidates nothing can tell apart yet, with those candidates, the word from
-    the landmark that led there and its sensation. ``made_by[s]``: the action that led to the
-    world state ``s`` was created for.
+    the pairs whose candidates nothing could tell apart yet (:class:`Deferral`).
+    ``made_by[s]``: the action that led to the world state ``s`` was created for.
     """
 
     def __init__(self, agent: AgentView, *, doubts: int) -> None:
@@ -35,7 +46,7 @@ class Identifier(Walker):
         self.doubts = doubts
         self.made_by: dict[int, int] = {}
         self.traces: dict[tuple[int, int], list[Trace]] = {}
-        self.deferred: dict[tuple[int, int], tuple[frozenset[int], tuple[int, ...], bool]] = {}
+        self.deferred: dict[tuple[int, int], Deferral] = {}
 
     def confirm(self, q: int, a: int, t: int) -> None:
         self.deferred.pop((q, a), None)
@@ -114,7 +125,9 @@ class Identifier(Walker):
                             return
                     if not untried:  # nothing can tell these candidates apart yet
                         self.count("deferred")
-                        self.deferred[(q, a)] = (frozenset(candidates), access, label)
+                        self.deferred[(q, a)] = Deferral(
+                            frozenset(candidates), access, label, h.version
+                        )
                         return
                     first = min(untried, key=lambda c: (distance[c], c))
                 if first is not None:
@@ -133,7 +146,7 @@ class Identifier(Walker):
             self.count("sessions")
             start = self.agent.step
             survivors, candidates, at_landmark = yield from self.session(
-                candidates, first, script, follow=follow
+                (q, a), candidates, first, script, follow=follow
             )
             self.record(q, a, label, start)
             here = False
@@ -148,6 +161,7 @@ class Identifier(Walker):
                     self.confirm(q, a, ordered[0])
                     return
                 separate = word
+                tried -= survivors  # each may need its own path again after the separation
 
     def predict(self, q: int, a: int, candidates: set[int], undo: int | None) -> list[int]:
         """Candidates for ``q -a->`` that confirmed transitions point at, most votes first.
@@ -173,13 +187,20 @@ class Identifier(Walker):
         return sorted(votes, key=lambda c: (-votes[c], c))
 
     def session(
-        self, candidates: set[int], first: int | None, script: list[int], *, follow: bool = True
+        self,
+        via: tuple[int, int],
+        candidates: set[int],
+        first: int | None,
+        script: list[int],
+        *,
+        follow: bool = True,
     ) -> Generator[int, bool, tuple[set[int], set[int], bool]]:
-        """One test from the world state being identified: follow paths to the landmark.
+        """One test from the world state ``via`` led to: follow paths to the landmark.
 
         Plays ``script`` first; then (if ``follow``) follows ``first``'s path to the landmark,
-        and the nearest remaining candidate's when ``first`` is ruled out. Returns the
-        candidates that reached the landmark with the world (if it was reached), the
+        and the nearest remaining candidate's when ``first`` is ruled out. A candidate is
+        followed on the hypothesis that it is the world state, ``via`` leading to it. Returns
+        the candidates that reached the landmark with the world (if it was reached), the
         candidates not ruled out, and whether the landmark was reached.
         """
         h = self.h
@@ -209,7 +230,7 @@ class Identifier(Walker):
                     chosen = int(ids[index])
                 action = h.actions[int(h.toward[position[index]])]
             sensation = yield from self.move(action)
-            moved = h.next[position, h.column[action]]
+            moved = h.step(ids, position, action, via)
             tracked &= moved >= 0
             position = np.where(tracked, moved, position)
             keep = ~tracked | (h.label[position] == sensation)

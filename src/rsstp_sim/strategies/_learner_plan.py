@@ -72,9 +72,9 @@ class Learning(Identifier):
                 yield from self.explore(*pair)
             return
         if self.deferred:
-            (q, a), (_, access, label) = min(self.deferred.items())
+            (q, a), deferral = min(self.deferred.items())
             self.count("forced")
-            self.new(q, a, label, access, here=False)
+            self.new(q, a, deferral.label, deferral.access, here=False)
             return
         reachable = h.reachable()
         garbage = [s for s in h.states() if s not in reachable]
@@ -122,10 +122,11 @@ class Learning(Identifier):
         for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
             a = h.actions[k]
             deferred = self.deferred.get((s, a))
-            if deferred is not None and not any(
-                u not in h.labels or distance[u] < FAR for u in deferred[0]
+            if deferred is not None and (
+                deferred.version == h.version
+                or not any(u not in h.labels or distance[u] < FAR for u in deferred.candidates)
             ):
-                continue
+                continue  # until the model changed and a candidate can be tested
             open_pairs.setdefault(s, []).append(a)
         if not open_pairs:
             return None
@@ -201,7 +202,7 @@ class Learning(Identifier):
                     continue
                 agreeing: set[int] | None = None
                 for word, outputs in self.traces.get((s, a), ()):
-                    found = set(h.consistent(word, outputs))
+                    found = set(h.consistent(word, outputs, (s, a)))
                     agreeing = found if agreeing is None else agreeing & found
                 if agreeing != {t}:
                     doubtful.setdefault(s, []).append(a)
