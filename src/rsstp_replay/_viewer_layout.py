@@ -1,0 +1,143 @@
+"""Where the viewer puts the model's states: one layout of every version at once.
+
+Positions are in points, y up (Graphviz's frame); the graph view draws y downwards, so the
+viewer logs ``(x, -y)`` (:func:`viewer_positions`), and
+:func:`rsstp_replay.viewer.render_graph` hands the same points to Graphviz.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import subprocess
+import warnings
+from collections.abc import Iterable, Sequence
+
+from rsstp_sim.errors import ModelError
+from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = [
+    "DOT_MAX_PAIRS",
+    "DOT_TIMEOUT_S",
+    "ViewerWarning",
+    "graph_positions",
+    "union_model",
+    "viewer_positions",
+]
+
+
+class ViewerWarning(UserWarning):
+    """Something the viewer could not show as asked; it showed what it could instead."""
+
+
+def union_model(
+    versions: Sequence[ModelRecord], extra_states: Iterable[int] = ()
+) -> TransitionSystem:
+    """A transition system holding every state and transition of every version (and
+    ``extra_states``): the one graph whose layout fixes every node's place."""
+    states: set[int] = set(extra_states)
+    actions: set[int] = set()
+    transitions: set[tuple[int, int, int]] = set()
+    for record in versions:
+        states.update(record.states)
+        actions.update(record.actions)
+        transitions.update(record.transitions)
+    if not states:
+        states.add(0)
+    ordered = sorted(states)
+    return TransitionSystem.from_snapshot(
+        {
+            "states": ordered,
+            "next_id": ordered[-1] + 1,
+            "current": ordered[0],
+            "actions": sorted(actions | {a for _, a, _ in transitions}),
+            "transitions": [list(triple) for triple in sorted(transitions)],
+        }
+    )
+
+
+def graph_positions(
+    versions: Sequence[ModelRecord], extra_states: Iterable[int] = ()
+) -> dict[int, tuple[float, float]]:
+    """Every state's place (points, y up), from one layout of :func:`union_model`.
+
+    The layout is Graphviz's: ``dot`` with :func:`rsstp_sim.graph.to_dot`'s graph attributes
+    (left to right, the same node and rank separations) over one edge per state pair of the
+    union, *without* the action labels (``dot`` places labels as nodes: on the union of a
+    learning run, 90 states and 718 state pairs, 3.2 s with them, 0.2 s without). ``dot``'s
+    crossing minimisation can take minutes on dense graphs, so past :data:`DOT_MAX_PAIRS` pairs,
+    or when ``dot`` runs longer than :data:`DOT_TIMEOUT_S`, the force-directed ``sfdp`` lays it
+    out instead (deterministic too). Without Graphviz the states go on a circle, with a
+    :class:`ViewerWarning`.
+    """
+    union = union_model(versions, extra_states)
+    pairs = sorted({(s, t) for s, _, t in union.transitions() if s != t})
+    if shutil.which("dot") is None:
+        warnings.warn(
+            ViewerWarning("Graphviz 'dot' not found: the model's states are drawn on a circle"),
+            stacklevel=2,
+        )
+        return _circle(union.states)
+    source = _layout_source(union.states, pairs)
+    if len(pairs) <= DOT_MAX_PAIRS:
+        try:
+            return _run_layout("dot", source, timeout=DOT_TIMEOUT_S)
+        except subprocess.TimeoutExpired:
+            pass
+    return _run_layout("sfdp", source, timeout=None)
+
+
+DOT_MAX_PAIRS = 400
+"""Above this many state pairs the union is laid out by ``sfdp`` rather than ``dot``."""
+DOT_TIMEOUT_S = 10.0
+"""How long ``dot`` may take before ``sfdp`` takes over."""
+_POINTS_PER_INCH = 72.0
+
+
+def _layout_source(states: Sequence[int], pairs: Sequence[tuple[int, int]]) -> str:
+    lines = [
+        "digraph union {",
+        '  graph [rankdir="LR", nodesep="0.6", ranksep="0.9", overlap="false", sep="+12"];',
+        '  node [shape="circle", width="0.5", fixedsize="true"];',
+        *(f"  {s};" for s in states),
+        *(f"  {s} -> {t};" for s, t in pairs),
+        "}",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def _run_layout(
+    engine: str, source: str, *, timeout: float | None
+) -> dict[int, tuple[float, float]]:
+    """Node centres in points from Graphviz's ``plain`` output."""
+    done = subprocess.run(
+        [engine, "-Tplain"], input=source, capture_output=True, text=True, timeout=timeout
+    )
+    if done.returncode != 0:
+        raise ModelError(f"graph layout: {engine} failed: {done.stderr.strip()}")
+    positions: dict[int, tuple[float, float]] = {}
+    for line in done.stdout.splitlines():
+        fields = line.split()
+        if fields and fields[0] == "node":
+            positions[int(fields[1])] = (
+                round(float(fields[2]) * _POINTS_PER_INCH, 2),
+                round(float(fields[3]) * _POINTS_PER_INCH, 2),
+            )
+    return positions
+
+
+def _circle(states: Sequence[int]) -> dict[int, tuple[float, float]]:
+    radius = max(60.0, 20.0 * len(states))
+    return {
+        s: (
+            round(radius * math.cos(2 * math.pi * i / len(states)), 2),
+            round(radius * math.sin(2 * math.pi * i / len(states)), 2),
+        )
+        for i, s in enumerate(states)
+    }
+
+
+def viewer_positions(positions: dict[int, tuple[float, float]]) -> dict[int, tuple[float, float]]:
+    """Graphviz's y-up points as the graph view's y-down coordinates."""
+    return {s: (x, -y) for s, (x, y) in positions.items()}

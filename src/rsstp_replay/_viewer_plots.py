@@ -1,0 +1,236 @@
+"""Time series and the audit log for the viewer.
+
+Series (``rr.Scalars``, one row per step unless said): the sensation (0 or 1) and the float
+feedback, each obstacle sensor reading, and the model's size (rows only at the steps where the
+model changed, drawn as a step function).
+
+The log (``rr.TextLog`` at ``log/audit``) holds, at their steps: every contradiction the
+consistency audit finds (the state, its shortest witness, the number of contradicting pairs),
+the step from which the model stayed deterministic (or, at the last step, that it never did),
+the first step at which it was deterministic and complete, every split and merge, and the
+contradictions and notes a strategy recorded as events.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+import rerun as rr
+
+from rsstp_replay._viewer_chunks import TIMELINE, send_rows
+from rsstp_replay.audits.consistency import ConsistencyFindings
+from rsstp_replay.audits.determinism import DeterminismFindings
+from rsstp_sim.recording.records import ModelRecord
+
+__all__ = [
+    "DISTANCE",
+    "FEEDBACK",
+    "LOG",
+    "MODEL_STATES",
+    "MODEL_TRANSITIONS",
+    "SENSATION",
+    "LogLine",
+    "audit_lines",
+    "distance_path",
+    "log_lines",
+    "log_model_size",
+    "log_series",
+]
+
+SENSATION = "plots/agent/sensation"
+FEEDBACK = "plots/agent/feedback"
+DISTANCE = "plots/distance"
+MODEL_STATES = "plots/model/states"
+MODEL_TRANSITIONS = "plots/model/transitions"
+LOG = "log/audit"
+
+
+def distance_path(link: int, obstacle: int) -> str:
+    """The series of the distance from link ``link``'s tip to obstacle ``obstacle``."""
+    return f"{DISTANCE}/link{link}/obstacle{obstacle}"
+
+
+def log_series(
+    stream: rr.RecordingStream,
+    steps: pd.DataFrame,
+    *,
+    n_joints: int,
+    n_obstacles: int,
+) -> dict[str, int]:
+    """Sensation, feedback and the sensor readings, one row per step; returns rows per path."""
+    times = steps["step"].to_numpy(np.int64)
+    series: list[tuple[str, str, npt.NDArray[np.float64]]] = [
+        (SENSATION, "sensation", steps["sensation"].to_numpy(np.float64)),
+        (FEEDBACK, "feedback", steps["feedback"].to_numpy(np.float64)),
+    ]
+    for k in range(n_joints):
+        for j in range(n_obstacles):
+            series.append(
+                (
+                    distance_path(k, j),
+                    f"tip of link {k} to obstacle {j}",
+                    steps[f"dist_{k}_{j}"].to_numpy(np.float64),
+                )
+            )
+    logged = {}
+    for path, name, values in series:
+        stream.log(path, rr.SeriesLines(names=name), static=True)
+        logged[path] = send_rows(stream, path, times, _scalars(values))
+    return logged
+
+
+def _scalars(values: npt.NDArray[np.float64]) -> Callable[[slice], rr.ComponentColumnList]:
+    def columns(rows: slice) -> rr.ComponentColumnList:
+        return rr.Scalars.columns(scalars=values[rows])
+
+    return columns
+
+
+def log_model_size(
+    stream: rr.RecordingStream,
+    versions: Sequence[ModelRecord],
+    steps: Sequence[int],
+    last_step: int,
+) -> dict[str, int]:
+    """States and transitions of each version at its step, and once more at ``last_step`` so
+    the step function reaches the end; returns rows per path."""
+    times = [*steps, last_step] if steps[-1] != last_step else list(steps)
+    sizes = [*versions, versions[-1]][: len(times)]
+    index = rr.TimeColumn(TIMELINE, sequence=np.asarray(times, np.int64))
+    counts = {
+        MODEL_STATES: ("states", [len(record.states) for record in sizes]),
+        MODEL_TRANSITIONS: ("transitions", [len(record.transitions) for record in sizes]),
+    }
+    for path, (name, values) in counts.items():
+        stream.log(path, rr.SeriesLines(names=name, interpolation_mode="StepAfter"), static=True)
+        stream.send_columns(
+            path,
+            indexes=[index],
+            columns=rr.Scalars.columns(scalars=np.asarray(values, np.float64)),
+        )
+    return {path: len(times) for path in counts}
+
+
+@dataclass(frozen=True, slots=True)
+class LogLine:
+    """One line of the audit log."""
+
+    step: int
+    level: str
+    text: str
+
+
+def audit_lines(
+    versions: Sequence[ModelRecord],
+    consistency: ConsistencyFindings | None,
+    determinism: DeterminismFindings | None,
+    events: pd.DataFrame,
+    *,
+    last_step: int,
+) -> list[LogLine]:
+    """Every line of the audit log over the whole recording, sorted by step (stable)."""
+    lines: list[LogLine] = []
+    for record in versions:
+        for operation in record.operations:
+            if not operation.changed:
+                continue
+            if operation.kind == "split":
+                lines.append(
+                    LogLine(
+                        record.step,
+                        "INFO",
+                        f"split: state {operation.args[0]} -> new state {operation.result} "
+                        f"(model version {record.version})",
+                    )
+                )
+            elif operation.kind == "merge":
+                s, t = operation.args[:2]
+                lines.append(
+                    LogLine(
+                        record.step,
+                        "INFO",
+                        f"merge: state {t} into state {s} (model version {record.version})",
+                    )
+                )
+    if consistency is not None:
+        for found in consistency.contradictions:
+            witness = found.witness
+            lines.append(
+                LogLine(
+                    found.first_step,
+                    "WARN",
+                    f"contradiction: state {found.state}: after steps {witness.i} and "
+                    f"{witness.j} (both in state {found.state}) the actions "
+                    f"{list(witness.actions)} give different sensations at steps "
+                    f"{witness.i + witness.k} and {witness.j + witness.k}; {found.pairs} "
+                    f"contradicting pair{'' if found.pairs == 1 else 's'}",
+                )
+            )
+    if determinism is not None:
+        lines += _determinism_lines(determinism, last_step=last_step)
+    for step, kind, text in zip(
+        events["step"].tolist(),
+        events["kind"].astype(str).tolist(),
+        events["text"].tolist(),
+        strict=True,
+    ):
+        if kind == "contradiction":
+            lines.append(LogLine(int(step), "WARN", f"recorded contradiction: {text}"))
+        elif kind == "note":
+            lines.append(LogLine(int(step), "DEBUG", f"strategy note: {text}"))
+    lines.sort(key=lambda line: line.step)
+    return lines
+
+
+def _determinism_lines(found: DeterminismFindings, *, last_step: int) -> list[LogLine]:
+    lines = []
+    since = found.deterministic_from
+    if since is None:
+        final = found.final
+        lines.append(
+            LogLine(
+                last_step,
+                "WARN",
+                f"the final model (version {final.version}) is nondeterministic: "
+                f"{len(final.nondeterministic)} (state, action) pairs with several successors",
+            )
+        )
+    else:
+        version = next(v for v in found.versions if v.step == since)
+        lines.append(
+            LogLine(
+                since,
+                "INFO",
+                f"deterministic: the model is deterministic from here to the end (version "
+                f"{version.version}, {version.states} states, {version.transitions} transitions)",
+            )
+        )
+    complete = found.first_complete_step
+    if complete is not None:
+        lines.append(
+            LogLine(
+                complete,
+                "INFO",
+                "complete: the model is deterministic and complete (one successor for every "
+                "state and action) for the first time",
+            )
+        )
+    return lines
+
+
+def log_lines(stream: rr.RecordingStream, lines: Sequence[LogLine]) -> int:
+    """The audit log lines at their steps; returns the rows logged."""
+    if not lines:
+        return 0
+    stream.send_columns(
+        LOG,
+        indexes=[rr.TimeColumn(TIMELINE, sequence=[line.step for line in lines])],
+        columns=rr.TextLog.columns(
+            text=[line.text for line in lines], level=[line.level for line in lines]
+        ),
+    )
+    return len(lines)

@@ -1,0 +1,199 @@
+"""The world for the viewer: the arm among its obstacles, in the plane, one row per step.
+
+Everything here is logged with ``send_columns`` (one call per entity for the whole step
+range); the obstacles and the feedback points do not move and are logged as static data.
+Coordinates are the recording's, in its length unit, in the world frame (x right, y up):
+the ``world`` entity carries a static transform that mirrors y, because Rerun's 2D views
+draw y downwards.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+import rerun as rr
+
+from rsstp_replay._viewer_chunks import send_rows
+from rsstp_sim.scenario import Scenario
+
+__all__ = [
+    "ARM",
+    "BLOCKED",
+    "FEEDBACK_POINTS",
+    "JOINTS",
+    "OBSTACLES",
+    "SENSOR",
+    "WORLD",
+    "joint_positions",
+    "log_world",
+    "log_world_static",
+    "sensor_segments",
+]
+
+WORLD = "world"
+ARM = "world/arm"
+JOINTS = "world/joints"
+OBSTACLES = "world/obstacles"
+FEEDBACK_POINTS = "world/feedback_points"
+SENSOR = "world/sensor"
+BLOCKED = "world/blocked"
+
+_ARM_COLOR = (70, 130, 200)
+_BLOCKED_COLOR = (230, 40, 40)
+_JOINT_COLOR = (40, 40, 40)
+_OBSTACLE_FILL = (225, 140, 140)
+_OBSTACLE_EDGE = (190, 60, 60)
+_FEEDBACK_COLOR = (40, 170, 80)
+_SENSOR_COLORS = ((230, 150, 30), (150, 90, 200), (30, 160, 160), (200, 90, 130))
+
+_Floats = npt.NDArray[np.float64]
+
+
+def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
+    """The y-up transform, the obstacles (filled disks with their outline) and the feedback
+    points, as static data; the styles of the per-step entities."""
+    stream.log(WORLD, rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)
+    if scenario.obstacles:
+        centers = np.array([obstacle.center for obstacle in scenario.obstacles], np.float64)
+        radii = np.array([obstacle.radius for obstacle in scenario.obstacles], np.float64)
+        labels = [f"obstacle {j}" for j in range(len(radii))]
+        stream.log(
+            OBSTACLES,
+            rr.Points2D(centers, radii=radii, colors=_OBSTACLE_FILL, labels=labels, draw_order=1.0),
+            rr.Ellipses2D(
+                centers=centers,
+                half_sizes=np.stack([radii, radii], axis=1),
+                colors=_OBSTACLE_EDGE,
+                line_radii=rr.Radius.ui_points(1.5),
+                draw_order=2.0,
+            ),
+            static=True,
+        )
+        colors = [_SENSOR_COLORS[j % len(_SENSOR_COLORS)] for j in range(len(radii))]
+        stream.log(
+            SENSOR,
+            rr.LineStrips2D.from_fields(
+                colors=colors * scenario.n_joints,
+                radii=rr.Radius.ui_points(0.75),
+                draw_order=3.0,
+            ),
+            static=True,
+        )
+    points = np.array(scenario.feedback_points, np.float64).reshape(-1, 2)
+    stream.log(
+        FEEDBACK_POINTS,
+        rr.Points2D(
+            points,
+            radii=rr.Radius.ui_points(5.0),
+            colors=_FEEDBACK_COLOR,
+            labels=[f"f{k}" for k in range(len(points))],
+            draw_order=4.0,
+        ),
+        static=True,
+    )
+    stream.log(
+        ARM,
+        rr.LineStrips2D.from_fields(radii=rr.Radius.ui_points(3.0), draw_order=5.0),
+        static=True,
+    )
+    stream.log(
+        JOINTS,
+        rr.Points2D.from_fields(
+            radii=rr.Radius.ui_points(4.0), colors=_JOINT_COLOR, draw_order=6.0
+        ),
+        static=True,
+    )
+    stream.log(
+        BLOCKED,
+        rr.Points2D.from_fields(
+            radii=rr.Radius.ui_points(8.0), colors=_BLOCKED_COLOR, draw_order=7.0
+        ),
+        static=True,
+    )
+
+
+def joint_positions(steps: pd.DataFrame, n_joints: int) -> _Floats:
+    """``(rows, n + 1, 2)``: the base and every link's tip at each step (columns
+    ``joint{k}_x``, ``joint{k}_y`` of :meth:`Recording.steps`)."""
+    names = [f"joint{k}_{axis}" for k in range(n_joints + 1) for axis in ("x", "y")]
+    return steps[names].to_numpy(np.float64).reshape(len(steps), n_joints + 1, 2)
+
+
+def sensor_segments(positions: _Floats, scenario: Scenario) -> _Floats:
+    """``(rows, n, m, 2, 2)``: for every step, tip ``k`` (of link ``k``) and obstacle ``j``,
+    the segment from the tip to the obstacle's nearest point ``c + r (p - c) / |p - c|``
+    (thesis figure 17); its length is the sensor reading ``|p - c| - r``."""
+    centers = np.array([obstacle.center for obstacle in scenario.obstacles], np.float64)
+    radii = np.array([obstacle.radius for obstacle in scenario.obstacles], np.float64)
+    tips = positions[:, 1:, None, :]  # (rows, n, 1, 2)
+    away = tips - centers[None, None, :, :]  # (rows, n, m, 2)
+    norm = np.hypot(away[..., 0], away[..., 1])[..., None]
+    # A tip exactly on a centre (impossible in a valid pose) has no direction: take +x.
+    unit = np.divide(away, norm, out=np.tile([1.0, 0.0], away.shape[:-1] + (1,)), where=norm > 0)
+    nearest = centers[None, None, :, :] + radii[None, None, :, None] * unit
+    return np.stack([np.broadcast_to(tips, nearest.shape), nearest], axis=-2)
+
+
+def log_world(
+    stream: rr.RecordingStream,
+    steps: pd.DataFrame,
+    scenario: Scenario,
+) -> dict[str, int]:
+    """The arm, its joints, the obstacle sensor and the blocked moves, one row per step of
+    ``steps``; returns the rows logged per entity path."""
+    times = steps["step"].to_numpy(np.int64)
+    n = scenario.n_joints
+    positions = joint_positions(steps, n)
+    strips = positions.astype(np.float32)  # what Rerun stores
+    blocked = steps["blocked"].to_numpy(np.bool_)
+    colors = np.where(blocked[:, None], _BLOCKED_COLOR, _ARM_COLOR).astype(np.uint8)
+    logged = {
+        ARM: send_rows(
+            stream,
+            ARM,
+            times,
+            lambda rows: rr.LineStrips2D.columns(strips=strips[rows], colors=colors[rows]),
+        ),
+        JOINTS: send_rows(
+            stream,
+            JOINTS,
+            times,
+            lambda rows: rr.Points2D.columns(positions=positions[rows].reshape(-1, 2)).partition(
+                np.full(len(times[rows]), n + 1)
+            ),
+        ),
+    }
+    m = len(scenario.obstacles)
+    if m:
+        segments = sensor_segments(positions, scenario).astype(np.float32)
+        logged[SENSOR] = send_rows(
+            stream,
+            SENSOR,
+            times,
+            lambda rows: rr.LineStrips2D.columns(strips=segments[rows].reshape(-1, 2, 2)).partition(
+                np.full(len(times[rows]), n * m)
+            ),
+        )
+    if blocked.any():
+        labels = ("blocked: " + steps["blocked_by"].astype(str)).to_numpy(object)
+        tips = positions[:, -1, :]
+        logged[BLOCKED] = send_rows(
+            stream, BLOCKED, times, lambda rows: _blocked(tips, labels, blocked, rows)
+        )
+    return logged
+
+
+def _blocked(
+    tips: _Floats, labels: npt.NDArray[np.object_], blocked: npt.NDArray[np.bool_], rows: slice
+) -> rr.ComponentColumnList:
+    """The marker at the arm's tip, with what blocked the move, at the blocked steps of
+    ``rows``; no point at the others (so the marker disappears)."""
+    mask = blocked[rows]
+    if not mask.any():
+        return rr.Points2D.columns(positions=np.zeros((0, 2)), labels=[]).partition(
+            np.zeros(len(mask), np.int64)
+        )
+    return rr.Points2D.columns(
+        positions=tips[rows][mask], labels=labels[rows][mask].tolist()
+    ).partition(mask.astype(np.int64))

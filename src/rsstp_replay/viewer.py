@@ -1,0 +1,394 @@
+"""Streaming a recording to Rerun: the world, the learned model, time series and audit findings.
+
+>>> with open_recording("run.mcap") as recording:  # doctest: +SKIP
+...     result = view(recording, save=Path("run.rrd"), spawn=False, serve_web=False,
+...                   start=None, end=None)
+...     render_graph(recording, 500, Path("model.svg"))
+
+Everything is on one sequence timeline, ``step`` (step 0 is the reset), and is logged column
+by column (``rr.send_columns``: one call per entity for the whole range), so a 100,000-step
+recording streams in about a second. ``docs/viewer.md`` lists every entity path, what it
+shows and how; :data:`ENTITY_PATHS` is that list for code.
+
+This is the one lenient part of the project (as Rerun's own ``error_utils``): what cannot be
+shown (no Graphviz for the layout, an audit that fails on the data, a viewer that cannot be
+spawned) is reported as a :class:`ViewerWarning` and the rest is still shown. Bad arguments
+(a step outside the recording, an output in a missing folder) still raise.
+"""
+
+from __future__ import annotations
+
+import bisect
+import time
+import urllib.parse
+import uuid
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Protocol
+
+import numpy as np
+import pandas as pd
+import rerun as rr
+
+from rsstp_replay import _viewer_model as model_part
+from rsstp_replay import _viewer_plots as plots_part
+from rsstp_replay import _viewer_world as world_part
+from rsstp_replay._viewer_blueprint import default_blueprint
+from rsstp_replay._viewer_chunks import TIMELINE
+from rsstp_replay._viewer_layout import ViewerWarning, graph_positions, viewer_positions
+from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
+from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
+from rsstp_replay.errors import ReplayError, StepOutOfRange
+from rsstp_sim import graph
+from rsstp_sim.errors import RsstpError
+from rsstp_sim.memory import Memory
+from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.scenario import Scenario
+from rsstp_sim.transition_system import TransitionSystem
+
+__all__ = [
+    "APPLICATION_ID",
+    "ENTITY_PATHS",
+    "TIMELINE",
+    "LogSummary",
+    "ViewResult",
+    "ViewSource",
+    "ViewerWarning",
+    "default_blueprint",
+    "graph_positions",
+    "log_recording",
+    "render_graph",
+    "view",
+]
+
+APPLICATION_ID = "rsstp"
+SPAWN_PORT = 9876
+"""The port of a spawned native viewer (Rerun's default)."""
+SERVE_PORT = 9877
+"""The gRPC port of ``serve_web``'s server (the web page itself is on 9090)."""
+WEB_PORT = 9090
+
+ENTITY_PATHS: tuple[str, ...] = (
+    world_part.WORLD,
+    world_part.ARM,
+    world_part.JOINTS,
+    world_part.OBSTACLES,
+    world_part.FEEDBACK_POINTS,
+    world_part.SENSOR,
+    world_part.BLOCKED,
+    model_part.GRAPH,
+    model_part.STATE,
+    plots_part.SENSATION,
+    plots_part.FEEDBACK,
+    plots_part.DISTANCE + "/link{k}/obstacle{j}",
+    plots_part.MODEL_STATES,
+    plots_part.MODEL_TRANSITIONS,
+    plots_part.LOG,
+)
+"""Every entity path the viewer writes (``{k}``, ``{j}``: link and obstacle indices)."""
+
+
+class ViewSource(Protocol):
+    """What the viewer reads of a recording (:class:`rsstp_replay.recording.Recording`)."""
+
+    @property
+    def scenario(self) -> Scenario: ...
+
+    @property
+    def n_steps(self) -> int: ...
+
+    def steps(self) -> pd.DataFrame: ...
+
+    def model_versions(self) -> Sequence[ModelRecord]: ...
+
+    def events(self) -> pd.DataFrame: ...
+
+    def model_at(self, step: int) -> TransitionSystem: ...
+
+
+@dataclass(frozen=True, slots=True)
+class LogSummary:
+    """What :func:`log_recording` wrote: steps ``first_step .. last_step``, the rows of every
+    time-indexed entity path, and where the time went (seconds): reading the recording,
+    auditing it and laying out the graph, building and sending the Rerun columns."""
+
+    first_step: int
+    last_step: int
+    rows: dict[str, int]
+    model_versions: int
+    log_lines: int
+    seconds_read: float
+    seconds_prepare: float
+    seconds_rerun: float
+
+
+@dataclass(slots=True)
+class ViewResult:
+    """The outcome of :func:`view`. ``seconds_rerun`` includes flushing the sinks (writing
+    the ``.rrd``). With ``web_url`` set, a gRPC server holds the data for the web viewer
+    until :meth:`close` (or the end of :meth:`serve_forever`)."""
+
+    summary: LogSummary
+    saved: Path | None
+    spawned: bool
+    web_url: str | None
+    seconds_rerun: float
+    _stream: rr.RecordingStream | None = field(default=None, repr=False)
+
+    def to_text(self) -> str:
+        """One line for the command line."""
+        s = self.summary
+        where = [f"saved {self.saved}"] if self.saved is not None else []
+        if self.spawned:
+            where.append("sent to a native viewer")
+        if self.web_url is not None:
+            where.append(f"serving the web viewer at {self.web_url}")
+        return (
+            f"steps {s.first_step}..{s.last_step}: {len(s.rows)} entities, "
+            f"{s.model_versions} model versions, {s.log_lines} log lines; read "
+            f"{s.seconds_read:.2f} s, audits and layout {s.seconds_prepare:.2f} s, Rerun "
+            f"{self.seconds_rerun:.2f} s" + ("; " + ", ".join(where) if where else "")
+        )
+
+    def serve_forever(self) -> None:
+        """Keep serving the web viewer until interrupted (Ctrl-C), then stop."""
+        try:
+            while self.web_url is not None and self._stream is not None:
+                time.sleep(0.5)
+        except KeyboardInterrupt:
+            pass
+        finally:
+            self.close()
+
+    def close(self) -> None:
+        """Stop serving (if serving) and release the stream."""
+        if self._stream is not None:
+            self._stream.disconnect()
+            self._stream = None
+
+
+def view(
+    recording: ViewSource,
+    *,
+    save: Path | None,
+    spawn: bool,
+    serve_web: bool,
+    start: int | None,
+    end: int | None,
+) -> ViewResult:
+    """Stream steps ``start .. end`` (inclusive; default: all) of ``recording`` to Rerun.
+
+    ``save``: write an ``.rrd`` file (the default blueprint inside); ``spawn``: send to a native
+    viewer, started if none listens on port 9876; ``serve_web``: host a web viewer
+    (``web_url``; keep the process alive with :meth:`ViewResult.serve_forever`). With none of
+    them a native viewer is spawned. Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a
+    bad range and :class:`~rsstp_replay.errors.ReplayError` for an unwritable ``save``.
+    """
+    first, last = _step_range(recording, start, end)
+    if save is not None:
+        save = Path(save)
+        if not save.parent.is_dir():
+            raise ReplayError(f"cannot write {save}: the folder {save.parent} does not exist")
+    if save is None and not spawn and not serve_web:
+        spawn = True
+    loaded = _load(recording)
+    stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
+    sinks: list[rr.FileSink | rr.GrpcSink | rr.GrpcServerSink] = []
+    if save is not None:
+        sinks.append(rr.FileSink(save))
+    spawned = False
+    if spawn:
+        try:
+            rr.spawn(port=SPAWN_PORT, connect=False)
+        except Exception as exc:  # the lenient adapter: no viewer, still save or serve
+            warnings.warn(ViewerWarning(f"could not spawn a Rerun viewer: {exc}"), stacklevel=2)
+        else:
+            sinks.append(rr.GrpcSink(f"rerun+http://127.0.0.1:{SPAWN_PORT}/proxy"))
+            spawned = True
+    web_url = None
+    if serve_web:
+        server = rr.GrpcServerSink(port=SERVE_PORT)
+        sinks.append(server)
+        rr.serve_web_viewer(web_port=WEB_PORT, open_browser=False, connect_to=server.uri)
+        web_url = f"http://127.0.0.1:{WEB_PORT}/?url={urllib.parse.quote(server.uri, safe='')}"
+    blueprint = default_blueprint(
+        recording.scenario, first=first, last=last, positions=loaded.positions
+    )
+    stream.set_sinks(*sinks, default_blueprint=blueprint)
+    summary = _log(recording, loaded, stream, first, last)
+    began = time.perf_counter()
+    stream.flush()
+    if web_url is None:
+        stream.disconnect()  # finishes the file (its footer) and the connection
+    seconds = summary.seconds_rerun + time.perf_counter() - began
+    return ViewResult(
+        summary=summary,
+        saved=save,
+        spawned=spawned,
+        web_url=web_url,
+        seconds_rerun=seconds,
+        _stream=stream if web_url is not None else None,
+    )
+
+
+def log_recording(
+    recording: ViewSource,
+    stream: rr.RecordingStream,
+    *,
+    start: int | None = None,
+    end: int | None = None,
+) -> LogSummary:
+    """Log steps ``start .. end`` (inclusive; default: all) of ``recording`` to ``stream``
+    (the caller sets its sinks, and the blueprint if it wants one, and flushes it). The audits
+    run over the whole recording; the model version in force at ``start`` is shown from
+    ``start`` on."""
+    first, last = _step_range(recording, start, end)
+    return _log(recording, _load(recording), stream, first, last)
+
+
+@dataclass(frozen=True, slots=True)
+class _Loaded:
+    """A recording read once, audited, its graph laid out (viewer coordinates)."""
+
+    steps: pd.DataFrame
+    versions: list[ModelRecord]
+    events: pd.DataFrame
+    consistency: ConsistencyFindings | None
+    determinism: DeterminismFindings | None
+    positions: dict[int, tuple[float, float]]
+    seconds_read: float
+    seconds_prepare: float
+
+
+def _load(recording: ViewSource) -> _Loaded:
+    began = time.perf_counter()
+    steps = recording.steps()
+    versions = list(recording.model_versions())
+    events = recording.events()
+    read = time.perf_counter()
+    consistency, determinism = _audits(steps, versions)
+    positions = viewer_positions(graph_positions(versions))
+    return _Loaded(
+        steps,
+        versions,
+        events,
+        consistency,
+        determinism,
+        positions,
+        seconds_read=read - began,
+        seconds_prepare=time.perf_counter() - read,
+    )
+
+
+def _log(
+    recording: ViewSource, loaded: _Loaded, stream: rr.RecordingStream, first: int, last: int
+) -> LogSummary:
+    began = time.perf_counter()
+    window = loaded.steps.iloc[first : last + 1]
+    scenario = recording.scenario
+    stream.send_recording_name(f"{scenario.name} ({getattr(recording, 'path', 'recording')})")
+    world_part.log_world_static(stream, scenario)
+    rows = world_part.log_world(stream, window, scenario)
+    rows |= plots_part.log_series(
+        stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
+    )
+    shown, times = _versions_in(loaded.versions, first, last)
+    rows[model_part.GRAPH] = model_part.log_model(stream, shown, times, loaded.positions)
+    rows |= plots_part.log_model_size(stream, shown, times, last)
+    rows[model_part.STATE] = model_part.log_current_state(
+        stream,
+        window["step"].to_numpy(np.int64),
+        window["internal_state"].to_numpy(np.int64),
+        loaded.positions,
+    )
+    every_line = plots_part.audit_lines(
+        loaded.versions,
+        loaded.consistency,
+        loaded.determinism,
+        loaded.events,
+        last_step=recording.n_steps,
+    )
+    lines = [line for line in every_line if first <= line.step <= last]
+    if lines:
+        rows[plots_part.LOG] = plots_part.log_lines(stream, lines)
+    return LogSummary(
+        first_step=first,
+        last_step=last,
+        rows=rows,
+        model_versions=len(shown),
+        log_lines=len(lines),
+        seconds_read=loaded.seconds_read,
+        seconds_prepare=loaded.seconds_prepare,
+        seconds_rerun=time.perf_counter() - began,
+    )
+
+
+def render_graph(recording: ViewSource, step: int, path: Path) -> Path:
+    """Draw the model at the end of step ``step`` with Graphviz (the format from the suffix:
+    ``.svg``, ``.png``, ``.pdf``, ``.dot``, ``.gv``), the current state filled, every state
+    where the Rerun view puts it (the same layout of all versions). Returns ``path``.
+
+    Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a bad step and
+    :class:`~rsstp_sim.errors.GraphvizMissing` when a picture format needs ``dot``.
+    """
+    model = recording.model_at(step)
+    positions = graph_positions(recording.model_versions())
+    return graph.render(model, path, positions={s: positions[s] for s in model.states})
+
+
+# ------------------------------------------------------------------------------ helpers
+
+
+def _step_range(recording: ViewSource, start: int | None, end: int | None) -> tuple[int, int]:
+    n = recording.n_steps
+    where = getattr(recording, "path", "the recording")
+    bounds = (0 if start is None else start, n if end is None else end)
+    for name, value in zip(("start", "end"), bounds, strict=True):
+        if isinstance(value, bool) or not isinstance(value, int | np.integer):
+            raise StepOutOfRange(f"{where}: the {name} step must be an integer, got {value!r}")
+        if not 0 <= value <= n:
+            raise StepOutOfRange(
+                f"{where}: the {name} step {value} is out of range: the recording has steps 0 "
+                f"to {n}"
+            )
+    first, last = int(bounds[0]), int(bounds[1])
+    if first > last:
+        raise StepOutOfRange(f"{where}: no step from {first} to {last}: the start is after the end")
+    return first, last
+
+
+def _versions_in(
+    versions: Sequence[ModelRecord], first: int, last: int
+) -> tuple[list[ModelRecord], list[int]]:
+    """The versions to show for steps ``first .. last`` and the step of each: the version in
+    force at ``first`` (at ``first``), then every later one up to ``last``."""
+    steps = [record.step for record in versions]
+    begin = max(0, bisect.bisect_right(steps, first) - 1)
+    stop = bisect.bisect_right(steps, last)
+    shown = list(versions[begin:stop])
+    return shown, [max(record.step, first) for record in shown]
+
+
+def _audits(
+    steps: pd.DataFrame, versions: Sequence[ModelRecord]
+) -> tuple[ConsistencyFindings | None, DeterminismFindings | None]:
+    """The consistency and determinism audits, or None (with a warning) when they fail."""
+    consistency: ConsistencyFindings | None = None
+    determinism: DeterminismFindings | None = None
+    try:
+        memory = Memory.from_arrays(
+            steps["action"].fillna(-1).to_numpy(np.int64),
+            steps["internal_state"].to_numpy(np.int64),
+            steps["sensation"].to_numpy(np.bool_),
+            steps["feedback"].to_numpy(np.float64),
+        )
+        consistency = audit_consistency(memory)
+    except RsstpError as exc:
+        warnings.warn(ViewerWarning(f"consistency audit not shown: {exc}"), stacklevel=3)
+    try:
+        determinism = audit_determinism(versions)
+    except RsstpError as exc:
+        warnings.warn(ViewerWarning(f"determinism audit not shown: {exc}"), stacklevel=3)
+    return consistency, determinism
