@@ -6,7 +6,7 @@
 ...     render_graph(recording, 500, Path("model.svg"))
 
 Everything is on one sequence timeline, ``step`` (step 0 is the reset), and is logged column
-by column (``rr.send_columns``: one call per entity for the whole range), so a 100,000-step
+by column (``rr.send_columns``: one call per entity and 1,024 steps), so a 100,000-step
 recording streams in about a second. ``docs/viewer.md`` lists every entity path, what it
 shows and how; :data:`ENTITY_PATHS` is that list for code.
 
@@ -201,7 +201,7 @@ def view(
     spawned = False
     if spawn:
         try:
-            rr.spawn(port=SPAWN_PORT, connect=False)
+            stream.spawn(port=SPAWN_PORT, connect=False)
         except Exception as exc:  # the lenient adapter: no viewer, still save or serve
             warnings.warn(ViewerWarning(f"could not spawn a Rerun viewer: {exc}"), stacklevel=2)
         else:
@@ -211,15 +211,20 @@ def view(
     if serve_web:
         server = rr.GrpcServerSink(port=SERVE_PORT)
         sinks.append(server)
-        rr.serve_web_viewer(web_port=WEB_PORT, open_browser=False, connect_to=server.uri)
-        web_url = f"http://127.0.0.1:{WEB_PORT}/?url={urllib.parse.quote(server.uri, safe='')}"
+        grpc_url = f"rerun+http://127.0.0.1:{SERVE_PORT}/proxy"
+        rr.serve_web_viewer(web_port=WEB_PORT, open_browser=False, connect_to=grpc_url)
+        web_url = f"http://127.0.0.1:{WEB_PORT}/?url={urllib.parse.quote(grpc_url, safe='')}"
     blueprint = default_blueprint(
         recording.scenario, first=first, last=last, positions=loaded.positions
     )
     stream.set_sinks(*sinks, default_blueprint=blueprint)
     summary = _log(recording, loaded, stream, first, last)
     began = time.perf_counter()
-    stream.flush()
+    try:
+        stream.flush()
+    except RuntimeError as exc:  # a spawned viewer that never listened: the file is still whole
+        warnings.warn(ViewerWarning(f"the Rerun viewer could not be reached: {exc}"), stacklevel=2)
+        spawned = False
     if web_url is None:
         stream.disconnect()  # finishes the file (its footer) and the connection
     seconds = summary.seconds_rerun + time.perf_counter() - began

@@ -398,10 +398,10 @@ def test_a_viewer_that_cannot_be_spawned_is_a_warning(
 ) -> None:
     recording, _ = refined
 
-    def no_viewer(**_: object) -> None:
+    def no_viewer(self: rr.RecordingStream, **_: object) -> None:
         raise RuntimeError("no display")
 
-    monkeypatch.setattr(rr, "spawn", no_viewer)
+    monkeypatch.setattr(rr.RecordingStream, "spawn", no_viewer)
     with pytest.warns(ViewerWarning, match="could not spawn a Rerun viewer: no display"):
         result = view(
             recording, save=tmp_path / "s.rrd", spawn=True, serve_web=False, start=0, end=10
