@@ -192,6 +192,54 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_output(out: Path, *, force: bool) -> None:
+    """One line for an output path we must not or cannot write."""
+    if out.is_dir():
+        raise UsageError(f"{out}: is a directory, not an output file")
+    if out.exists() and not force:
+        raise UsageError(f"{out}: already exists (use --force to overwrite)")
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        raise UsageError(f"{out}: the output directory {parent} does not exist")
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    from rsstp_replay.viewer import ViewerWarning, view
+
+    save = Path(args.save) if args.save is not None else None
+    if save is not None:
+        _check_output(save, force=args.force)
+    with _open(args.file) as recording, warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ViewerWarning)
+        result = view(
+            recording,
+            save=save,
+            spawn=args.spawn or (save is None and not args.serve_web),
+            serve_web=args.serve_web,
+            start=args.start,
+            end=args.end,
+        )
+    for warning in caught:
+        print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
+    print(result.to_text())
+    if save is not None:
+        print(f"open it with: rerun {save}")
+    if args.serve_web:
+        result.serve_forever()
+    return 0
+
+
+def _cmd_graph(args: argparse.Namespace) -> int:
+    from rsstp_replay.viewer import render_graph
+
+    out = Path(args.output)
+    _check_output(out, force=args.force)
+    with _open(args.file) as recording:
+        written = render_graph(recording, args.step, out)
+    print(f"wrote {written} (the model at step {args.step})")
+    return 0
+
+
 def _integer(text: str) -> int:
     try:
         return int(text)
@@ -229,6 +277,25 @@ def _build_parser() -> _Parser:
         help="exit with 1 when such a finding exists (repeatable)",
     )
     p.set_defaults(func=_cmd_audit)
+
+    p = sub.add_parser("view", help="stream a recording to the Rerun viewer or an .rrd file")
+    p.add_argument("file", help="the .mcap recording")
+    p.add_argument(
+        "--save", metavar="OUT.rrd", help="write an .rrd file (open it with: rerun OUT.rrd)"
+    )
+    p.add_argument("--spawn", action="store_true", help="open the native viewer")
+    p.add_argument("--serve-web", action="store_true", help="serve the web viewer on localhost")
+    p.add_argument("--from", dest="start", type=_integer, metavar="STEP", help="first step")
+    p.add_argument("--to", dest="end", type=_integer, metavar="STEP", help="last step (inclusive)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing .rrd file")
+    p.set_defaults(func=_cmd_view)
+
+    p = sub.add_parser("graph", help="draw the model at a step (same node positions as the viewer)")
+    p.add_argument("file", help="the .mcap recording")
+    p.add_argument("--step", type=_integer, required=True, help="the step")
+    p.add_argument("-o", "--output", required=True, help="output: .svg, .png, .pdf or .dot")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.set_defaults(func=_cmd_graph)
 
     p = sub.add_parser("compare", help="the thesis's compare of the sub-memories at N and M")
     p.add_argument("file", help="the .mcap recording")
