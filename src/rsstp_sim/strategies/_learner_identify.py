@@ -119,8 +119,8 @@ class Identifier(Walker):
                         # transition by ``undo`` leads elsewhere is not it.
                         column = h.column[undo] if undo is not None else 0
                         untried = [c for c in untried if h.next[c, column] < 0]
-                        if len(untried) > self.doubts or tried - set(ranked):
-                            self.count("tentative")
+                        if not untried or len(untried) > self.doubts or tried - set(ranked):
+                            self.count("taken_as_new")
                             self.new(q, a, label, access, here=False)
                             return
                     if not untried:  # nothing can tell these candidates apart yet

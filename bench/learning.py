@@ -1,0 +1,376 @@
+"""Learning the minimal model from one trajectory: the ``learner`` strategy against AALpy.
+
+    PYTHONPATH=src python bench/learning.py                 # everything, a few minutes
+    PYTHONPATH=src python bench/learning.py --aalpy-seconds 30
+    PYTHONPATH=src python bench/learning.py --no-aalpy
+
+For each built-in scenario: the ground truth's minimal model (N states); the ``learner``
+strategy run until it is done (or its step budget is spent), its steps, seconds and whether its
+final model is equivalent to the truth (:func:`rsstp_sim.truth.check_equivalence` from the state
+the run started in, and N states); then AALpy 2.x on the same world:
+
+- ``run_hW`` (hW-inference, reset-free), the world wrapped as an AALpy SUL whose ``step``
+  moves the arm and returns the sensation and whose reset refuses (there is none): run in a
+  subprocess, stopped after ``--aalpy-seconds`` (default 240);
+- the passive learners RPNI and EDSM on one trajectory (the prefixes of a random walk of the
+  learner's step budget), on the small cycles only.
+
+An AALpy model is judged equivalent when one of its states is equivalent to the start pose's
+class: run_hW is not asked for its initial state (that would need a reset).
+
+Targets: equivalent on every scenario; at most 4 x N^2 steps on the one-joint cycles and 50,000
+on two-joint-30; each learner run under a minute.
+
+AALpy is the ``bench`` extra (``pip install aalpy``); without it the AALpy columns say so.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import subprocess
+import sys
+import time
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rsstp_sim.coupling import Runner
+from rsstp_sim.scenario import Scenario, load_scenario
+from rsstp_sim.strategies.learner import LearnerStrategy
+from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
+from rsstp_sim.world import World
+
+SCENARIOS = ("thesis-roulette", "one-joint-10", "thesis-algo", "two-joint-30")
+TWO_JOINT_BUDGET = 50_000
+PASSIVE_LIMIT = 40
+"""Passive learners run on scenarios with at most this many states (the data grows as T^2)."""
+
+
+def budget_for(name: str, truth: GroundTruth) -> int:
+    return TWO_JOINT_BUDGET if truth.n_joints > 1 else 4 * truth.n_classes**2
+
+
+# ------------------------------------------------------------------ judging
+
+
+def equivalent_states(
+    successors: Sequence[Sequence[int]], labels: Sequence[bool], truth: GroundTruth
+) -> list[int]:
+    """The states of a complete Moore machine equivalent to the truth's start class.
+
+    ``successors[s][k]`` is the state ``s`` reaches by ``truth.actions[k]``. The machine and
+    the truth's minimal machine are refined together (Moore's partition refinement over their
+    disjoint union); a state is equivalent to the start class when they end in one block.
+    """
+    n = len(successors)
+    nxt = np.concatenate(
+        [np.asarray(successors, dtype=np.int64).reshape(n, -1), truth.class_next + n]
+    )
+    out = np.concatenate([np.asarray(labels, dtype=bool), truth.class_sensation])
+    block = out.astype(np.int64)
+    count = len(np.unique(block))
+    while True:
+        signature = np.concatenate([block[:, None], block[nxt]], axis=1)
+        block = np.unique(signature, axis=0, return_inverse=True)[1].ravel()
+        refined = int(block.max()) + 1
+        if refined == count:
+            break
+        count = refined
+    return [s for s in range(n) if block[s] == block[n]]
+
+
+@dataclass
+class Row:
+    scenario: str
+    n: int
+    budget: int
+    steps: int
+    seconds: float
+    states: int
+    equivalent: bool
+    done: bool
+    hw: dict[str, Any] | None = None
+    passive: dict[str, str] | None = None
+
+
+# ------------------------------------------------------------------ the learner
+
+
+def run_learner(scenario: Scenario, truth: GroundTruth, budget: int, seed: int) -> Row:
+    learner = LearnerStrategy()
+    runner = Runner(scenario, learner, seed=seed)
+    step = runner.step
+    started = time.perf_counter()
+    steps = 0
+    while not learner.done and steps < budget:
+        step()
+        steps += 1
+    seconds = time.perf_counter() - started
+    model = runner.model
+    start = learner.start_state
+    equivalent = (
+        start is not None
+        and len(model) == truth.n_classes
+        and check_equivalence(model, learner.labels(), truth, start_state=start) is None
+    )
+    return Row(
+        scenario.name, truth.n_classes, budget, steps, seconds, len(model), equivalent, learner.done
+    )
+
+
+# ------------------------------------------------------------------ AALpy
+
+
+def _aalpy_version() -> str | None:
+    try:
+        from importlib.metadata import version
+
+        return version("aalpy")
+    except Exception:
+        return None
+
+
+class _OutOfTime(Exception):
+    pass
+
+
+def _world_sul(scenario: Scenario, deadline: float) -> Any:
+    """The arm as an AALpy SUL: ``step(action)`` moves it, ``step(None)`` reads the sensation."""
+    from aalpy.base import SUL  # type: ignore[import-untyped,import-not-found,unused-ignore]
+
+    class WorldSUL(SUL):  # type: ignore[misc]
+        def __init__(self) -> None:
+            super().__init__()
+            self.world = World(scenario)
+            self.world.reset()
+            self.moves = 0
+            self.started = False
+
+        def pre(self) -> None:
+            if self.started:
+                raise RuntimeError("the arm cannot be reset: a reset-free learner must not ask")
+            self.started = True
+
+        def post(self) -> None:
+            return None
+
+        def step(self, letter: Any) -> bool:
+            if letter is not None:
+                self.world.move(letter)
+                self.moves += 1
+                if self.moves % 65_536 == 0:
+                    print(json.dumps({"progress": self.moves}), file=sys.stderr, flush=True)
+                    if time.perf_counter() > deadline:
+                        raise _OutOfTime
+            return self.world.sensation
+
+    return WorldSUL()
+
+
+def _hw_child(name: str, seconds: float, seed: int, memory_gib: float) -> None:
+    """Run hW-inference on one scenario and print one JSON line (the subprocess's job)."""
+    from aalpy import RandomWphWOracle, run_hW  # type: ignore[import-untyped,import-not-found,unused-ignore]
+
+    try:  # hW keeps the whole trace: 5 GiB after 80 million steps
+        import resource
+
+        limit = int(memory_gib * 2**30)
+        resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    except (ImportError, ValueError, OSError):
+        pass
+    random.seed(seed)
+    scenario = load_scenario(name)
+    truth = compute_truth(scenario)
+    started = time.perf_counter()
+    sul = _world_sul(scenario, started + seconds)
+    result: dict[str, Any]
+    try:
+        model = run_hW(
+            list(scenario.actions),
+            sul,
+            RandomWphWOracle(),
+            "moore",
+            query_for_initial_state=False,
+            print_level=0,
+        )
+    except _OutOfTime:
+        result = {"result": f"no model within {seconds:g} s"}
+    except MemoryError:
+        result = {"result": f"no model: out of its {memory_gib:g} GiB of memory"}
+    except Exception as exc:  # report what happened, whatever it is
+        result = {"result": f"error: {type(exc).__name__}: {exc}"}
+    else:
+        states = list(model.states)
+        index = {id(s): i for i, s in enumerate(states)}
+        try:
+            successors = [[index[id(s.transitions[a])] for a in scenario.actions] for s in states]
+        except KeyError:
+            result = {"result": "incomplete model", "states": len(states)}
+        else:
+            labels = [bool(s.output) for s in states]
+            same = equivalent_states(successors, labels, truth)
+            verdict = "equivalent" if same and len(states) == truth.n_classes else "NOT equivalent"
+            result = {"result": verdict, "states": len(states)}
+    result["steps"] = sul.moves
+    result["seconds"] = round(time.perf_counter() - started, 2)
+    print(json.dumps(result), flush=True)
+
+
+def run_hw(name: str, seconds: float, seed: int, memory_gib: float) -> dict[str, Any]:
+    """hW-inference in a subprocess, stopped after ``seconds`` (and killed a minute later)."""
+    command = [
+        sys.executable,
+        __file__,
+        "--hw-child",
+        name,
+        "--aalpy-seconds",
+        str(seconds),
+        "--aalpy-memory-gib",
+        str(memory_gib),
+        "--seed",
+        str(seed),
+    ]
+    started = time.perf_counter()
+    try:
+        done = subprocess.run(command, capture_output=True, text=True, timeout=seconds + 60)
+    except subprocess.TimeoutExpired as exc:
+        progress = [
+            json.loads(line)["progress"]
+            for line in (exc.stderr or b"").decode().splitlines()
+            if line.startswith('{"progress"')
+        ]
+        return {
+            "result": f"killed after {seconds + 60:g} s",
+            "steps": progress[-1] if progress else None,
+            "seconds": round(time.perf_counter() - started, 2),
+        }
+    lines = [line for line in done.stdout.splitlines() if line.startswith("{")]
+    if not lines:
+        tail = (done.stderr.strip().splitlines() or ["no output"])[-1]
+        return {"result": f"error: {tail}", "steps": None, "seconds": None}
+    report: dict[str, Any] = json.loads(lines[-1])
+    return report
+
+
+def run_passive(scenario: Scenario, truth: GroundTruth, steps: int, seed: int) -> dict[str, str]:
+    """RPNI and EDSM on the prefixes of one random walk of ``steps`` steps."""
+    from aalpy.learning_algs import (  # type: ignore[import-untyped,import-not-found,unused-ignore]
+        run_EDSM,
+        run_RPNI,
+    )
+
+    world = World(scenario)
+    rng = np.random.default_rng(seed)
+    inputs = [int(a) for a in rng.choice(scenario.actions, size=steps)]
+    outputs = [world.reset().sensation]
+    for a in inputs:
+        world.move(a)
+        outputs.append(world.sensation)
+    data = [(tuple(inputs[:t]), outputs[t]) for t in range(steps + 1)]
+    verdicts: dict[str, str] = {}
+    for label, learn in (("RPNI", run_RPNI), ("EDSM", run_EDSM)):
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # "not input-complete": completed below
+                model = learn(data, "moore", print_info=False)
+        except Exception as exc:
+            verdicts[label] = f"error: {type(exc).__name__}"
+            continue
+        if model is None:
+            verdicts[label] = "no model"
+            continue
+        model.make_input_complete("self_loop")
+        states = list(model.states)
+        index = {id(s): i for i, s in enumerate(states)}
+        successors = [[index[id(s.transitions[a])] for a in scenario.actions] for s in states]
+        labels = [bool(s.output) for s in states]
+        same = equivalent_states(successors, labels, truth)
+        right = index[id(model.initial_state)] in same and len(states) == truth.n_classes
+        verdicts[label] = f"{len(states)} states, {'equivalent' if right else 'NOT equivalent'}"
+    return verdicts
+
+
+# ------------------------------------------------------------------ report
+
+
+def _format(rows: list[Row]) -> str:
+    head = (
+        f"{'scenario':16s} {'N':>4s} | {'learner steps':>13s} {'x N^2':>6s} {'budget':>8s} "
+        f"{'s':>6s} {'equiv':>5s} | {'AALpy hW steps':>14s} {'x N^2':>6s} {'s':>7s}  result"
+    )
+    lines = [head, "-" * len(head)]
+    for r in rows:
+        ok = "yes" if r.equivalent else "NO"
+        within = "" if r.steps <= r.budget and r.done else " (budget spent)"
+        if r.hw is None:
+            hw = f"{'-':>14s} {'-':>6s} {'-':>7s}  not run"
+        else:
+            steps = r.hw.get("steps")
+            secs = r.hw.get("seconds")
+            hw = (
+                f"{'-' if steps is None else format(steps, ','):>14} "
+                f"{'-' if steps is None else format(steps / r.n**2, '.1f'):>6} "
+                f"{'-' if secs is None else format(secs, '.1f'):>7}  {r.hw['result']}"
+                + (f" ({r.hw['states']} states)" if "states" in r.hw else "")
+            )
+        lines.append(
+            f"{r.scenario:16s} {r.n:>4d} | {r.steps:>13,} {r.steps / r.n**2:>6.1f} "
+            f"{r.budget:>8,} {r.seconds:>6.2f} {ok:>5s} | {hw}{within}"
+        )
+    passive = [r for r in rows if r.passive]
+    if passive:
+        lines.append("")
+        lines.append("AALpy passive learners on one random walk of the learner's budget:")
+        for r in passive:
+            assert r.passive is not None
+            found = ", ".join(f"{k}: {v}" for k, v in r.passive.items())
+            lines.append(f"  {r.scenario:16s} {r.budget:>8,} steps  {found}")
+    return "\n".join(lines)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--aalpy-seconds", type=float, default=240.0)
+    parser.add_argument("--aalpy-memory-gib", type=float, default=8.0)
+    parser.add_argument("--no-aalpy", action="store_true")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
+    parser.add_argument("scenarios", nargs="*", default=list(SCENARIOS))
+    args = parser.parse_args(argv)
+    if args.hw_child:
+        _hw_child(args.hw_child, args.aalpy_seconds, args.seed, args.aalpy_memory_gib)
+        return 0
+
+    aalpy = None if args.no_aalpy else _aalpy_version()
+    if not args.no_aalpy and aalpy is None:
+        print("AALpy is not installed (pip install aalpy, the bench extra): its columns are empty")
+    elif aalpy is not None:
+        print(
+            f"AALpy {aalpy}; run_hW with RandomWphWOracle(), capped at {args.aalpy_seconds:g} s "
+            f"and {args.aalpy_memory_gib:g} GiB"
+        )
+    rows: list[Row] = []
+    for name in args.scenarios:
+        scenario = load_scenario(name)
+        truth = compute_truth(scenario)
+        budget = budget_for(name, truth)
+        row = run_learner(scenario, truth, budget, args.seed)
+        if aalpy is not None:
+            row.hw = run_hw(name, args.aalpy_seconds, args.seed, args.aalpy_memory_gib)
+            if truth.n_classes <= PASSIVE_LIMIT:
+                row.passive = run_passive(scenario, truth, budget, args.seed)
+        rows.append(row)
+        print(f"  {name}: learner {row.steps:,} steps, {row.seconds:.2f} s", flush=True)
+    print()
+    print(_format(rows))
+    good = all(r.equivalent and r.steps <= r.budget and r.seconds < 60 for r in rows)
+    return 0 if good else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
