@@ -155,7 +155,10 @@ class Identifier(Walker):
                 ranked = sorted(survivors) + ranked
                 continue
             if at_landmark and survivors:
-                ordered = sorted(survivors)
+                # The predicted first: if nothing confirmed tells two apart, the likelier.
+                ordered = sorted(
+                    survivors, key=lambda c: (ranked.index(c) if c in ranked else len(ranked), c)
+                )
                 word = None if len(ordered) == 1 else h.separating_word(ordered[0], ordered[1])
                 if word is None:
                     self.confirm(q, a, ordered[0])
