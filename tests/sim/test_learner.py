@@ -71,6 +71,18 @@ def test_learns_two_joint_30_within_50000_steps() -> None:
     assert_minimal_and_equivalent(learner, runner.model, truth)
 
 
+def test_learns_a_three_joint_arm_with_blocked_moves() -> None:
+    scenario = parse_scenario(
+        'name = "three-joint-60"\n[arm]\nlengths = [2.0, 1.0, 0.5]\ninitial_deg = [0, 0, 0]\n'
+        "step_deg = 60\n[[obstacles]]\ncenter = [0.0, 2.5]\nradius = 0.5\n"
+    )
+    truth = compute_truth(scenario)
+    assert truth.n_classes == 140
+    learner, runner = learn(scenario, 4 * truth.n_classes**2)
+    assert learner.done
+    assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
 @settings(max_examples=40, deadline=None)
 @given(
     step=st.sampled_from([30, 45, 60, 90, 120]),

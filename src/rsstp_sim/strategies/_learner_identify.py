@@ -161,6 +161,11 @@ class Identifier(Walker):
                 )
                 word = None if len(ordered) == 1 else h.separating_word(ordered[0], ordered[1])
                 if word is None:
+                    blocked = q in candidates and q not in survivors and q not in tried
+                    if blocked and h.distance[q] < FAR:
+                        # The move may have been blocked: follow q itself through too.
+                        ranked = [q, *ordered, *ranked]
+                        continue
                     self.confirm(q, a, ordered[0])
                     return
                 separate = word
