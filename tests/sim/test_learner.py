@@ -12,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rsstp_sim.coupling import Runner
+from rsstp_sim.errors import StrategyError
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 from rsstp_sim.strategies import AgentView
@@ -197,6 +198,10 @@ def test_notes_are_few() -> None:
 def test_params() -> None:
     assert LearnerStrategy.name == "learner"
     assert LearnerStrategy(doubts=2).params() == {"doubts": 2}
+    with pytest.raises(StrategyError, match="doubts must be an integer >= 0, got -1"):
+        LearnerStrategy(doubts=-1)
+    with pytest.raises(StrategyError, match="reset"):
+        LearnerStrategy().labels()
 
 
 # ------------------------------------------------------------------ no ground truth

@@ -27,9 +27,14 @@ class LearnerStrategy(StrategyBase):
     Each transition is *confirmed* (taken and identified) or a *conjecture* (copied by the
     split that created its state). Located at an internal state, the agent walks confirmed
     transitions to the nearest unconfirmed pair, takes it, and identifies the world state it
-    reached by ruling candidates out along paths to the landmark; none left: a new state
-    (``split``). A wrong prediction on a confirmed path is a counterexample: the landmark
-    serves as the reset of Rivest and Schapire's analysis, which finds the wrong transition.
+    reached by ruling candidates out along paths to the landmark: first the paths of the
+    candidates the confirmed transitions predict, then *the way back* (the action that undoes
+    the one taken, then the known path to the landmark: it reaches the landmark if the state
+    is new), then the paths of the candidates left. None left: a new state (``split``); one
+    left: that state. Which action undoes which, and which actions commute, are learned from
+    the confirmed transitions and only order the tests. A wrong prediction on a confirmed path
+    is a counterexample: the landmark serves as the reset of Rivest and Schapire's analysis,
+    which finds the wrong transition.
     When every transition is confirmed the hypothesis is minimised (``merge``), the tests kept
     for each transition are replayed against it and the doubtful ones taken again; then
     :attr:`done` is set, and the agent walks its model at random, every prediction checked (a
