@@ -7,6 +7,7 @@ from typing import Any
 
 from rsstp_sim.errors import StrategyError
 from rsstp_sim.strategies._base import AgentView, Strategy, StrategyBase
+from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.strategies.random_walk import RandomStrategy
 from rsstp_sim.strategies.roulette import RouletteStrategy
 from rsstp_sim.strategies.script import ScriptStrategy
@@ -14,6 +15,7 @@ from rsstp_sim.strategies.splitter import SplitterStrategy
 
 __all__ = [
     "AgentView",
+    "LearnerStrategy",
     "RandomStrategy",
     "RouletteStrategy",
     "ScriptStrategy",
@@ -25,6 +27,7 @@ __all__ = [
 ]
 
 _BUILTIN: dict[str, Callable[..., Strategy]] = {
+    "learner": LearnerStrategy,
     "random": RandomStrategy,
     "roulette": RouletteStrategy,
     "script": ScriptStrategy,
