@@ -14,28 +14,18 @@ import json
 import os
 import sys
 import warnings
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
-from typing import NoReturn
 
-from rsstp_replay.errors import ReplayError, StepOutOfRange, UnfinishedRecordingWarning
+from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
-from rsstp_sim.errors import RsstpError
+from rsstp_sim.commandline import Parser, UsageError, run_command
 
 __all__ = ["main"]
 
 PROG = "rsstp-replay"
 _TABLE_FORMATS = (".parquet", ".csv")
 _FAIL_ON = ("contradiction", "nondeterministic", "aliasing", "redundancy", "not-equivalent")
-
-
-class UsageError(ReplayError):
-    """A command-line argument is invalid."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> NoReturn:
-        raise UsageError(message)
 
 
 def _open(path: str) -> Recording:
@@ -247,9 +237,9 @@ def _integer(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
 
 
-def _build_parser() -> _Parser:
-    parser = _Parser(prog=PROG, description="Read, export and audit RSSTP recordings (MCAP).")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+def _build_parser() -> Parser:
+    parser = Parser(prog=PROG, description="Read, export and audit RSSTP recordings (MCAP).")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("info", help="what a recording holds: scenario, strategy, steps, topics")
     p.add_argument("file", help="the .mcap recording")
@@ -308,22 +298,7 @@ def _build_parser() -> _Parser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code (0 ok, 1 an audit failed, 2 bad input)."""
-    parser = _build_parser()
-    try:
-        args = parser.parse_args(argv)
-        func: Callable[[argparse.Namespace], int] = args.func
-        return func(args)
-    except RsstpError as exc:
-        print(f"{PROG}: error: {exc}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:
-        # The reader went away (e.g. `| head`): stop quietly, as other Unix tools do.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        return 141
-    except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=sys.stderr)
-        return 130
+    return run_command(PROG, _build_parser(), argv)
 
 
 if __name__ == "__main__":

@@ -8,17 +8,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import signal
 import sys
 import time
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import Any
 
 from rsstp_sim import graph
+from rsstp_sim.commandline import Parser, UsageError, run_command
 from rsstp_sim.coupling import Runner
-from rsstp_sim.errors import RsstpError
 from rsstp_sim.scenario import builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
@@ -26,15 +25,6 @@ from rsstp_sim.transition_system import TransitionSystem
 __all__ = ["main"]
 
 PROG = "rsstp-sim"
-
-
-class UsageError(RsstpError):
-    """A command-line argument is invalid."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> NoReturn:
-        raise UsageError(message)
 
 
 def _parse_params(items: Sequence[str]) -> dict[str, Any]:
@@ -208,9 +198,9 @@ def _progress_printer(total: int) -> Callable[[int], None]:
     return show
 
 
-def _build_parser() -> _Parser:
-    parser = _Parser(prog=PROG, description="RSSTP simulator: scenarios, strategies, models.")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+def _build_parser() -> Parser:
+    parser = Parser(prog=PROG, description="RSSTP simulator: scenarios, strategies, models.")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("scenarios", help="list the built-in scenarios")
     p.set_defaults(func=_cmd_scenarios)
@@ -258,22 +248,7 @@ def _build_parser() -> _Parser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code (0 ok, 2 bad input, 130 interrupted)."""
-    parser = _build_parser()
-    try:
-        args = parser.parse_args(argv)
-        func: Callable[[argparse.Namespace], int] = args.func
-        return func(args)
-    except RsstpError as exc:
-        print(f"{PROG}: error: {exc}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:
-        # The reader went away (e.g. `| head`): stop quietly, as other Unix tools do.
-        devnull = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(devnull, sys.stdout.fileno())
-        return 141
-    except KeyboardInterrupt:
-        print(f"{PROG}: interrupted", file=sys.stderr)
-        return 130
+    return run_command(PROG, _build_parser(), argv)
 
 
 if __name__ == "__main__":
