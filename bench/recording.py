@@ -61,24 +61,17 @@ from typing import Any
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
-from rsstp_sim import RandomStrategy, Runner, builtin_scenarios, load_scenario, parse_scenario
+from rsstp_sim import RandomStrategy, Runner, builtin_scenarios, load_scenario
 from rsstp_sim.recording.recorder import DEFAULT_CHUNK_SIZE, Recorder
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.scenario import Scenario
+from step_rate import float_mode  # bench/ is the script folder
 
 SEED = 1
 TARGET_RECORDED = 50_000
 TARGET_OVERHEAD = 0.50
 TARGET_BYTES = 120
 MESSAGE_RECORD_OVERHEAD = 1 + 8 + 2 + 4 + 8 + 8  # opcode, length, channel, sequence, 2 times
-
-
-def float_mode(name: str) -> Scenario:
-    base = load_scenario(name)
-    text = base.source.replace("[feedback]\n", '[feedback]\nmode = "float"\n', 1)
-    if "[feedback]" not in base.source:
-        text += '\n[feedback]\nmode = "float"\n'
-    return parse_scenario(text, origin=f"{name} (float feedback)")
 
 
 def walk_actions(scenario: Scenario, steps: int) -> list[int]:
