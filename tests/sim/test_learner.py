@@ -55,7 +55,7 @@ def one_joint(step: int, initial: int, target: int, actions: list[int]) -> Scena
 # ------------------------------------------------------------------ targets
 
 
-@pytest.mark.parametrize("name", ["thesis-roulette", "one-joint-10"])
+@pytest.mark.parametrize("name", ["thesis-roulette", "one-joint-10", "thesis-algo"])
 def test_learns_the_one_joint_cycles_within_four_n_squared_steps(name: str) -> None:
     scenario = load_scenario(name)
     truth = compute_truth(scenario)
