@@ -170,8 +170,8 @@ class World:
         self.last_blocker = None
         return self._pose
 
-    def move(self, action: int) -> Blocker | None:
-        """Execute an action; return None when the arm moved, else why it was blocked."""
+    def _outcome(self, action: int) -> tuple[int, Blocker | None]:
+        """(pose code reached, blocker) for ``action`` from the current pose; cached."""
         moves = self._moves.get(self._code)
         if moves is None:
             self._prefetch(self._code)
@@ -179,11 +179,15 @@ class World:
         try:
             if action.__class__ is bool:  # True would pass for action 1
                 raise KeyError(action)
-            code, blocker = moves[action]
+            return moves[action]
         except KeyError:
             raise ActionError(
                 f"action {action!r} is not one of the scenario's actions {list(moves)}"
             ) from None
+
+    def move(self, action: int) -> Blocker | None:
+        """Execute an action; return None when the arm moved, else why it was blocked."""
+        code, blocker = self._outcome(action)
         if code != self._code:
             self._code = code
             pose = self._poses.get(code)
@@ -193,15 +197,7 @@ class World:
 
     def peek(self, action: int) -> tuple[Pose, Blocker | None]:
         """Where an action would lead from the current pose, without moving."""
-        moves = self._moves.get(self._code)
-        if moves is None:
-            self._prefetch(self._code)
-            moves = self._moves[self._code]
-        if action not in moves:
-            raise ActionError(
-                f"action {action!r} is not one of the scenario's actions {list(moves)}"
-            )
-        code, blocker = moves[action]
+        code, blocker = self._outcome(action)
         return self.pose(code), blocker
 
     @property

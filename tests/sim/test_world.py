@@ -443,3 +443,10 @@ def test_a_bool_is_not_an_action() -> None:
     with pytest.raises(ActionError, match="action True is not one of the scenario's actions"):
         world.move(True)
     assert world.angles_deg == (95,)
+
+
+def test_peek_refuses_what_move_refuses() -> None:
+    world = World(load_scenario("thesis-algo"))
+    for action in (True, 7):
+        with pytest.raises(ActionError, match="is not one of the scenario's actions"):
+            world.peek(action)
