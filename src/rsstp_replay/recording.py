@@ -271,8 +271,8 @@ class Recording:
         """The model at the end of step ``step``, after the strategy's refinement.
 
         Its structure is the last model message at or before ``step``; its current state is
-        the internal state the next step starts from (``state_before`` of step ``step + 1``),
-        or, at the last step, that of the model message of this step, else the step's own.
+        the step's internal state (which the contract makes the state of that version the
+        next step starts from: docs/contract.md).
         """
         step = self._check_step(step)
         models = self.model_versions()
@@ -286,12 +286,7 @@ class Recording:
                 f"last model message at or before it (step {record.step}) is version "
                 f"{record.version}"
             )
-        if step < self.n_steps:
-            current = self._agent_row(step + 1).state_before
-        elif record.step == step:
-            current = record.current
-        else:
-            current = here.internal_state
+        current = here.internal_state
         if current not in model:
             raise CorruptRecording(
                 f"{self.path}: step {step}: the internal state {current} is not a state of "

@@ -6,6 +6,13 @@ chosen by the run's seeded generator when there are several, and stays (with
 a ``no_transition`` event) when there is none; the memory gets the entry; the
 strategy may refine the model. The agent never sees whether the move was
 blocked: that is ground truth, kept for analysis.
+
+The internal state of a step is the model's current state at the *end* of the
+step, after the refinement: a strategy that re-localises (sets
+``model.current``, or merges the current state away) changes where the agent
+is, and the memory entry of the step says so. So the state of entry ``t`` is
+always a state of the model as it was at the end of step ``t``, and it is the
+state step ``t + 1`` starts from (docs/contract.md).
 """
 
 from __future__ import annotations
@@ -30,7 +37,12 @@ EventKind = Literal["no_transition", "note"]
 
 
 class StepOutcome(NamedTuple):
-    """What happened in one step (the ground truth ``blocker`` included)."""
+    """What happened in one step (the ground truth ``blocker`` included).
+
+    ``followed`` is the successor the transition led to; ``state_after`` is the internal
+    state at the end of the step, after the strategy's refinement (the two differ when the
+    strategy re-localised).
+    """
 
     step: int
     action: int
@@ -38,6 +50,7 @@ class StepOutcome(NamedTuple):
     state_after: int
     blocker: Blocker | None
     no_transition: bool
+    followed: int
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,6 +124,8 @@ class Runner:
         self.no_transition = 0
         self._step = 0
         self.strategy.reset(self.agent)
+        if self.model.current != self.memory.last_state:
+            self.memory.relocate_last(self.model.current)
         self._version = self.model.version
         self._flush_model()
 
@@ -165,9 +180,12 @@ class Runner:
                     )
                 )
         self.strategy.refine(self.agent)
+        now = model.current
+        if now != after:
+            self.memory.relocate_last(now)
         if model.version != self._version:
             self._flush_model()
-        return StepOutcome(self._step, action, before, after, blocker, empty)
+        return StepOutcome(self._step, action, before, now, blocker, empty, after)
 
     def run(self, steps: int) -> RunSummary:
         """Take ``steps`` more steps and summarise the run so far."""

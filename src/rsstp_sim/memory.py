@@ -82,7 +82,8 @@ class Memory:
 
     - :attr:`actions` (int32): the action that led to the entry, ``0 .. 2n-1`` for an arm of
       ``n`` links; :data:`NO_ACTION` (-1) at entry 0.
-    - :attr:`internal_states` (int64): the internal state id after the step.
+    - :attr:`internal_states` (int64): the internal state id at the end of the step (after the
+      strategy's refinement, see :mod:`rsstp_sim.coupling`).
     - :attr:`sensations` (bool): the boolean sensation after the step.
     - :attr:`feedback` (float64): the float feedback (closeness in ``[0, 1]``) after the step.
 
@@ -141,6 +142,20 @@ class Memory:
         self._sensations[t] = sensation
         self._feedback[t] = feedback
         self._length = t + 1
+
+    def relocate_last(self, internal_state: int) -> None:
+        """Set the internal state of the last entry: the agent re-localised in the step's
+        refinement, so the step ended in ``internal_state`` (see :mod:`rsstp_sim.coupling`)."""
+        if self._length == 0:
+            raise MemoryRangeError("relocate_last on an empty memory: there is no entry yet")
+        self._states[self._length - 1] = internal_state
+
+    @property
+    def last_state(self) -> int:
+        """The internal state of the last entry."""
+        if self._length == 0:
+            raise MemoryRangeError("last_state of an empty memory: there is no entry yet")
+        return int(self._states[self._length - 1])
 
     def _make_room(self) -> None:
         if self._length == 0:

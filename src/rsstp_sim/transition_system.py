@@ -227,6 +227,11 @@ class TransitionSystem:
         """Every (state, action) has at most one successor (O(1), kept incrementally)."""
         return self._n_nondeterministic == 0
 
+    @property
+    def nondeterministic_pairs(self) -> int:
+        """How many (state, action) pairs have several successors (O(1), kept incrementally)."""
+        return self._n_nondeterministic
+
     def determinism_report(self) -> DeterminismReport:
         """The pairs with several successors and the pairs with none (thesis 4.3)."""
         nondeterministic: list[tuple[int, int, tuple[int, ...]]] = []

@@ -1,0 +1,162 @@
+"""The contract between the step records and the model messages (docs/contract.md).
+
+A recording holds the agent's internal state twice: in every step record and, implicitly, as
+the current state of the model. The contract ties them together, step by step:
+
+- ``model-version``: a step names the model version in force at its end (the last model
+  message at or before it);
+- ``state-in-model``: its internal state is a state of that version;
+- ``state-chain``: a step starts where the step before it ended (``state_before`` of step
+  ``t`` is the internal state of step ``t - 1``);
+- ``versions-in-order``: model versions grow from one message to the next.
+
+So ``Recording.model_at(t).current`` is the internal state of step ``t`` at every step, and an
+audit can read a state id as what its version says. :func:`check_contract` checks every step
+with numpy (no per-step Python), and reports each broken rule once, at its first step.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+import numpy as np
+import numpy.typing as npt
+import pandas as pd
+
+from rsstp_sim.recording.records import ModelRecord
+
+__all__ = ["ContractFindings", "ContractSource", "Violation", "check_contract", "version_index"]
+
+_Ints = npt.NDArray[np.int64]
+
+
+class ContractSource(Protocol):
+    """What the contract check reads of a recording."""
+
+    def steps(self) -> pd.DataFrame: ...
+    def model_versions(self) -> Sequence[ModelRecord]: ...
+
+
+@dataclass(frozen=True, slots=True)
+class Violation:
+    """A broken rule: its name, the first step that breaks it, how many steps do, and why."""
+
+    rule: str
+    step: int
+    count: int
+    text: str
+
+
+@dataclass(frozen=True, slots=True)
+class ContractFindings:
+    """The contract check of a recording of ``steps`` steps."""
+
+    steps: int
+    violations: tuple[Violation, ...]
+
+    @property
+    def holds(self) -> bool:
+        return not self.violations
+
+    def to_text(self) -> str:
+        if self.holds:
+            return f"contract: holds at every one of the {self.steps + 1:,} steps"
+        lines = [f"contract: {len(self.violations)} rule(s) broken"]
+        lines += [
+            f"  {v.rule}: from step {v.step} ({v.count:,} step(s)): {v.text}"
+            for v in self.violations
+        ]
+        return "\n".join(lines)
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "holds": self.holds,
+            "violations": [
+                {"rule": v.rule, "step": v.step, "count": v.count, "text": v.text}
+                for v in self.violations
+            ],
+        }
+
+
+def version_index(versions: Sequence[ModelRecord], steps: _Ints) -> _Ints:
+    """For each step, the index in ``versions`` of the model message in force at its end (the
+    last at or before it; -1 before the first message)."""
+    message_steps = np.fromiter((record.step for record in versions), np.int64, len(versions))
+    return np.searchsorted(message_steps, steps, side="right").astype(np.int64) - 1
+
+
+def check_contract(source: ContractSource) -> ContractFindings:
+    """Check every step against the model messages (see the module docstring)."""
+    table = source.steps()
+    versions = list(source.model_versions())
+    step = table["step"].to_numpy(np.int64)
+    state = table["internal_state"].to_numpy(np.int64)
+    named = table["model_version"].to_numpy(np.int64)
+    before = table["state_before"].to_numpy(np.int64, na_value=-1)
+    found: list[Violation] = []
+
+    numbers = np.fromiter((record.version for record in versions), np.int64, len(versions))
+    backwards = np.flatnonzero(np.diff(numbers) <= 0)
+    if len(backwards):
+        at = int(backwards[0]) + 1
+        found.append(
+            Violation(
+                "versions-in-order",
+                versions[at].step,
+                len(backwards),
+                f"model version {numbers[at]} follows version {numbers[at - 1]}",
+            )
+        )
+
+    index = version_index(versions, step)
+    in_force = np.where(index >= 0, numbers[np.maximum(index, 0)], -1)
+    wrong = np.flatnonzero(named != in_force)
+    if len(wrong):
+        t = int(wrong[0])
+        found.append(
+            Violation(
+                "model-version",
+                int(step[t]),
+                len(wrong),
+                f"step {step[t]} names model version {named[t]}, but the version in force is "
+                f"{in_force[t]}",
+            )
+        )
+
+    sizes = np.fromiter((len(record.states) for record in versions), np.int64, len(versions))
+    members = np.fromiter(
+        (s for record in versions for s in record.states), np.int64, int(sizes.sum())
+    )
+    base = int(max(members.max(initial=0), state.max(initial=0))) + 1
+    keys = np.sort(np.repeat(np.arange(len(versions), dtype=np.int64), sizes) * base + members)
+    wanted = np.maximum(index, 0) * base + state
+    where = np.minimum(np.searchsorted(keys, wanted), max(len(keys) - 1, 0))
+    outside = np.flatnonzero((index < 0) | (state < 0) | (keys[where] != wanted))
+    if len(outside):
+        t = int(outside[0])
+        found.append(
+            Violation(
+                "state-in-model",
+                int(step[t]),
+                len(outside),
+                f"step {step[t]} is in internal state {state[t]}, which is not a state of model "
+                f"version {in_force[t]}",
+            )
+        )
+
+    broken = np.flatnonzero(before[1:] != state[:-1]) + 1
+    if len(broken):
+        t = int(broken[0])
+        found.append(
+            Violation(
+                "state-chain",
+                int(step[t]),
+                len(broken),
+                f"step {step[t]} starts in state {before[t]}, but step {step[t - 1]} ended in "
+                f"state {state[t - 1]}",
+            )
+        )
+    found.sort(key=lambda v: v.step)
+    return ContractFindings(int(step[-1]) if len(step) else 0, tuple(found))

@@ -1,0 +1,131 @@
+"""The step records agree with the model messages at every step, for every strategy.
+
+The property: for every step ``t`` of a recording, its internal state is the current state of
+``model_at(t)`` (the version in force at the end of the step) and a state of it, step ``t + 1``
+starts there, and the step names that version. Checked at every step (no sampling) over
+strategies (the built-ins, a random refiner that splits, merges, adds and deletes, and one that
+re-localises by setting ``model.current``), scenarios and seeds.
+"""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+from typing import ClassVar
+
+import numpy as np
+import pytest
+from fakes import RandomRefiner
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from rsstp_replay import open_recording
+from rsstp_replay.audits.contract import check_contract
+from rsstp_sim import AgentView, load_scenario, make_strategy
+from rsstp_sim.coupling import Runner
+from rsstp_sim.recording import record
+from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.strategies import Strategy
+
+REFERENCE = Path(__file__).resolve().parents[2] / "recordings"
+
+
+class Relocator(RandomRefiner):
+    """A random refiner that also re-localises: now and then it decides it is elsewhere."""
+
+    name: ClassVar[str] = "relocator"
+
+    def refine(self, agent: AgentView) -> None:
+        super().refine(agent)
+        if float(agent.rng.random()) < 0.2:
+            states = agent.model.states
+            agent.model.current = states[int(agent.rng.integers(len(states)))]
+
+
+def _strategy(name: str) -> Strategy:
+    if name == "refiner":
+        return RandomRefiner(split=0.1, max_states=8)
+    if name == "relocator":
+        return Relocator(split=0.1, max_states=8)
+    return make_strategy(name)
+
+
+STRATEGIES = ["random", "roulette", "splitter", "learner", "refiner", "relocator"]
+SCENARIOS = ["thesis-roulette", "one-joint-10", "two-joint-30", "thesis-obstacles"]
+
+
+@settings(
+    max_examples=24,
+    deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+@given(
+    strategy=st.sampled_from(STRATEGIES),
+    scenario=st.sampled_from(SCENARIOS),
+    seed=st.integers(0, 2**16),
+    steps=st.integers(1, 160),
+)
+def test_every_step_is_in_the_current_state_of_its_model_version(
+    strategy: str, scenario: str, seed: int, steps: int
+) -> None:
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "run.mcap"
+        record(path, load_scenario(scenario), _strategy(strategy), steps=steps, seed=seed)
+        with open_recording(path) as recording:
+            assert check_contract(recording).holds, check_contract(recording).to_text()
+            table = recording.steps()
+            states = table["internal_state"].to_numpy(np.int64)
+            versions = table["model_version"].to_numpy(np.int64)
+            before = table["state_before"].to_numpy(np.int64, na_value=-1)
+            for t in range(recording.n_steps + 1):
+                model = recording.model_at(t)
+                assert model.current == states[t], f"step {t}"
+                assert model.version == versions[t], f"step {t}"
+                if t:
+                    assert before[t] == states[t - 1], f"step {t}"
+
+
+def test_the_live_memory_ends_each_step_where_the_model_is() -> None:
+    """A re-localising strategy: the memory entry of a step is the model's current state at
+    the end of the step, not the successor the transition led to."""
+    runner = Runner(load_scenario("one-joint-10"), Relocator(split=0.2, max_states=8), seed=3)
+    relocated = 0
+    for _ in range(300):
+        outcome = runner.step()
+        assert runner.memory.last_state == runner.model.current == outcome.state_after
+        relocated += outcome.followed != outcome.state_after
+    assert relocated > 10
+
+
+@pytest.mark.parametrize("path", sorted(REFERENCE.glob("*.mcap")), ids=lambda p: p.name)
+def test_reference_recordings_keep_the_contract(path: Path) -> None:
+    with open_recording(path) as recording:
+        assert check_contract(recording).holds
+
+
+def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
+    """The check reads the columns, not the live run: feed it a step that starts elsewhere,
+    a step in a state its version lacks, and a step naming the wrong version."""
+    path = tmp_path / "run.mcap"
+    record(path, load_scenario("thesis-roulette"), make_strategy("roulette"), steps=40, seed=0)
+    with open_recording(path) as recording:
+        table, versions = recording.steps(), list(recording.model_versions())
+
+    class Edited:
+        def __init__(self, table: object) -> None:
+            self.table = table
+
+        def steps(self) -> object:
+            return self.table
+
+        def model_versions(self) -> list[ModelRecord]:
+            return versions
+
+    edited = table.copy()
+    edited.loc[20, "state_before"] = 999
+    edited.loc[30, "internal_state"] = 998
+    edited.loc[35, "model_version"] = 997
+    found = check_contract(Edited(edited))  # type: ignore[arg-type]
+    rules = {v.rule: v.step for v in found.violations}
+    assert rules == {"state-chain": 20, "state-in-model": 30, "model-version": 35}
+    assert "step 30 is in internal state 998" in found.to_text()
