@@ -224,10 +224,6 @@ class StepColumns:
                 f"{list(actions)}",
                 step=t,
             )
-        stayed = np.flatnonzero(self.no_transition & (self.internal_state != self.state_before))
-        if stayed.size and self.n_rows > 1:
-            t = int(stayed[0])
-            raise BadStep("agent.no_transition is true but the internal state changed", step=t)
         if self.truth:
             mismatch = np.flatnonzero(self.blocked != (self.blocker >= 0))
             if mismatch.size:

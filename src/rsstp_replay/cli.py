@@ -25,7 +25,15 @@ __all__ = ["main"]
 
 PROG = "rsstp-replay"
 _TABLE_FORMATS = (".parquet", ".csv")
-_FAIL_ON = ("contradiction", "nondeterministic", "aliasing", "redundancy", "not-equivalent")
+_FAIL_ON = (
+    "contradiction",
+    "nondeterministic",
+    "not-learned",
+    "aliasing",
+    "redundancy",
+    "not-equivalent",
+)
+_TRUTH_GATES = ("not-learned", "aliasing", "redundancy", "not-equivalent")
 
 
 def _open(path: str) -> Recording:
@@ -125,7 +133,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
     from rsstp_replay.audits import audit_truth, run_audits
 
     fail_on = set(args.fail_on or [])
-    needs_truth = fail_on & {"aliasing", "redundancy", "not-equivalent"}
+    needs_truth = fail_on & set(_TRUTH_GATES)
     if needs_truth and not args.truth:
         raise UsageError(f"--fail-on {sorted(needs_truth)[0]} needs --truth")
     with _open(args.file) as recording:
@@ -134,20 +142,28 @@ def _cmd_audit(args: argparse.Namespace) -> int:
     if args.json:
         document = report.to_json()
         if truth is not None:
-            document["truth"] = truth.to_json()
+            document = {"verdict": truth.verdict.to_json(), **document, "truth": truth.to_json()}
         print(json.dumps(document, indent=2))
     else:
+        if truth is not None:
+            print(f"{truth.verdict.to_text()}\n")
         text = report.to_text()
         print(text, end="" if text.endswith("\n") else "\n")
         if truth is not None:
             print("\n== truth ==")
-            print(truth.to_text(), end="")
+            print(truth.to_text(verdict=False), end="")
     findings = {
-        "contradiction": (report.has_contradiction, "the memory contradicts an internal state"),
+        "contradiction": (
+            report.has_contradiction,
+            "the memory contradicts a state of the final model version",
+        ),
         "nondeterministic": (report.has_nondeterminism, "the final model is nondeterministic"),
     }
     if truth is not None:
+        # Over the whole history, as the README's accumulated figures (the per-version ones
+        # are in the JSON and the verdict).
         findings |= {
+            "not-learned": (not truth.verdict.learned, truth.verdict.line()),
             "aliasing": (bool(truth.aliased), "an internal state stood for several true classes"),
             "redundancy": (bool(truth.redundant), "a true class was split over several states"),
             "not-equivalent": (
@@ -257,8 +273,8 @@ def _build_parser() -> Parser:
     p.add_argument(
         "--truth",
         action="store_true",
-        help="also compare the internal states with the ground truth (aliasing, redundancy, "
-        "equivalence of the final model)",
+        help="open with the verdict (learned, from which step, or why not) and compare every "
+        "model version with the ground truth (aliasing, redundancy, equivalence)",
     )
     p.add_argument(
         "--fail-on",

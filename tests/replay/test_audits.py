@@ -20,6 +20,7 @@ from rsstp_replay.audits import (
     AuditReport,
     CompareFindings,
     audit_consistency,
+    audit_consistency_by_version,
     audit_determinism,
     audit_summary,
     compare,
@@ -267,21 +268,34 @@ def test_report_text_and_json() -> None:
     text = report.to_text()
     for heading in ("== summary ==", "== consistency ==", "== determinism =="):
         assert heading in text
-    assert f"consistency: {count} contradictory states, first at step {first}\n" in text
-    for found in report.consistency.contradictions:
+    assert (
+        f"accumulated over the whole history (state ids across versions): {count:,} "
+        f"contradictory states, first at step {first}\n"
+    ) in text
+    for found in report.consistency.contradictions[:10]:
         assert f"  state {found.state}: contradictory from step {found.first_step};" in text
+    within = report.within_versions
+    assert within == audit_consistency_by_version(
+        fake.runner.memory, fake.steps()["model_version"].to_numpy()
+    )
+    assert f"within each model version: {len(within.contradictions):,} states contradicted" in text
     assert f"steps: {fake.n_steps}" in text
     assert "determinism: final model (version" in text
     data = report.to_json()
     assert json.loads(json.dumps(data)) == data
     assert set(data) == {
         "has_contradiction",
+        "ever_contradicted",
         "has_nondeterminism",
         "summary",
+        "consistency_within_versions",
         "consistency",
         "determinism",
     }
-    assert data["has_contradiction"] is report.has_contradiction is True
+    final = report.determinism.final.version
+    in_final = any(found.version == final for found in within.contradictions)
+    assert data["has_contradiction"] is report.has_contradiction is in_final
+    assert data["ever_contradicted"] is report.ever_contradicted is True
     assert report.has_nondeterminism == (not fake.runner.model.is_deterministic())
     assert report.summary == audit_summary(fake)
     assert report.determinism == audit_determinism(fake)
@@ -308,7 +322,8 @@ def test_report_of_a_consistent_run() -> None:
     model = TransitionSystem.universal([0])
     report = run_audits(StaticRecording(versions(model, []), memory))
     assert not report.has_contradiction
-    assert "consistency: no contradictory state in 10 steps" in report.to_text()
+    assert "within each model version: no contradictory state in 10 steps" in report.to_text()
+    assert "accumulated over the whole history: no contradictory state" in report.to_text()
     assert report.summary.first_contradiction_step is None
     assert report.summary.last_contradiction_step is None
     assert "contradictions: none" in report.summary.to_text()

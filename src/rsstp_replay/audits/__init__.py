@@ -7,8 +7,11 @@ Each audit returns a frozen findings object with ``to_text()`` and ``to_json()``
 - :func:`audit_determinism`: nondeterministic and empty pairs of every model version;
 - :func:`audit_summary`: the numbers of a run;
 - :func:`run_audits`: consistency, determinism and summary in one :class:`AuditReport`;
-- :func:`audit_truth`: the internal states against the ground truth (aliasing, redundancy,
-  equivalence of the final model).
+- :func:`audit_consistency_by_version`: the same, inside the model version in force at each
+  step (a state id means what its version says);
+- :func:`audit_truth`: the verdict (learned, from which step, or why not), and every model
+  version against the ground truth (aliasing, redundancy, contradictions, equivalence);
+- :func:`check_contract`: the step records against the model messages, at every step.
 
 The audits read a recording through :class:`AuditSource` (``memory()``, ``model_versions()``,
 ``steps()``), so anything with those methods can be audited.
@@ -20,8 +23,10 @@ from rsstp_replay.audits.consistency import (
     StateContradiction,
     Witness,
     audit_consistency,
+    audit_consistency_by_version,
     find_contradictions,
 )
+from rsstp_replay.audits.contract import ContractFindings, Violation, check_contract
 from rsstp_replay.audits.determinism import (
     DeterminismFindings,
     HasModelVersions,
@@ -31,12 +36,15 @@ from rsstp_replay.audits.determinism import (
 from rsstp_replay.audits.report import AuditReport, run_audits
 from rsstp_replay.audits.summary import AuditSource, ModelSize, SummaryFindings, audit_summary
 from rsstp_replay.audits.truth import TruthFindings, TruthSource, audit_truth, step_true_classes
+from rsstp_replay.audits.verdict import Counterexample, Verdict
 
 __all__ = [
     "AuditReport",
     "AuditSource",
     "CompareFindings",
     "ConsistencyFindings",
+    "ContractFindings",
+    "Counterexample",
     "DeterminismFindings",
     "HasMemory",
     "HasModelVersions",
@@ -45,12 +53,16 @@ __all__ = [
     "SummaryFindings",
     "TruthFindings",
     "TruthSource",
+    "Verdict",
     "VersionDeterminism",
+    "Violation",
     "Witness",
     "audit_consistency",
+    "audit_consistency_by_version",
     "audit_determinism",
     "audit_summary",
     "audit_truth",
+    "check_contract",
     "compare",
     "find_contradictions",
     "run_audits",

@@ -23,7 +23,7 @@ those two first times. The whole audit is ``O(T log T)`` numpy work.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -37,6 +37,7 @@ __all__ = [
     "StateContradiction",
     "Witness",
     "audit_consistency",
+    "audit_consistency_by_version",
     "find_contradictions",
 ]
 
@@ -66,12 +67,15 @@ class StateContradiction:
     ``first_step`` is the first step ``t`` such that the memory prefix ``0..t`` already contains
     a contradiction for this state (the minimum of ``j + k`` over all contradicting pairs).
     ``pairs`` counts the contradicting pairs ``(i, j)`` (each has exactly one ``k``).
+    ``version``: the model version both times were in, when judged within versions
+    (:func:`audit_consistency_by_version`); None over the whole history.
     """
 
     state: int
     witness: Witness
     first_step: int
     pairs: int
+    version: int | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -100,8 +104,9 @@ class ConsistencyFindings:
         lines = []
         for found in self.contradictions:
             witness = found.witness
+            version = "" if found.version is None else f" of version {found.version}"
             lines.append(
-                f"state {found.state}: contradictory from step {found.first_step}; "
+                f"state {found.state}{version}: contradictory from step {found.first_step}; "
                 f"shortest witness: steps {witness.i} and {witness.j} then actions "
                 f"{list(witness.actions)} (k={witness.k}); {found.pairs} contradicting "
                 f"pair{'' if found.pairs == 1 else 's'}"
@@ -117,6 +122,7 @@ class ConsistencyFindings:
             "contradictions": [
                 {
                     "state": found.state,
+                    **({} if found.version is None else {"version": found.version}),
                     "first_step": found.first_step,
                     "pairs": found.pairs,
                     "witness": {
@@ -134,6 +140,41 @@ class ConsistencyFindings:
 def audit_consistency(memory: Memory) -> ConsistencyFindings:
     """Find every internal state the memory contradicts (see the module docstring)."""
     return find_contradictions(memory.actions, memory.internal_states, memory.sensations)
+
+
+def audit_consistency_by_version(
+    memory: Memory, model_versions: npt.ArrayLike
+) -> ConsistencyFindings:
+    """Contradictions judged inside the model version in force at each step.
+
+    ``model_versions[t]`` is the version of entry ``t`` (a recording's ``model_version``
+    column). Two times contradict only when they are in the same internal state *of the same
+    version*: a state id means what its version says, and a state that a later version split
+    or merged is another state. (The continuations after the two times may run through any
+    versions: they are what the world did.) Each finding names its version.
+    """
+    versions = np.asarray(model_versions, dtype=np.int64)
+    states = memory.internal_states
+    if len(versions) != len(states):
+        raise MemoryRangeError(
+            f"model_versions has {len(versions)} entries, the memory {len(states)}"
+        )
+    version_ids, version_codes = np.unique(versions, return_inverse=True)
+    state_ids, state_codes = np.unique(states, return_inverse=True)
+    keys = version_codes.astype(np.int64) * max(len(state_ids), 1) + state_codes
+    found = find_contradictions(memory.actions, keys, memory.sensations)
+    width = max(len(state_ids), 1)
+    return ConsistencyFindings(
+        tuple(
+            replace(
+                item,
+                state=int(state_ids[item.state % width]),
+                version=int(version_ids[item.state // width]),
+            )
+            for item in found.contradictions
+        ),
+        found.steps,
+    )
 
 
 def find_contradictions(

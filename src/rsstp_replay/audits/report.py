@@ -6,12 +6,18 @@ order: what did the run do (summary); does the memory itself prove the learned l
 deterministic model with these internal states can be right); and did the strategy end with a
 model that knows where every action leads (determinism).
 
-``--fail-on contradiction`` fails when any state is contradictory
-(:attr:`AuditReport.has_contradiction`); ``--fail-on nondeterministic`` fails when the *final*
-model is nondeterministic (:attr:`AuditReport.has_nondeterminism`). Only the final model
-counts: a split makes a model nondeterministic until deletes resolve it, which is the normal
-course of the thesis algorithm and no defect; what was learned is the final model.
-:attr:`AuditReport.ever_nondeterministic` tells whether any version was.
+Contradictions are judged inside the model version in force at each step
+(:attr:`AuditReport.within_versions`): a state id means what its version says, and a learner
+that split a contradicted state has fixed it. The same audit over the whole history, state ids
+across versions (:attr:`AuditReport.consistency`), stays below it, labelled as such.
+
+``--fail-on contradiction`` fails when the memory contradicts a state of the *final* model
+version, over the steps it was in force (:attr:`AuditReport.has_contradiction`);
+``--fail-on nondeterministic`` fails when the *final* model is nondeterministic
+(:attr:`AuditReport.has_nondeterminism`). Only the final model counts: a split makes a model
+nondeterministic until deletes resolve it, which is the normal course of learning and no
+defect; what was learned is the final model. :attr:`AuditReport.ever_nondeterministic` and
+:attr:`AuditReport.ever_contradicted` tell whether any version was.
 """
 
 from __future__ import annotations
@@ -20,9 +26,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
-from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
+from rsstp_replay.audits.consistency import (
+    ConsistencyFindings,
+    audit_consistency,
+    audit_consistency_by_version,
+)
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.audits.summary import AuditSource, SummaryFindings, audit_summary
 from rsstp_sim.memory import Memory
@@ -38,11 +49,19 @@ class AuditReport:
     summary: SummaryFindings
     consistency: ConsistencyFindings
     determinism: DeterminismFindings
+    within_versions: ConsistencyFindings
 
     @property
     def has_contradiction(self) -> bool:
-        """The memory contradicts at least one internal state."""
-        return not self.consistency.consistent
+        """The memory contradicts a state of the final model version (earlier versions do not
+        count)."""
+        final = self.determinism.final.version
+        return any(found.version == final for found in self.within_versions.contradictions)
+
+    @property
+    def ever_contradicted(self) -> bool:
+        """The memory contradicted a state of some version, the final one or an earlier one."""
+        return not self.within_versions.consistent
 
     @property
     def has_nondeterminism(self) -> bool:
@@ -56,31 +75,56 @@ class AuditReport:
 
     def to_text(self) -> str:
         """Sections with headings, for a terminal."""
-        consistency = self.consistency
-        if consistency.consistent:
-            head = f"consistency: no contradictory state in {consistency.steps} steps"
-        else:
-            count = len(consistency.contradictions)
-            head = (
-                f"consistency: {count} contradictory state{'' if count == 1 else 's'}, "
-                f"first at step {consistency.first_contradiction_step}"
-            )
         sections = [
             ("summary", self.summary.to_text()),
-            (
-                "consistency",
-                head if consistency.consistent else head + "\n" + _indent(consistency.to_text()),
-            ),
+            ("consistency", self._consistency_text()),
             ("determinism", "determinism: " + self.determinism.to_text()),
         ]
         return "\n\n".join(f"== {title} ==\n{body}" for title, body in sections) + "\n"
 
+    def _consistency_text(self) -> str:
+        within, history = self.within_versions, self.consistency
+        final = self.determinism.final.version
+        in_final = [f for f in within.contradictions if f.version == final]
+        if within.consistent:
+            lines = [f"within each model version: no contradictory state in {within.steps} steps"]
+        else:
+            versions = len({found.version for found in within.contradictions})
+            last = max(within.contradictions, key=lambda found: found.first_step)
+            lines = [
+                f"within each model version: {_plural(len(within.contradictions), 'state')} "
+                f"contradicted in {_plural(versions, 'version')}, first at step "
+                f"{within.first_contradiction_step}, last at step {last.first_step}; "
+                + (
+                    "none in the final version"
+                    if not in_final
+                    else f"{len(in_final)} in the final version (version {final})"
+                )
+            ]
+            shown = in_final or list(within.contradictions[-_TEXT_LIMIT:])
+            lines += [f"  {line}" for line in _short_text(ConsistencyFindings(tuple(shown), 0))]
+        if history.consistent:
+            lines.append(
+                f"accumulated over the whole history: no contradictory state in {history.steps} "
+                f"steps"
+            )
+        else:
+            lines.append(
+                f"accumulated over the whole history (state ids across versions): "
+                f"{_plural(len(history.contradictions), 'contradictory state')}, first at step "
+                f"{history.first_contradiction_step}"
+            )
+            lines += [f"  {line}" for line in _short_text(history)]
+        return "\n".join(lines)
+
     def to_json(self) -> dict[str, Any]:
-        """A JSON-ready dict: one key per audit, and the two verdicts."""
+        """A JSON-ready dict: one key per audit, and the verdicts."""
         return {
             "has_contradiction": self.has_contradiction,
+            "ever_contradicted": self.ever_contradicted,
             "has_nondeterminism": self.has_nondeterminism,
             "summary": self.summary.to_json(),
+            "consistency_within_versions": self.within_versions.to_json(),
             "consistency": self.consistency.to_json(),
             "determinism": self.determinism.to_json(),
         }
@@ -93,11 +137,15 @@ def run_audits(source: AuditSource) -> AuditReport:
     audited once for consistency (the summary reuses that audit).
     """
     loaded = _Loaded(source.memory(), source.model_versions(), source.steps())
-    consistency = audit_consistency(loaded.memory())
+    memory = loaded.memory()
+    consistency = audit_consistency(memory)
     return AuditReport(
         summary=audit_summary(loaded, consistency=consistency),
         consistency=consistency,
         determinism=audit_determinism(loaded),
+        within_versions=audit_consistency_by_version(
+            memory, loaded.steps()["model_version"].to_numpy(np.int64)
+        ),
     )
 
 
@@ -117,5 +165,16 @@ class _Loaded:
         return self._steps
 
 
-def _indent(text: str) -> str:
-    return "\n".join(f"  {line}" for line in text.splitlines())
+_TEXT_LIMIT = 10
+"""Contradicted states listed in the text (all are in the JSON)."""
+
+
+def _short_text(findings: ConsistencyFindings) -> list[str]:
+    lines = findings.to_text().splitlines() if findings.contradictions else []
+    if len(lines) > _TEXT_LIMIT:
+        return [*lines[:_TEXT_LIMIT], f"... and {len(lines) - _TEXT_LIMIT} more (see --json)"]
+    return lines
+
+
+def _plural(count: int, noun: str) -> str:
+    return f"{count:,} {noun}{'' if count == 1 else 's'}"

@@ -1,10 +1,18 @@
-"""The truth audit: what the agent's internal states really stood for (DESIGN.md section 5).
+"""The truth audit: did the run learn the world, and what did its internal states stand for.
 
 The world is finite; its reachable poses, labelled with their sensation, form a
 deterministic Moore machine whose minimisation is the smallest correct model
 (:mod:`rsstp_sim.truth`). Every step of a recording has a pose, so every step
-has a *true class*: the state of that minimal machine. Comparing the agent's
-internal states with the true classes says exactly what went wrong:
+has a *true class*: the state of that minimal machine.
+
+The audit opens with a **verdict** (:mod:`rsstp_replay.audits.verdict`): learned, from
+which step, or not learned and the shortest action sequence that shows it. Then each
+model version is judged on its own, since a state id means what its version says (a
+split narrows a state, a merge widens it): for every version, over the steps it was in
+force, which of its states stood for several true classes, which classes it spread over
+several states, which of its states the memory contradicts, and whether it was
+equivalent to the truth (:attr:`TruthFindings.versions`, one row per version, for pandas).
+Last, the same figures accumulated over the whole history, state ids across versions:
 
 - **aliasing**: one internal state stood for several true classes. The agent
   confuses situations that behave differently; a deterministic model with that
@@ -14,14 +22,15 @@ internal states with the true classes says exactly what went wrong:
   algorithm's failure: it never recognises a state it already created).
 - **first mismatch**: the first step at which the correspondence between
   internal states and true classes stopped being one to one.
-- **final model**: whether the model at the last step, with each state labelled
-  by the sensation last seen in it, is equivalent to the truth from where the
-  agent ended, and if not the shortest action sequence that tells them apart.
+
+Those accumulated figures read a successful learner as a failure (its early versions
+reused state ids that meant something else then); they stay, labelled as such, because a
+strategy that should never change its mind is judged by them.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -29,10 +38,13 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from rsstp_replay.audits.consistency import audit_consistency_by_version
+from rsstp_replay.audits.contract import version_index
+from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
 from rsstp_sim.memory import Memory
+from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
-from rsstp_sim.transition_system import TransitionSystem
-from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
+from rsstp_sim.truth import GroundTruth, compute_truth
 
 __all__ = ["TruthFindings", "TruthSource", "audit_truth", "step_true_classes"]
 
@@ -46,7 +58,7 @@ class TruthSource(Protocol):
     def n_steps(self) -> int: ...
     def steps(self) -> pd.DataFrame: ...
     def memory(self) -> Memory: ...
-    def model_at(self, step: int) -> TransitionSystem: ...
+    def model_versions(self) -> Sequence[ModelRecord]: ...
 
 
 def step_true_classes(steps: pd.DataFrame, truth: GroundTruth) -> NDArray[np.int64]:
@@ -62,6 +74,13 @@ def _first_change(keys: NDArray[np.int64], values: NDArray[np.int64]) -> int | N
     return int(np.argmax(differs)) if differs.any() else None
 
 
+def _grouped_counts(keys: NDArray[np.int64], values: NDArray[np.int64]) -> NDArray[np.int64]:
+    """For every row, how many distinct values its key has over all rows."""
+    pairs = np.unique(np.stack([keys, values], axis=1), axis=0)
+    distinct_keys, per_key = np.unique(pairs[:, 0], return_counts=True)
+    return np.asarray(per_key[np.searchsorted(distinct_keys, keys)], np.int64)
+
+
 def _grouped(keys: NDArray[np.int64], values: NDArray[np.int64]) -> dict[int, tuple[int, ...]]:
     pairs = np.unique(np.stack([keys, values], axis=1), axis=0)
     out: dict[int, list[int]] = {}
@@ -72,34 +91,62 @@ def _grouped(keys: NDArray[np.int64], values: NDArray[np.int64]) -> dict[int, tu
 
 @dataclass(frozen=True)
 class TruthFindings:
-    """The truth audit of one recording (see the module docstring for what each part means)."""
+    """The truth audit of one recording (see the module docstring for what each part means).
+
+    ``versions`` has one row per model version: ``version``, ``step`` (the step it came into
+    force), ``last_step`` (the last step it was in force; ``step - 1`` for a version replaced
+    within its own step), ``steps_in_force``, ``states``, ``transitions``, ``deterministic``,
+    ``aliased_states`` and ``redundant_classes`` (over its steps), ``contradictory_states`` (the
+    memory's contradictions between two times in the same state of this version) and
+    ``equivalent`` (to the truth, where it came into force). ``aliased_step`` says per step
+    whether its internal state stood for several true classes under its version.
+    """
 
     scenario: str
     reachable_poses: int
     minimal_states: int
     steps: int
+    verdict: Verdict
+    versions: pd.DataFrame = field(repr=False, compare=False)
     classes_of_state: Mapping[int, tuple[int, ...]]
     states_of_class: Mapping[int, tuple[int, ...]]
     first_aliasing_step: int | None
     first_redundancy_step: int | None
-    final_model_states: int
-    final_equivalent: bool
-    counterexample: tuple[int, ...] | None
+    final_aliased: Mapping[int, tuple[int, ...]]
+    final_redundant: Mapping[int, tuple[int, ...]]
     true_class: NDArray[np.int64] = field(repr=False, compare=False)
+    aliased_step: NDArray[np.bool_] = field(repr=False, compare=False)
+
+    @property
+    def learned_at_step(self) -> int | None:
+        return self.verdict.learned_at_step
+
+    @property
+    def final_equivalent(self) -> bool:
+        return self.verdict.learned
+
+    @property
+    def final_model_states(self) -> int:
+        return self.verdict.final_states
+
+    @property
+    def counterexample(self) -> Counterexample | None:
+        return self.verdict.counterexample
 
     @property
     def aliased(self) -> dict[int, tuple[int, ...]]:
-        """Internal states that stood for more than one true class."""
+        """Over the whole history: internal states that stood for several true classes."""
         return {s: c for s, c in self.classes_of_state.items() if len(c) > 1}
 
     @property
     def redundant(self) -> dict[int, tuple[int, ...]]:
-        """True classes represented by more than one internal state."""
+        """Over the whole history: true classes represented by several internal states."""
         return {c: s for c, s in self.states_of_class.items() if len(s) > 1}
 
     @property
     def first_mismatch_step(self) -> int | None:
-        """The first step where states and classes stopped corresponding one to one."""
+        """Over the whole history: the first step where states and classes stopped
+        corresponding one to one."""
         found = [s for s in (self.first_aliasing_step, self.first_redundancy_step) if s is not None]
         return min(found) if found else None
 
@@ -107,66 +154,106 @@ class TruthFindings:
     def classes_visited(self) -> int:
         return len(self.states_of_class)
 
-    def to_text(self) -> str:
-        aliased, redundant = self.aliased, self.redundant
+    def to_text(self, *, verdict: bool = True) -> str:
+        """The audit for a terminal; ``verdict=False`` leaves out the verdict (shown first)."""
+        table = self.versions
         lines = [
-            f"truth: {self.scenario}: {self.reachable_poses:,} reachable poses, "
-            f"minimal model {self.minimal_states} states; the run visited "
-            f"{self.classes_visited} classes with {len(self.classes_of_state)} internal states",
-            f"aliasing: {len(aliased)} internal states stood for several true classes"
-            + (f", first at step {self.first_aliasing_step}" if aliased else ""),
+            *([self.verdict.to_text()] if verdict else []),
+            f"truth: {self.scenario}: {self.reachable_poses:,} reachable poses, minimal model "
+            f"{self.minimal_states} states; the run visited {self.classes_visited} classes in "
+            f"{self.steps:,} steps",
+            f"within each model version ({len(table):,} versions; a state id means what its "
+            f"version says):",
         ]
-        for state, classes in sorted(aliased.items())[:10]:
-            lines.append(f"  state {state}: classes {_short(classes)}")
+        for column, what in (
+            ("aliased_states", "a state stood for several true classes"),
+            ("redundant_classes", "a true class was spread over several states"),
+            ("contradictory_states", "the memory contradicts a state"),
+        ):
+            lines.append(f"  {what}: {_versions_with(table, column)}")
+        for state, classes in sorted(self.final_aliased.items())[:10]:
+            lines.append(f"    final version: state {state} stood for classes {_short(classes)}")
+        for cls, states in sorted(self.final_redundant.items())[:10]:
+            lines.append(f"    final version: class {cls} was in states {_short(states)}")
+        equivalent = table.loc[table["equivalent"]]
         lines.append(
-            f"redundancy: {len(redundant)} true classes were split over several internal states"
+            f"  equivalent to the truth: {len(equivalent):,} "
+            f"version{'' if len(equivalent) == 1 else 's'}"
+            + (
+                f", the first at step {int(equivalent['step'].iloc[0]):,}"
+                if len(equivalent)
+                else ""
+            )
+        )
+        aliased, redundant = self.aliased, self.redundant
+        lines.append(
+            "accumulated over the whole history (state ids across versions, so a state "
+            "counts what it meant in every version):"
+        )
+        lines.append(
+            f"  aliasing: {len(aliased)} internal states stood for several true classes"
+            + (f", first at step {self.first_aliasing_step}" if aliased else "")
+        )
+        lines.append(
+            f"  redundancy: {len(redundant)} true classes were split over several internal states"
             + (f", first at step {self.first_redundancy_step}" if redundant else "")
         )
-        for cls, states in sorted(redundant.items())[:10]:
-            lines.append(f"  class {cls}: states {_short(states)}")
         if self.first_mismatch_step is None:
-            lines.append("the internal states matched the true classes one to one at every step")
+            lines.append("  the internal states matched the true classes one to one at every step")
         else:
-            lines.append(f"first mismatch at step {self.first_mismatch_step}")
-        if self.final_equivalent:
-            lines.append(f"final model ({self.final_model_states} states): equivalent to the truth")
-        else:
-            lines.append(
-                f"final model ({self.final_model_states} states): NOT equivalent; shortest "
-                f"counterexample: actions {list(self.counterexample or ())}"
-            )
+            lines.append(f"  first mismatch at step {self.first_mismatch_step}")
         return "\n".join(lines) + "\n"
 
     def to_json(self) -> dict[str, Any]:
+        counterexample = self.counterexample
         return {
+            "verdict": self.verdict.to_json(),
+            "learned_at_step": self.learned_at_step,
+            "counterexample": None if counterexample is None else counterexample.to_json(),
             "scenario": self.scenario,
             "reachable_poses": self.reachable_poses,
             "minimal_states": self.minimal_states,
             "steps": self.steps,
-            "classes_visited": self.classes_visited,
-            "internal_states_visited": len(self.classes_of_state),
-            "aliased_states": {str(s): list(c) for s, c in sorted(self.aliased.items())},
-            "redundant_classes": {str(c): list(s) for c, s in sorted(self.redundant.items())},
-            "first_aliasing_step": self.first_aliasing_step,
-            "first_redundancy_step": self.first_redundancy_step,
-            "first_mismatch_step": self.first_mismatch_step,
             "final_model_states": self.final_model_states,
             "final_equivalent": self.final_equivalent,
-            "counterexample": None if self.counterexample is None else list(self.counterexample),
+            "final_version": {
+                "aliased_states": {str(s): list(c) for s, c in sorted(self.final_aliased.items())},
+                "redundant_classes": {
+                    str(c): list(s) for c, s in sorted(self.final_redundant.items())
+                },
+            },
+            "versions": {
+                column: self.versions[column].tolist() for column in self.versions.columns
+            },
+            "history": {
+                "classes_visited": self.classes_visited,
+                "internal_states_visited": len(self.classes_of_state),
+                "aliased_states": {str(s): list(c) for s, c in sorted(self.aliased.items())},
+                "redundant_classes": {str(c): list(s) for c, s in sorted(self.redundant.items())},
+                "first_aliasing_step": self.first_aliasing_step,
+                "first_redundancy_step": self.first_redundancy_step,
+                "first_mismatch_step": self.first_mismatch_step,
+            },
         }
+
+
+def _versions_with(table: pd.DataFrame, column: str) -> str:
+    """``in N versions, the last at steps a..b (version v); none in the final version``."""
+    hit = table.loc[table[column] > 0]
+    if not len(hit):
+        return "in no version"
+    last = hit.iloc[-1]
+    final = int(table[column].iloc[-1])
+    return (
+        f"in {len(hit):,} of {len(table):,} versions, the last version {int(last['version'])} "
+        f"(steps {int(last['step']):,}..{int(last['last_step']):,})"
+        + ("; none in the final version" if final == 0 else f"; {final} in the final version")
+    )
 
 
 def _short(values: tuple[int, ...], limit: int = 12) -> str:
     shown = ", ".join(map(str, values[:limit]))
     return f"[{shown}{', ...' if len(values) > limit else ''}] ({len(values)})"
-
-
-def _labels(memory: Memory) -> dict[int, bool]:
-    """Each internal state's label: the sensation last seen in it."""
-    states = memory.internal_states[::-1]
-    sensations = memory.sensations[::-1]
-    unique, last = np.unique(states, return_index=True)
-    return dict(zip(unique.tolist(), sensations[last].tolist(), strict=True))
 
 
 def audit_truth(source: TruthSource, *, truth: GroundTruth | None = None) -> TruthFindings:
@@ -175,26 +262,81 @@ def audit_truth(source: TruthSource, *, truth: GroundTruth | None = None) -> Tru
     steps = source.steps()
     true_class = step_true_classes(steps, truth)
     memory = source.memory()
+    versions = list(source.model_versions())
     states = np.asarray(memory.internal_states, dtype=np.int64)
-    final = source.model_at(source.n_steps)
-    counterexample = check_equivalence(
-        final,
-        _labels(memory),
-        truth,
-        start_state=final.current,
-        start_class=int(true_class[-1]),
+    step_numbers = np.arange(len(states), dtype=np.int64)
+    index = version_index(versions, step_numbers)
+    verdict, equivalent = judge_versions(
+        versions,
+        truth=truth,
+        states=states,
+        sensations=np.asarray(memory.sensations, np.bool_),
+        true_class=true_class,
     )
+
+    # Within each version: keys (version index, state) and (version index, class).
+    width_state = int(states.max(initial=0)) + 1
+    width_class = truth.n_classes
+    state_key = index * width_state + states
+    class_key = index * width_class + true_class
+    aliased_step = _grouped_counts(state_key, true_class) > 1
+    redundant_step = _grouped_counts(class_key, states) > 1
+    n = len(versions)
+    aliased_states = _distinct_per_version(index[aliased_step], states[aliased_step], n)
+    redundant_classes = _distinct_per_version(index[redundant_step], true_class[redundant_step], n)
+    contradictions = audit_consistency_by_version(memory, steps["model_version"].to_numpy(np.int64))
+    numbers = [record.version for record in versions]
+    contradicted = np.zeros(n, np.int64)
+    position = {version: k for k, version in enumerate(numbers)}
+    for found in contradictions.contradictions:
+        assert found.version is not None
+        contradicted[position[found.version]] += 1
+
+    starts = np.fromiter((record.step for record in versions), np.int64, n)
+    ends = np.r_[starts[1:], len(states)] - 1
+    table = pd.DataFrame(
+        {
+            "version": np.asarray(numbers, np.int64),
+            "step": starts,
+            "last_step": ends,
+            "steps_in_force": np.maximum(ends - starts + 1, 0),
+            "states": np.fromiter((len(r.states) for r in versions), np.int64, n),
+            "transitions": np.fromiter((len(r.transitions) for r in versions), np.int64, n),
+            "deterministic": np.fromiter((r.deterministic for r in versions), np.bool_, n),
+            "aliased_states": aliased_states,
+            "redundant_classes": redundant_classes,
+            "contradictory_states": contradicted,
+            "equivalent": equivalent,
+        }
+    )
+    last = index == n - 1
     return TruthFindings(
         scenario=truth.scenario_name,
         reachable_poses=truth.n_poses,
         minimal_states=truth.n_classes,
-        steps=source.n_steps,
+        steps=len(states) - 1,
+        verdict=verdict,
+        versions=table,
         classes_of_state=_grouped(states, true_class),
         states_of_class=_grouped(true_class, states),
         first_aliasing_step=_first_change(states, true_class),
         first_redundancy_step=_first_change(true_class, states),
-        final_model_states=len(final),
-        final_equivalent=counterexample is None,
-        counterexample=counterexample,
+        final_aliased={
+            s: c for s, c in _grouped(states[last], true_class[last]).items() if len(c) > 1
+        },
+        final_redundant={
+            c: s for c, s in _grouped(true_class[last], states[last]).items() if len(s) > 1
+        },
         true_class=true_class,
+        aliased_step=aliased_step,
     )
+
+
+def _distinct_per_version(
+    version: NDArray[np.int64], values: NDArray[np.int64], n: int
+) -> NDArray[np.int64]:
+    """How many distinct values each version index ``0 .. n-1`` has."""
+    if not len(version):
+        return np.zeros(n, np.int64)
+    pairs = np.unique(np.stack([version, values], axis=1), axis=0)
+    return np.bincount(pairs[:, 0], minlength=n).astype(np.int64)
