@@ -157,8 +157,8 @@ class GroundTruth:
             )
         return index
 
-    def classes_of(self, angles_deg: ArrayLike) -> NDArray[np.int64]:
-        """Classes of many poses at once: ``angles_deg`` has shape ``(B, n)``.
+    def poses_of(self, angles_deg: ArrayLike) -> NDArray[np.int64]:
+        """Pose indices of many poses at once: ``angles_deg`` has shape ``(B, n)``.
 
         Raises :class:`TruthError` naming the first pose that is not reachable.
         """
@@ -173,7 +173,12 @@ class GroundTruth:
                 f"{self.scenario_name}: the pose {angles[first].tolist()} is not reachable "
                 f"from the start"
             )
-        return np.asarray(self.true_class[index], dtype=np.int64)
+        return np.asarray(index, dtype=np.int64)
+
+    def classes_of(self, angles_deg: ArrayLike) -> NDArray[np.int64]:
+        """Classes of many poses at once: ``angles_deg`` has shape ``(B, n)`` (see
+        :meth:`poses_of`)."""
+        return np.asarray(self.true_class[self.poses_of(angles_deg)], dtype=np.int64)
 
     def class_of(self, angles_deg: Sequence[int]) -> int:
         """Class (minimal machine state) of the pose with these joint angles."""

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from rsstp_replay import open_recording
-from rsstp_replay.audits import audit_truth
+from rsstp_replay.audits import audit_truth, truth_table
 from rsstp_sim import (
     AgentView,
     RandomStrategy,
@@ -260,3 +260,19 @@ def test_the_counterexample_names_the_step_its_path_last_changed(tmp_path: Path)
     assert example.last_changed_step == 30
     text = findings.to_text()
     assert "the transitions on that path last changed at step 30" in text
+
+
+def test_the_truth_table_gives_class_pose_and_aliasing_per_step() -> None:
+    with open_recording(LEARNER) as rec:
+        table = truth_table(rec)
+        findings = audit_truth(rec)
+        truth = rec.ground_truth()
+    angles = table[["angle_deg_0", "angle_deg_1"]].to_numpy()
+    assert (truth.angles_deg[table["pose"].to_numpy()] == angles).all()
+    assert (truth.true_class[table["pose"].to_numpy()] == table["true_class"].to_numpy()).all()
+    assert table["aliased"].tolist() == findings.aliased_step.tolist()
+    # After the learner's last version came into force, no step is aliased.
+    learned = findings.learned_at_step
+    assert learned is not None
+    assert not table.loc[table["step"] >= learned, "aliased"].any()
+    assert table.loc[table["step"] < learned, "aliased"].any()

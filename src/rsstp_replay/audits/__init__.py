@@ -35,7 +35,13 @@ from rsstp_replay.audits.determinism import (
 )
 from rsstp_replay.audits.report import AuditReport, run_audits
 from rsstp_replay.audits.summary import AuditSource, ModelSize, SummaryFindings, audit_summary
-from rsstp_replay.audits.truth import TruthFindings, TruthSource, audit_truth, step_true_classes
+from rsstp_replay.audits.truth import (
+    TruthFindings,
+    TruthSource,
+    audit_truth,
+    step_true_classes,
+    truth_table,
+)
 from rsstp_replay.audits.verdict import Counterexample, Verdict
 
 __all__ = [
@@ -67,4 +73,5 @@ __all__ = [
     "find_contradictions",
     "run_audits",
     "step_true_classes",
+    "truth_table",
 ]

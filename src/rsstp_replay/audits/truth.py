@@ -46,7 +46,7 @@ from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.truth import GroundTruth, compute_truth
 
-__all__ = ["TruthFindings", "TruthSource", "audit_truth", "step_true_classes"]
+__all__ = ["TruthFindings", "TruthSource", "audit_truth", "step_true_classes", "truth_table"]
 
 
 class TruthSource(Protocol):
@@ -65,6 +65,24 @@ def step_true_classes(steps: pd.DataFrame, truth: GroundTruth) -> NDArray[np.int
     """The true class of every row's pose (columns ``angle_deg_0 .. angle_deg_{n-1}``)."""
     columns = [f"angle_deg_{j}" for j in range(truth.n_joints)]
     return truth.classes_of(steps[columns].to_numpy(dtype=np.int64))
+
+
+def truth_table(
+    source: TruthSource, *, truth: GroundTruth | None = None, findings: TruthFindings | None = None
+) -> pd.DataFrame:
+    """The steps table with the ground truth of every step: ``true_class`` (int64), ``pose``
+    (int64, the pose's index among the scenario's reachable poses, as in
+    :class:`~rsstp_sim.truth.GroundTruth`) and ``aliased`` (bool: the step's internal state
+    stood for several true classes under the model version in force, over that version's
+    steps). ``findings`` is the truth audit when already at hand."""
+    truth = compute_truth(source.scenario) if truth is None else truth
+    findings = audit_truth(source, truth=truth) if findings is None else findings
+    table = source.steps()
+    columns = [f"angle_deg_{j}" for j in range(truth.n_joints)]
+    table["true_class"] = findings.true_class
+    table["pose"] = truth.poses_of(table[columns].to_numpy(dtype=np.int64))
+    table["aliased"] = findings.aliased_step
+    return table
 
 
 def _first_change(keys: NDArray[np.int64], values: NDArray[np.int64]) -> int | None:
