@@ -85,7 +85,7 @@ def test_a_one_state_model_aliases_every_class(tmp_path: Path) -> None:
     assert example.last_changed_step is None  # the one-state model never changed
     assert findings.learned_at_step is None
     assert findings.verdict.line() == (
-        "not learned: 1 states for 4 true classes after 20 steps; the model has not changed "
+        "not learned: 1 state for 4 true classes after 20 steps; the model has not changed "
         "size since step 0"
     )
 

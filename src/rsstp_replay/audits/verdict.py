@@ -19,7 +19,7 @@ in force (a transition system has no labels of its own; the memory gives them).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -68,20 +68,20 @@ class Counterexample:
         return "the model predicts the wrong sensation after the last action"
 
     def to_text(self) -> str:
-        shown = ", ".join(_sensation(p) for p in self.predicted)
-        actual = ", ".join(_sensation(a) for a in self.actual)
+        """One line; repeated values are run-length shortened (``false x22``)."""
         changed = (
             "never changed since step 0"
             if self.last_changed_step is None
             else f"last changed at step {self.last_changed_step:,}"
         )
+        states = ["-" if s is None else str(s) for s in self.model_states]
         return (
             f"counterexample: from state {self.from_state} at step {self.from_step:,} (true "
-            f"class {self.true_class}), actions {list(self.actions)}: the model goes through "
-            f"states [{', '.join('-' if s is None else str(s) for s in self.model_states)}] "
-            f"and predicts "
-            f"[{shown}], the world senses [{actual}] ({self.disagreement}); the transitions "
-            f"on that path {changed}"
+            f"class {self.true_class}), actions {_runs(map(str, self.actions))}: the model goes "
+            f"through states {_runs(states)} and predicts "
+            f"{_runs(map(_sensation, self.predicted))}, the world senses "
+            f"{_runs(map(_sensation, self.actual))} ({self.disagreement}); the transitions on "
+            f"that path {changed}"
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -124,8 +124,9 @@ class Verdict:
                 )
             return f"learned: {what} from step {self.learned_at_step:,} to the end"
         head = (
-            f"not learned: {self.final_states} states for {self.minimal_states} true classes "
-            f"after {self.steps:,} steps; "
+            f"not learned: {_count(self.final_states, 'state')} for "
+            f"{_count(self.minimal_states, 'true class', 'true classes')} after "
+            f"{_count(self.steps, 'step')}; "
         )
         if self.growth_per_step > 0:
             return head + f"the model grows by about {self.growth_per_step:.2g} states a step"
@@ -313,6 +314,21 @@ def _growth(versions: Sequence[ModelRecord], steps: int) -> float:
     sizes = np.fromiter((len(record.states) for record in versions), np.int64, len(versions))
     size_middle = int(sizes[int(np.searchsorted(at, middle, side="right")) - 1])
     return round((int(sizes[-1]) - size_middle) / (steps - middle), 4)
+
+
+def _count(n: int, one: str, many: str | None = None) -> str:
+    return f"{n:,} {one if n == 1 else many or one + 's'}"
+
+
+def _runs(values: Iterable[str]) -> str:
+    """``[a x3, b]``: consecutive repeats folded."""
+    runs: list[list[Any]] = []
+    for value in values:
+        if runs and runs[-1][0] == value:
+            runs[-1][1] += 1
+        else:
+            runs.append([value, 1])
+    return "[" + ", ".join(v if n == 1 else f"{v} x{n}" for v, n in runs) + "]"
 
 
 def _sensation(value: bool | None) -> str:
