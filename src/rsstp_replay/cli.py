@@ -138,7 +138,9 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         raise UsageError(f"--fail-on {sorted(needs_truth)[0]} needs --truth")
     with _open(args.file) as recording:
         report = run_audits(recording)
-        truth = audit_truth(recording) if args.truth else None
+        truth = (
+            audit_truth(recording, within_versions=report.within_versions) if args.truth else None
+        )
     if args.json:
         document = report.to_json()
         if truth is not None:

@@ -154,6 +154,7 @@ class Recording:
         self.scenario = rebuild_scenario(container, self.scenario_record, self.metadata)
         self._agent_cache: dict[int, StepColumns] = {}
         self._agent: StepColumns | None = None
+        self._full: StepColumns | None = None
         self._models: tuple[ModelRecord, ...] | None = None
 
     # -- properties ------------------------------------------------------------------------
@@ -186,6 +187,7 @@ class Recording:
         """Drop the cached tables; later calls raise :class:`ReplayError`."""
         self._closed = True
         self._agent = None
+        self._full = None
         self._agent_cache.clear()
         self._models = None
 
@@ -218,7 +220,11 @@ class Recording:
         - with ``truth=True``, also ``true_class`` (int64): the state of the minimal correct
           model (the ground truth of :mod:`rsstp_sim.truth`) that the step's pose belongs to.
         """
-        frame = self._step_columns(truth=True).frame()
+        self._check_open()
+        if self._full is None:  # decoded once: the audits of one command all read it
+            self._full = self._step_columns(truth=True)
+            self._agent = self._full
+        frame = self._full.frame().copy()  # the caller's own: editing it cannot touch the cache
         if truth:
             from rsstp_replay.audits.truth import step_true_classes
 

@@ -353,6 +353,13 @@ def test_random_strategy() -> None:
     sensations = fake.memory().sensations
     assert sensations.any() and not sensations.all()
     assert report.has_contradiction
+    # One version: the within-versions audit is the whole-history one, each finding naming it.
+    assert report.within_versions == audit_consistency_by_version(
+        fake.memory(), fake.steps()["model_version"].to_numpy()
+    )
+    assert {found.version for found in report.within_versions.contradictions} == {
+        report.determinism.final.version
+    }
     (found,) = report.consistency.contradictions
     assert found.state == 0
     witness = found.witness

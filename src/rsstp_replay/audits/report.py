@@ -23,7 +23,7 @@ defect; what was learned is the final model. :attr:`AuditReport.ever_nondetermin
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -136,16 +136,23 @@ def run_audits(source: AuditSource) -> AuditReport:
     The memory, the model messages and the steps table are read once, and the memory is
     audited once for consistency (the summary reuses that audit).
     """
-    loaded = _Loaded(source.memory(), source.model_versions(), source.steps())
+    steps = source.steps()  # first: a recording then builds the memory from the same decode
+    loaded = _Loaded(source.memory(), source.model_versions(), steps)
     memory = loaded.memory()
     consistency = audit_consistency(memory)
+    versions = steps["model_version"].to_numpy(np.int64)
+    if len(versions) and (versions == versions[0]).all():  # one version: the same audit
+        within = ConsistencyFindings(
+            tuple(replace(found, version=int(versions[0])) for found in consistency.contradictions),
+            consistency.steps,
+        )
+    else:
+        within = audit_consistency_by_version(memory, versions)
     return AuditReport(
         summary=audit_summary(loaded, consistency=consistency),
         consistency=consistency,
         determinism=audit_determinism(loaded),
-        within_versions=audit_consistency_by_version(
-            memory, loaded.steps()["model_version"].to_numpy(np.int64)
-        ),
+        within_versions=within,
     )
 
 

@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
-from rsstp_replay.audits.consistency import audit_consistency_by_version
+from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
 from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
 from rsstp_sim.memory import Memory
@@ -85,6 +85,25 @@ def truth_table(
     return table
 
 
+def _codes(values: NDArray[np.int64]) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """The distinct values, sorted, and each value's index among them."""
+    distinct, codes = np.unique(values, return_inverse=True)
+    return distinct, codes.astype(np.int64)
+
+
+def _pairs(keys: NDArray[np.int64], values: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The distinct ``(key, value)`` pairs, sorted, shape ``(P, 2)`` (one integer sort, not a
+    row-wise ``unique``)."""
+    if not len(keys):
+        return np.empty((0, 2), np.int64)
+    key_ids, key_codes = _codes(keys)
+    value_ids, value_codes = _codes(values)
+    combined = np.unique(key_codes * len(value_ids) + value_codes)
+    return np.stack(
+        [key_ids[combined // len(value_ids)], value_ids[combined % len(value_ids)]], axis=1
+    )
+
+
 def _first_change(keys: NDArray[np.int64], values: NDArray[np.int64]) -> int | None:
     """First index where a key is seen with a value other than the one it first had."""
     _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
@@ -94,17 +113,21 @@ def _first_change(keys: NDArray[np.int64], values: NDArray[np.int64]) -> int | N
 
 def _grouped_counts(keys: NDArray[np.int64], values: NDArray[np.int64]) -> NDArray[np.int64]:
     """For every row, how many distinct values its key has over all rows."""
-    pairs = np.unique(np.stack([keys, values], axis=1), axis=0)
+    pairs = _pairs(keys, values)
     distinct_keys, per_key = np.unique(pairs[:, 0], return_counts=True)
     return np.asarray(per_key[np.searchsorted(distinct_keys, keys)], np.int64)
 
 
 def _grouped(keys: NDArray[np.int64], values: NDArray[np.int64]) -> dict[int, tuple[int, ...]]:
-    pairs = np.unique(np.stack([keys, values], axis=1), axis=0)
-    out: dict[int, list[int]] = {}
-    for key, value in pairs.tolist():
-        out.setdefault(key, []).append(value)
-    return {k: tuple(v) for k, v in out.items()}
+    pairs = _pairs(keys, values)
+    if not len(pairs):
+        return {}
+    starts = np.flatnonzero(np.r_[True, pairs[1:, 0] != pairs[:-1, 0]])
+    groups = np.split(pairs[:, 1], starts[1:])
+    return {
+        int(pairs[start, 0]): tuple(group.tolist())
+        for start, group in zip(starts, groups, strict=True)
+    }
 
 
 @dataclass(frozen=True)
@@ -274,8 +297,15 @@ def _short(values: tuple[int, ...], limit: int = 12) -> str:
     return f"[{shown}{', ...' if len(values) > limit else ''}] ({len(values)})"
 
 
-def audit_truth(source: TruthSource, *, truth: GroundTruth | None = None) -> TruthFindings:
-    """Run the truth audit (computes the ground truth unless ``truth`` is given)."""
+def audit_truth(
+    source: TruthSource,
+    *,
+    truth: GroundTruth | None = None,
+    within_versions: ConsistencyFindings | None = None,
+) -> TruthFindings:
+    """Run the truth audit. The ground truth is computed unless ``truth`` is given, and the
+    consistency audit within versions unless ``within_versions`` is (an
+    :class:`~rsstp_replay.audits.report.AuditReport` has it)."""
     truth = compute_truth(source.scenario) if truth is None else truth
     steps = source.steps()
     true_class = step_true_classes(steps, truth)
@@ -302,7 +332,9 @@ def audit_truth(source: TruthSource, *, truth: GroundTruth | None = None) -> Tru
     n = len(versions)
     aliased_states = _distinct_per_version(index[aliased_step], states[aliased_step], n)
     redundant_classes = _distinct_per_version(index[redundant_step], true_class[redundant_step], n)
-    contradictions = audit_consistency_by_version(memory, steps["model_version"].to_numpy(np.int64))
+    contradictions = within_versions or audit_consistency_by_version(
+        memory, steps["model_version"].to_numpy(np.int64)
+    )
     numbers = [record.version for record in versions]
     contradicted = np.zeros(n, np.int64)
     position = {version: k for k, version in enumerate(numbers)}
@@ -354,7 +386,5 @@ def _distinct_per_version(
     version: NDArray[np.int64], values: NDArray[np.int64], n: int
 ) -> NDArray[np.int64]:
     """How many distinct values each version index ``0 .. n-1`` has."""
-    if not len(version):
-        return np.zeros(n, np.int64)
-    pairs = np.unique(np.stack([version, values], axis=1), axis=0)
+    pairs = _pairs(version, values)
     return np.bincount(pairs[:, 0], minlength=n).astype(np.int64)
