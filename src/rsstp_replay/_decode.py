@@ -6,6 +6,13 @@ fields are then copied column by column into numpy arrays sized for the whole re
 the structs are dropped before the next chunk. The structs check types and ranges while
 decoding (integers stay integers, angles in ``0..359``, feedback in ``[0, 1]``); shapes and
 the rules between fields are checked on the columns.
+
+The joint positions and obstacle distances of a step are a function of its angles and the
+scenario (what the recorder computed them with, :mod:`rsstp_sim.geometry`). Parsing their
+floats is most of the cost of a step, so a batch is decoded without them, they are computed
+from the angles with numpy, and the batch's first message is decoded whole and compared
+with what was computed, bit for bit: a recording whose numbers do not follow from its
+angles is refused (the chunk CRC already guards every byte).
 """
 
 from __future__ import annotations
@@ -16,9 +23,12 @@ from typing import Annotated, Any, Literal
 
 import msgspec
 import numpy as np
+import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
-__all__ = ["BadStep", "StepColumns", "blocker_label"]
+from rsstp_sim.geometry import ArmGeometry, joint_positions, obstacle_distances
+
+__all__ = ["BadStep", "StepColumns", "blocker_label", "pose_numbers"]
 
 _Count = Annotated[int, msgspec.Meta(ge=0)]
 _Angle = Annotated[int, msgspec.Meta(ge=0, le=359)]
@@ -54,6 +64,21 @@ class _Step(msgspec.Struct, gc=False):
     truth: _Truth
 
 
+class _PoseTruth(msgspec.Struct, gc=False):
+    """The ground truth of a step without the numbers that follow from its angles (skipped by
+    the parser, not built)."""
+
+    angles_deg: list[_Angle]
+    blocked: bool
+    blocked_by: _BlockedBy | None
+
+
+class _PoseStep(msgspec.Struct, gc=False):
+    step: _Count
+    agent: _Agent
+    truth: _PoseTruth
+
+
 class _AgentStep(msgspec.Struct, gc=False):
     """A step message without its ground truth (skipped by the parser, not built)."""
 
@@ -62,7 +87,7 @@ class _AgentStep(msgspec.Struct, gc=False):
 
 
 _DECODERS: dict[bool, tuple[msgspec.json.Decoder[Any], msgspec.json.Decoder[Any]]] = {
-    True: (msgspec.json.Decoder(list[_Step]), msgspec.json.Decoder(_Step)),
+    True: (msgspec.json.Decoder(list[_PoseStep]), msgspec.json.Decoder(_Step)),
     False: (msgspec.json.Decoder(list[_AgentStep]), msgspec.json.Decoder(_AgentStep)),
 }
 _ARITY = {"fold": 1, "obstacle": 2, "links": 2}
@@ -97,7 +122,18 @@ class StepColumns:
     With ``truth=False`` only the agent's fields are decoded (what a memory needs).
     """
 
-    def __init__(self, n_rows: int, *, n_joints: int, n_obstacles: int, truth: bool = True) -> None:
+    def __init__(
+        self,
+        n_rows: int,
+        *,
+        n_joints: int,
+        n_obstacles: int,
+        truth: bool = True,
+        geometry: ArmGeometry | None = None,
+    ) -> None:
+        if truth and geometry is None:
+            raise ValueError("the ground truth columns need the scenario's geometry")
+        self.geometry = geometry
         self.n_rows = n_rows
         self.n_joints = n_joints
         self.n_obstacles = n_obstacles
@@ -119,8 +155,6 @@ class StepColumns:
             self.blocker_labels: dict[_BlockedBy, int] = {}
             # One row per column, so each DataFrame column is a contiguous array.
             self.angles_deg = np.empty((n_joints, n_rows), np.int64)
-            self.positions = np.empty((n_joints + 1, 2, n_rows), np.float64)
-            self.distances = np.empty((n_joints, n_obstacles, n_rows), np.float64)
 
     # -- filling ----------------------------------------------------------------------------
 
@@ -157,34 +191,48 @@ class StepColumns:
         self.model_version[s] = [a.model_version for a in agents]
         self.no_transition[s] = np.array([a.no_transition for a in agents], np.bool_)
         if self.truth:
-            self._add_truth([x.truth for x in rows], r)
+            self._add_truth([x.truth for x in rows], r, parts[0])
         self.rows = r + k
 
-    def _add_truth(self, truths: list[_Truth], r: int) -> None:
-        k = len(truths)
+    def _check_numbers(self, message: memoryview, angles: npt.NDArray[np.int64]) -> None:
+        """The first message of a batch, decoded whole: its joint positions and distances must
+        be, bit for bit, what its angles give (see the module docstring)."""
+        try:
+            truth = _DECODERS[True][1].decode(message).truth
+        except msgspec.DecodeError as exc:
+            raise BadStep(_describe(exc), index=0) from None
+        positions, distances = pose_numbers(self._geometry(), angles[None, :])
         n, m = self.n_joints, self.n_obstacles
+        _check_lengths([truth.joint_positions], n + 1, "truth.joint_positions", "points")
+        _check_lengths([truth.distances], n, "truth.distances", "rows (one per tip)")
+        if any(len(row) != m for row in truth.distances):
+            raise BadStep(f"truth.distances: expected rows of {m} values", index=0)
+        found = np.array(truth.joint_positions, np.float64).reshape(n + 1, 2)
+        if not np.array_equal(found, positions[0]):
+            raise BadStep(
+                "truth.joint_positions are not the positions of its angles "
+                f"{angles.tolist()}: {found.tolist()}",
+                index=0,
+            )
+        if m and not np.array_equal(np.array(truth.distances, np.float64), distances[0]):
+            raise BadStep(
+                f"truth.distances are not the distances of its angles {angles.tolist()}",
+                index=0,
+            )
+
+    def _geometry(self) -> ArmGeometry:
+        assert self.geometry is not None  # checked in __init__
+        return self.geometry
+
+    def _add_truth(self, truths: list[_PoseTruth], r: int, first: memoryview) -> None:
+        k = len(truths)
+        n = self.n_joints
         s = slice(r, r + k)
         angles = [t.angles_deg for t in truths]
         _check_lengths(angles, n, "truth.angles_deg", "angles")
         flat = np.fromiter(chain.from_iterable(angles), np.int64, k * n)
         self.angles_deg[:, s] = flat.reshape(k, n).T
-        positions = [t.joint_positions for t in truths]
-        _check_lengths(positions, n + 1, "truth.joint_positions", "points")
-        flat = np.fromiter(chain.from_iterable(chain.from_iterable(positions)), np.float64)
-        self.positions[:, :, s] = flat.reshape(k, n + 1, 2).transpose(1, 2, 0)
-        distances = [t.distances for t in truths]
-        _check_lengths(distances, n, "truth.distances", "rows (one per tip)")
-        if m:
-            rows = [row for tip in distances for row in tip]
-            if set(map(len, rows)) != {m}:
-                bad = next(i for i, d in enumerate(distances) if any(len(x) != m for x in d))
-                raise BadStep(f"truth.distances: expected rows of {m} values", index=bad)
-            flat = np.fromiter(chain.from_iterable(rows), np.float64, k * n * m)
-            self.distances[:, :, s] = flat.reshape(k, n, m).transpose(1, 2, 0)
-        else:
-            filled = next((i for i, tips in enumerate(distances) if any(tips)), None)
-            if filled is not None:
-                raise BadStep("truth.distances: expected empty rows (no obstacles)", index=filled)
+        self._check_numbers(first, flat[:n])
         self.blocked[s] = np.array([t.blocked for t in truths], np.bool_)
         labels = self.blocker_labels
         for index, truth in enumerate(truths):
@@ -256,13 +304,24 @@ class StepColumns:
             )
             for j in range(self.n_joints):
                 columns[f"angle_deg_{j}"] = self.angles_deg[j]
+            positions, distances = pose_numbers(self._geometry(), self.angles_deg.T)
             for k in range(self.n_joints + 1):
-                columns[f"joint{k}_x"] = self.positions[k, 0]
-                columns[f"joint{k}_y"] = self.positions[k, 1]
+                columns[f"joint{k}_x"] = positions[:, k, 0]
+                columns[f"joint{k}_y"] = positions[:, k, 1]
             for k in range(self.n_joints):
                 for j in range(self.n_obstacles):
-                    columns[f"dist_{k}_{j}"] = self.distances[k, j]
+                    columns[f"dist_{k}_{j}"] = distances[:, k, j]
         return pd.DataFrame(columns, copy=False)
+
+
+def pose_numbers(
+    geometry: ArmGeometry, angles_deg: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Joint positions ``(B, n + 1, 2)`` and obstacle distances ``(B, n, m)`` of poses
+    ``(B, n)``, computed as the recorder computes them."""
+    positions = joint_positions(angles_deg, geometry.lengths)
+    distances = obstacle_distances(positions[:, 1:], geometry.centers, geometry.radii)
+    return positions, distances
 
 
 def _nullable(values: list[int | None], first: int, nulls: list[int]) -> list[int] | Any:

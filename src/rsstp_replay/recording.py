@@ -49,6 +49,7 @@ from rsstp_replay.errors import (
     UnfinishedRecordingWarning,
 )
 from rsstp_sim.errors import MemoryRangeError
+from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import (
     EventRecord,
@@ -413,6 +414,7 @@ class Recording:
             n_joints=record.n_joints,
             n_obstacles=len(record.obstacles),
             truth=truth,
+            geometry=ArmGeometry.from_scenario(self.scenario) if truth else None,
         )
         with _gc_paused():
             for ref, data, parts, _ in self._chunks("/rsstp/step"):

@@ -211,6 +211,13 @@ CASES: dict[str, Case] = {
         reach=Recording.memory,
         command=("compare", "1", "2"),
     ),
+    "moved-joint": Case(
+        CorruptRecording,
+        r"moved-joint\.mcap: the step message at step 0 \(chunk at byte \d+\) is invalid: "
+        r"truth\.joint_positions are not the positions of its angles \[330, 3, 357\]",
+        reach=Recording.steps,
+        command=("table", "-o", "{tmp}/moved-joint.parquet"),
+    ),
     "step-gap": Case(
         CorruptRecording,
         r"step-gap\.mcap: step 50: expected step 50 in this place, found step 51",
@@ -276,6 +283,11 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
         step["agent"]["action"] = 1.5
 
     rewrite(original, files["bad-step"], message=edit_json("/rsstp/step", 17, set_action))
+
+    def move_the_tip(step: dict[str, Any]) -> None:
+        step["truth"]["joint_positions"][-1][0] += 1e-9  # the first message of the first chunk
+
+    rewrite(original, files["moved-joint"], message=edit_json("/rsstp/step", 0, move_the_tip))
 
     def drop_step_50(topic: str, log_time: int, data: bytes) -> bytes | None:
         return None if topic == "/rsstp/step" and log_time == 50_000_000 else data
