@@ -279,8 +279,9 @@ class StepColumns:
             if self.n_rows and self.blocked[0]:
                 raise BadStep("truth.blocked: expected false at step 0 (the reset)", step=0)
 
-    def frame(self) -> pd.DataFrame:
-        """The steps table (see :meth:`rsstp_replay.Recording.steps` for the columns)."""
+    def frame(self, *, geometry: bool = True) -> pd.DataFrame:
+        """The steps table (see :meth:`rsstp_replay.Recording.steps` for the columns);
+        ``geometry=False`` leaves out the joint positions and distances."""
         n = self.n_rows
         action_mask = np.zeros(n, np.bool_)
         action_mask[self.action_nulls] = True
@@ -304,6 +305,7 @@ class StepColumns:
             )
             for j in range(self.n_joints):
                 columns[f"angle_deg_{j}"] = self.angles_deg[j]
+        if self.truth and geometry:
             positions, distances = pose_numbers(self._geometry(), self.angles_deg.T)
             for k in range(self.n_joints + 1):
                 columns[f"joint{k}_x"] = positions[:, k, 0]

@@ -128,7 +128,7 @@ class FakeRecording:
     def n_steps(self) -> int:
         return len(self._steps) - 1
 
-    def steps(self) -> pd.DataFrame:
+    def steps(self, *, geometry: bool = True) -> pd.DataFrame:
         return self._steps.copy()
 
     def memory(self) -> Memory:
@@ -234,5 +234,5 @@ class StaticRecording:
     def model_versions(self) -> list[records.ModelRecord]:
         return list(self._models)
 
-    def steps(self) -> pd.DataFrame:
+    def steps(self, *, geometry: bool = True) -> pd.DataFrame:
         return self._steps.copy()

@@ -115,7 +115,7 @@ def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
         def __init__(self, table: object) -> None:
             self.table = table
 
-        def steps(self) -> object:
+        def steps(self, *, geometry: bool = True) -> object:
             return self.table
 
         def model_versions(self) -> list[ModelRecord]:

@@ -35,7 +35,7 @@ _Ints = npt.NDArray[np.int64]
 class ContractSource(Protocol):
     """What the contract check reads of a recording."""
 
-    def steps(self) -> pd.DataFrame: ...
+    def steps(self, *, geometry: bool = True) -> pd.DataFrame: ...
     def model_versions(self) -> Sequence[ModelRecord]: ...
 
 
@@ -89,7 +89,7 @@ def version_index(versions: Sequence[ModelRecord], steps: _Ints) -> _Ints:
 
 def check_contract(source: ContractSource) -> ContractFindings:
     """Check every step against the model messages (see the module docstring)."""
-    table = source.steps()
+    table = source.steps(geometry=False)
     versions = list(source.model_versions())
     step = table["step"].to_numpy(np.int64)
     state = table["internal_state"].to_numpy(np.int64)

@@ -136,7 +136,7 @@ def run_audits(source: AuditSource) -> AuditReport:
     The memory, the model messages and the steps table are read once, and the memory is
     audited once for consistency (the summary reuses that audit).
     """
-    steps = source.steps()  # first: a recording then builds the memory from the same decode
+    steps = source.steps(geometry=False)  # first: the memory then comes from the same decode
     loaded = _Loaded(source.memory(), source.model_versions(), steps)
     memory = loaded.memory()
     consistency = audit_consistency(memory)
@@ -168,7 +168,7 @@ class _Loaded:
     def model_versions(self) -> Sequence[ModelRecord]:
         return self._models
 
-    def steps(self) -> pd.DataFrame:
+    def steps(self, *, geometry: bool = True) -> pd.DataFrame:
         return self._steps
 
 

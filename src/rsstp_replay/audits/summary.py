@@ -39,11 +39,12 @@ class AuditSource(HasMemory, HasModelVersions, Protocol):
 
     - ``memory()``: the agent's :class:`~rsstp_sim.memory.Memory`;
     - ``model_versions()``: the ``/rsstp/model`` messages, in order;
-    - ``steps()``: one row per step (0 is the reset) with at least the boolean columns
-      ``blocked`` and ``no_transition``.
+    - ``steps(geometry=False)``: one row per step (0 is the reset) with at least the boolean
+      columns ``blocked`` and ``no_transition`` (``geometry=False``: the joint positions and
+      obstacle distances may be left out, the audits do not read them).
     """
 
-    def steps(self) -> pd.DataFrame: ...
+    def steps(self, *, geometry: bool = True) -> pd.DataFrame: ...
 
 
 @dataclass(frozen=True, slots=True)
@@ -181,7 +182,7 @@ def audit_summary(
         raise ModelError("summary: no model message (a recording has one at step 0)")
     if consistency is None:
         consistency = audit_consistency(memory)
-    steps = source.steps()
+    steps = source.steps(geometry=False)
     kinds = Counter(
         operation.kind for record in records for operation in record.operations if operation.changed
     )
