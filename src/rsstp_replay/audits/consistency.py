@@ -262,13 +262,15 @@ def _validated(
     )
 
 
-def _prefix_doubling_ranks(symbols: _IntArray) -> list[_IntArray]:
+def _prefix_doubling_ranks(symbols: _IntArray) -> list[npt.NDArray[np.integer[Any]]]:
     """Ranks of every suffix's prefixes of length 1, 2, 4, ...: ``levels[e][p] == levels[e][q]``
     iff the suffixes at ``p`` and ``q`` agree on their first ``2**e`` symbols (shorter suffixes
     sort first). Stops as soon as all ranks differ: the last level is the suffix order."""
     size = len(symbols)
     rank = np.unique(symbols, return_inverse=True)[1].astype(np.int64)
-    levels = [rank]
+    # Kept as int32 where they fit (ranks < size): the levels are most of the audit's memory.
+    store: type[np.integer[Any]] = np.int32 if size < 2**31 else np.int64
+    levels: list[npt.NDArray[np.integer[Any]]] = [rank.astype(store)]
     distinct = int(rank.max()) + 1
     half = 1
     while distinct < size:
@@ -282,14 +284,14 @@ def _prefix_doubling_ranks(symbols: _IntArray) -> list[_IntArray]:
         np.not_equal(sorted_key[1:], sorted_key[:-1], out=new_group[1:])
         rank = np.empty(size, dtype=np.int64)
         rank[by_key] = np.cumsum(new_group)
-        levels.append(rank)
+        levels.append(rank.astype(store))
         distinct = int(rank[by_key[-1]]) + 1
         half *= 2
     return levels
 
 
 def _common_prefix_lengths(
-    left: _IntArray, right: _IntArray, rank_levels: list[_IntArray]
+    left: _IntArray, right: _IntArray, rank_levels: list[npt.NDArray[np.integer[Any]]]
 ) -> _IntArray:
     """Longest common prefix of the suffixes at ``left[x]`` and ``right[x]`` (all distinct),
     by binary lifting over the doubling levels (it is below ``2**(len(rank_levels) - 1)``)."""
