@@ -1,4 +1,4 @@
-"""``rsstp-replay``: look into a recording: ``info``, ``table``, ``audit``, ``compare``.
+"""``rsstp-replay``: look into a recording: ``info``, ``check``, ``table``, ``audit``, ``compare``.
 
 Bad input (a missing or damaged file, a file from another tool, a schema version this reader
 does not know, a step out of range) gets one line on stderr naming the file and the problem,
@@ -26,6 +26,7 @@ __all__ = ["main"]
 PROG = "rsstp-replay"
 _TABLE_FORMATS = (".parquet", ".csv")
 _FAIL_ON = (
+    "contract",
     "contradiction",
     "nondeterministic",
     "not-learned",
@@ -155,6 +156,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
             print("\n== truth ==")
             print(truth.to_text(verdict=False), end="")
     findings = {
+        "contract": (not report.contract.holds, "the steps break the recording contract"),
         "contradiction": (
             report.has_contradiction,
             "the memory contradicts a state of the final model version",
@@ -178,6 +180,24 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         print(f"{PROG}: audit failed: {'; '.join(failed)}", file=sys.stderr)
         return 1
     return 0
+
+
+def _cmd_check(args: argparse.Namespace) -> int:
+    from rsstp_replay.audits import check_contract
+
+    with _open(args.file) as recording:
+        findings = check_contract(recording)  # reads and checks every step and model message
+        events = len(recording.events())
+        versions = len(recording.model_versions())
+    if args.json:
+        print(json.dumps(findings.to_json(), indent=2))
+    else:
+        print(
+            f"{recording.path}: {recording.n_steps + 1:,} steps, {versions:,} model versions, "
+            f"{events:,} events: every chunk read and checked"
+        )
+        print(findings.to_text())
+    return 0 if findings.holds else 1
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
@@ -304,6 +324,13 @@ def _build_parser() -> Parser:
     p.add_argument("-o", "--output", required=True, help="output: .svg, .png, .pdf or .dot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(func=_cmd_graph)
+
+    p = sub.add_parser(
+        "check", help="check a recording's meaning: every step against its model version"
+    )
+    p.add_argument("file", help="the .mcap recording")
+    p.add_argument("--json", action="store_true", help="print the findings as JSON")
+    p.set_defaults(func=_cmd_check)
 
     p = sub.add_parser("compare", help="the thesis's compare of the sub-memories at N and M")
     p.add_argument("file", help="the .mcap recording")

@@ -57,6 +57,7 @@ class FakeRecording:
             {
                 "step": 0,
                 "action": None,
+                "state_before": None,
                 "internal_state": int(memory.internal_states[0]),
                 "sensation": bool(memory.sensations[0]),
                 "feedback": float(memory.feedback[0]),
@@ -78,6 +79,7 @@ class FakeRecording:
                 {
                     "step": outcome.step,
                     "action": outcome.action,
+                    "state_before": outcome.state_before,
                     "internal_state": outcome.state_after,
                     "sensation": bool(pose.sensation),
                     "feedback": float(pose.feedback),
@@ -90,6 +92,7 @@ class FakeRecording:
             {
                 "step": "int64",
                 "action": "Int64",
+                "state_before": "Int64",
                 "internal_state": "int64",
                 "sensation": bool,
                 "feedback": "float64",
@@ -219,6 +222,7 @@ class StaticRecording:
         self._models = list(models)
         self._memory = memory
         frame = memory.to_dataframe()
+        frame["state_before"] = frame["internal_state"].shift(1).astype("Int64")
         frame["model_version"] = np.int64(self._models[-1].version)
         frame["no_transition"] = False
         frame["blocked"] = False

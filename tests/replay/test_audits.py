@@ -291,7 +291,10 @@ def test_report_text_and_json() -> None:
         "consistency_within_versions",
         "consistency",
         "determinism",
+        "contract",
     }
+    assert data["contract"] == {"holds": True, "violations": []}
+    assert "contract: holds at every one of the" in text
     final = report.determinism.final.version
     in_final = any(found.version == final for found in within.contradictions)
     assert data["has_contradiction"] is report.has_contradiction is in_final

@@ -129,3 +129,45 @@ def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
     rules = {v.rule: v.step for v in found.violations}
     assert rules == {"state-chain": 20, "state-in-model": 30, "model-version": 35}
     assert "step 30 is in internal state 998" in found.to_text()
+
+
+def test_check_and_audit_gate_on_the_contract(tmp_path: Path) -> None:
+    """`rsstp-replay check` exits 0 on a recording that keeps the contract and 1 on one that
+    breaks it (a step edited to start in another state), naming the rule and the step; `audit
+    --fail-on contract` exits 1 on the same."""
+    import json
+    import subprocess
+    import sys
+
+    from test_corrupt import edit_json, rewrite
+
+    good = tmp_path / "good.mcap"
+    record(good, load_scenario("thesis-roulette"), make_strategy("roulette"), steps=40, seed=0)
+
+    def elsewhere(step: dict[str, object]) -> None:
+        agent = step["agent"]
+        assert isinstance(agent, dict)
+        agent["state_before"] = agent["internal_state"] = 0  # roulette has moved on from 0
+
+    bad = rewrite(good, tmp_path / "bad.mcap", message=edit_json("/rsstp/step", 25, elsewhere))
+
+    def cli(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            [sys.executable, "-m", "rsstp_replay", *args],
+            capture_output=True,
+            text=True,
+            timeout=120,
+        )
+
+    ok = cli("check", str(good))
+    assert ok.returncode == 0, ok.stderr
+    assert "contract: holds at every one of the 41 steps" in ok.stdout
+    broken = cli("check", str(bad))
+    assert broken.returncode == 1
+    assert "state-chain: from step 25 (2 step(s)): step 25 starts in state 0" in broken.stdout
+    as_json = json.loads(cli("check", "--json", str(bad)).stdout)
+    assert {v["rule"] for v in as_json["violations"]} == {"state-chain"}  # 0 is still a state
+    gated = cli("audit", str(bad), "--fail-on", "contract")
+    assert gated.returncode == 1
+    assert "the steps break the recording contract" in gated.stderr
+    assert cli("audit", str(good), "--fail-on", "contract").returncode == 0

@@ -34,6 +34,7 @@ from rsstp_replay.audits.consistency import (
     audit_consistency,
     audit_consistency_by_version,
 )
+from rsstp_replay.audits.contract import ContractFindings, check_contract
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.audits.summary import AuditSource, SummaryFindings, audit_summary
 from rsstp_sim.memory import Memory
@@ -50,6 +51,7 @@ class AuditReport:
     consistency: ConsistencyFindings
     determinism: DeterminismFindings
     within_versions: ConsistencyFindings
+    contract: ContractFindings
 
     @property
     def has_contradiction(self) -> bool:
@@ -79,6 +81,7 @@ class AuditReport:
             ("summary", self.summary.to_text()),
             ("consistency", self._consistency_text()),
             ("determinism", "determinism: " + self.determinism.to_text()),
+            ("contract", self.contract.to_text()),
         ]
         return "\n\n".join(f"== {title} ==\n{body}" for title, body in sections) + "\n"
 
@@ -127,6 +130,7 @@ class AuditReport:
             "consistency_within_versions": self.within_versions.to_json(),
             "consistency": self.consistency.to_json(),
             "determinism": self.determinism.to_json(),
+            "contract": self.contract.to_json(),
         }
 
 
@@ -153,6 +157,7 @@ def run_audits(source: AuditSource) -> AuditReport:
         consistency=consistency,
         determinism=audit_determinism(loaded),
         within_versions=within,
+        contract=check_contract(loaded),
     )
 
 
