@@ -279,9 +279,10 @@ class StepColumns:
             if self.n_rows and self.blocked[0]:
                 raise BadStep("truth.blocked: expected false at step 0 (the reset)", step=0)
 
-    def frame(self, *, geometry: bool = True) -> pd.DataFrame:
+    def frame(self, *, geometry: bool = True, copy: bool = False) -> pd.DataFrame:
         """The steps table (see :meth:`rsstp_replay.Recording.steps` for the columns);
-        ``geometry=False`` leaves out the joint positions and distances."""
+        ``geometry=False`` leaves out the joint positions and distances; ``copy=True`` gives a
+        table that shares no array with these columns."""
         n = self.n_rows
         action_mask = np.zeros(n, np.bool_)
         action_mask[self.action_nulls] = True
@@ -313,7 +314,7 @@ class StepColumns:
             for k in range(self.n_joints):
                 for j in range(self.n_obstacles):
                     columns[f"dist_{k}_{j}"] = distances[:, k, j]
-        return pd.DataFrame(columns, copy=False)
+        return pd.DataFrame(columns, copy=copy)
 
 
 def pose_numbers(
@@ -321,9 +322,13 @@ def pose_numbers(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Joint positions ``(B, n + 1, 2)`` and obstacle distances ``(B, n, m)`` of poses
     ``(B, n)``, computed as the recorder computes them."""
-    positions = joint_positions(angles_deg, geometry.lengths)
+    # A long run revisits its poses: each distinct pose is computed once (codes as the world's).
+    codes = angles_deg @ (360 ** np.arange(angles_deg.shape[1], dtype=np.int64))
+    _, first, index = np.unique(codes, return_index=True, return_inverse=True)
+    poses = angles_deg[first]
+    positions = joint_positions(poses, geometry.lengths)
     distances = obstacle_distances(positions[:, 1:], geometry.centers, geometry.radii)
-    return positions, distances
+    return positions[index], distances[index]
 
 
 def _nullable(values: list[int | None], first: int, nulls: list[int]) -> list[int] | Any:

@@ -228,7 +228,7 @@ class Recording:
         if self._full is None:  # decoded once: the audits of one command all read it
             self._full = self._step_columns(truth=True)
             self._agent = self._full
-        frame = self._full.frame(geometry=geometry).copy()  # the caller's own, to edit
+        frame = self._full.frame(geometry=geometry, copy=True)  # the caller's own, to edit
         if truth:
             from rsstp_replay.audits.truth import step_true_classes
 
