@@ -132,16 +132,16 @@ def _cmd_table(args: argparse.Namespace) -> int:
 
 def _cmd_audit(args: argparse.Namespace) -> int:
     from rsstp_replay.audits import audit_truth, run_audits
+    from rsstp_replay.audits.loaded import load
 
     fail_on = set(args.fail_on or [])
     needs_truth = fail_on & set(_TRUTH_GATES)
     if needs_truth and not args.truth:
         raise UsageError(f"--fail-on {sorted(needs_truth)[0]} needs --truth")
     with _open(args.file) as recording:
-        report = run_audits(recording)
-        truth = (
-            audit_truth(recording, within_versions=report.within_versions) if args.truth else None
-        )
+        loaded = load(recording)  # the steps decoded once for every audit
+        report = run_audits(loaded)
+        truth = audit_truth(loaded, within_versions=report.within_versions) if args.truth else None
     if args.json:
         document = report.to_json()
         if truth is not None:

@@ -155,7 +155,6 @@ class Recording:
         self.scenario = rebuild_scenario(container, self.scenario_record, self.metadata)
         self._agent_cache: dict[int, StepColumns] = {}
         self._agent: StepColumns | None = None
-        self._full: StepColumns | None = None
         self._models: tuple[ModelRecord, ...] | None = None
 
     # -- properties ------------------------------------------------------------------------
@@ -188,7 +187,6 @@ class Recording:
         """Drop the cached tables; later calls raise :class:`ReplayError`."""
         self._closed = True
         self._agent = None
-        self._full = None
         self._agent_cache.clear()
         self._models = None
 
@@ -225,10 +223,7 @@ class Recording:
         do not read: a tenth of the memory per step).
         """
         self._check_open()
-        if self._full is None:  # decoded once: the audits of one command all read it
-            self._full = self._step_columns(truth=True)
-            self._agent = self._full
-        frame = self._full.frame(geometry=geometry, copy=True)  # the caller's own, to edit
+        frame = self._step_columns(truth=True).frame(geometry=geometry)
         if truth:
             from rsstp_replay.audits.truth import step_true_classes
 

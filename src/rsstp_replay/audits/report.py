@@ -22,12 +22,10 @@ defect; what was learned is the final model. :attr:`AuditReport.ever_nondetermin
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from rsstp_replay.audits.consistency import (
     ConsistencyFindings,
@@ -36,9 +34,8 @@ from rsstp_replay.audits.consistency import (
 )
 from rsstp_replay.audits.contract import ContractFindings, check_contract
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
+from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.summary import AuditSource, SummaryFindings, audit_summary
-from rsstp_sim.memory import Memory
-from rsstp_sim.recording.records import ModelRecord
 
 __all__ = ["AuditReport", "run_audits"]
 
@@ -135,14 +132,14 @@ class AuditReport:
 
 
 def run_audits(source: AuditSource) -> AuditReport:
-    """Run the consistency, determinism and summary audits over ``source`` (a recording).
+    """Run the consistency, determinism, summary and contract audits over ``source`` (a
+    recording, or a :class:`~rsstp_replay.audits.loaded.LoadedRecording` of one).
 
     The memory, the model messages and the steps table are read once, and the memory is
     audited once for consistency (the summary reuses that audit).
     """
-    steps = source.steps(geometry=False)  # first: the memory then comes from the same decode
-    loaded = _Loaded(source.memory(), source.model_versions(), steps)
-    memory = loaded.memory()
+    loaded = load(source)
+    steps, memory = loaded.steps(), loaded.memory()
     consistency = audit_consistency(memory)
     versions = steps["model_version"].to_numpy(np.int64)
     if len(versions) and (versions == versions[0]).all():  # one version: the same audit
@@ -159,22 +156,6 @@ def run_audits(source: AuditSource) -> AuditReport:
         within_versions=within,
         contract=check_contract(loaded),
     )
-
-
-class _Loaded:
-    """A source whose parts were read once (a recording may decode them on every call)."""
-
-    def __init__(self, memory: Memory, models: Sequence[ModelRecord], steps: pd.DataFrame) -> None:
-        self._memory, self._models, self._steps = memory, models, steps
-
-    def memory(self) -> Memory:
-        return self._memory
-
-    def model_versions(self) -> Sequence[ModelRecord]:
-        return self._models
-
-    def steps(self, *, geometry: bool = True) -> pd.DataFrame:
-        return self._steps
 
 
 _TEXT_LIMIT = 10

@@ -40,6 +40,7 @@ from numpy.typing import NDArray
 
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
 from rsstp_replay.audits.contract import version_index
+from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
@@ -307,10 +308,11 @@ def audit_truth(
     consistency audit within versions unless ``within_versions`` is (an
     :class:`~rsstp_replay.audits.report.AuditReport` has it)."""
     truth = compute_truth(source.scenario) if truth is None else truth
-    steps = source.steps(geometry=False)
+    loaded = load(source)
+    steps = loaded.steps()
     true_class = step_true_classes(steps, truth)
-    memory = source.memory()
-    versions = list(source.model_versions())
+    memory = loaded.memory()
+    versions = list(loaded.model_versions())
     states = np.asarray(memory.internal_states, dtype=np.int64)
     step_numbers = np.arange(len(states), dtype=np.int64)
     index = version_index(versions, step_numbers)

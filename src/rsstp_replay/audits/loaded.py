@@ -1,0 +1,69 @@
+"""A recording read once for several audits.
+
+Decoding a recording's steps is the cost of an audit (a million steps take seconds), and a
+command that runs several audits (``rsstp-replay audit --truth``) would otherwise decode them
+once per audit, and hold each copy. :func:`load` reads the steps table (without the joint
+positions and distances, which no audit reads), the model messages and the memory once; the
+memory is built from the table's columns, so nothing is decoded twice. The result has the
+methods the audits read, so it is passed to each audit in place of the recording.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Protocol
+
+import numpy as np
+import pandas as pd
+
+from rsstp_sim.memory import Memory
+from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.scenario import Scenario
+
+__all__ = ["LoadedRecording", "load"]
+
+
+class _Source(Protocol):
+    def steps(self, *, geometry: bool = True) -> pd.DataFrame: ...
+    def model_versions(self) -> Sequence[ModelRecord]: ...
+
+
+class LoadedRecording:
+    """The steps table, the model messages and the memory of a recording, read once."""
+
+    def __init__(self, source: _Source) -> None:
+        self.source = source
+        self._steps = source.steps(geometry=False)
+        self._models = tuple(source.model_versions())
+        table = self._steps
+        self._memory = Memory.from_arrays(
+            table["action"].to_numpy(np.int64, na_value=-1),
+            table["internal_state"].to_numpy(np.int64),
+            table["sensation"].to_numpy(np.bool_),
+            table["feedback"].to_numpy(np.float64),
+        )
+
+    @property
+    def scenario(self) -> Scenario:
+        scenario: Scenario = getattr(self.source, "scenario")  # noqa: B009 - not every source
+        return scenario
+
+    @property
+    def n_steps(self) -> int:
+        return len(self._steps) - 1
+
+    def steps(self, *, geometry: bool = True) -> pd.DataFrame:
+        """The steps table without the joint positions and distances (``geometry`` is
+        ignored: the audits do not read them)."""
+        return self._steps
+
+    def memory(self) -> Memory:
+        return self._memory
+
+    def model_versions(self) -> Sequence[ModelRecord]:
+        return self._models
+
+
+def load(source: _Source) -> LoadedRecording:
+    """``source`` read once (itself when it already is)."""
+    return source if isinstance(source, LoadedRecording) else LoadedRecording(source)
