@@ -251,3 +251,28 @@ def test_audit_of_memory_equals_columns() -> None:
 def test_bad_columns(columns: tuple[object, object, object], message: str) -> None:
     with pytest.raises(MemoryRangeError, match=message):
         find_contradictions(*columns)  # type: ignore[arg-type]
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    values=st.lists(st.integers(-1, 40), min_size=1, max_size=2000),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_range_minima_and_nearest_smaller_against_brute_force(values: list[int], seed: int):
+    """The O(n)-memory range minima (blocks of 256) and the pointer-jumping nearest position
+    with a value at most one's own, against plain Python."""
+    from rsstp_replay.audits.consistency import _nearest_at_most, _RangeMin
+
+    array = np.array(values, dtype=np.int64)
+    rng = np.random.default_rng(seed)
+    first = rng.integers(0, len(array), 300)
+    last = np.minimum(first + rng.integers(0, 1200, 300), len(array) - 1)
+    found = _RangeMin(array).query(first, last)
+    assert found.tolist() == [min(values[f : l + 1]) for f, l in zip(first, last, strict=True)]
+    fenced = np.array([-1, *values, -1], dtype=np.int64)  # as boundary_lcp: -1 at both ends
+    inner = np.arange(1, len(fenced) - 1)
+    before = _nearest_at_most(fenced, inner, step=-1)
+    after = _nearest_at_most(fenced, inner, step=1)
+    for p, b, a in zip(inner.tolist(), before.tolist(), after.tolist(), strict=True):
+        assert b == max(c for c in range(p) if fenced[c] <= fenced[p])
+        assert a == min(c for c in range(p + 1, len(fenced)) if fenced[c] <= fenced[p])

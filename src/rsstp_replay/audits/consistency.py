@@ -309,58 +309,106 @@ def _common_prefix_lengths(
 
 def _sibling_groups(boundary_lcp: _IntArray, boundaries: _IntArray) -> tuple[_IntArray, _IntArray]:
     """For each boundary ``b`` of depth ``d``: the sibling groups it separates are the sorted
-    entries ``[start, b)`` and ``[b, end)``, bounded by the nearest boundaries of depth ``<= d``."""
-    depth = boundary_lcp[boundaries]
-    mins = _RangeMin(boundary_lcp)
-    top = len(mins.levels) - 1
-    # Left: largest boundary c < b with boundary_lcp[c] <= d; boundary_lcp[0] == -1 stops it.
-    position = boundaries.copy()  # invariant: boundary_lcp[position:b] > d
-    for level in range(top, -1, -1):
-        span = 1 << level
-        candidate = position - span
-        move = candidate >= 0
-        move[move] = mins.levels[level][candidate[move]] > depth[move]
-        position[move] = candidate[move]
-    start = position - 1
-    # Right: smallest boundary c > b with boundary_lcp[c] <= d; boundary_lcp[-1] == -1 stops it.
-    position = boundaries + 1  # invariant: boundary_lcp[b+1:position] > d
-    last = len(boundary_lcp) - 1
-    for level in range(top, -1, -1):
-        span = 1 << level
-        move = position + span - 1 <= last
-        move[move] = mins.levels[level][position[move]] > depth[move]
-        position[move] += span
-    return start, position
+    entries ``[start, b)`` and ``[b, end)``, bounded by the nearest boundaries of depth ``<= d``
+    (``boundary_lcp`` is -1 at both ends, so there always is one)."""
+    return (
+        _nearest_at_most(boundary_lcp, boundaries, step=-1),
+        _nearest_at_most(boundary_lcp, boundaries, step=1),
+    )
+
+
+def _nearest_at_most(values: _IntArray, wanted: _IntArray, *, step: int) -> _IntArray:
+    """For each position ``p`` of ``wanted``, the nearest position ``c`` before it (``step``
+    -1) or after it (``step`` 1) with ``values[c] <= values[p]``; one must exist.
+
+    Pointer jumping over every position at once, ``O(n)`` memory: ``near[x]`` starts at the
+    neighbour and, while ``values[near[x]] > values[x]``, jumps to ``near[near[x]]`` (every
+    value strictly between ``x`` and ``near[x]`` stays above ``values[x]``), so a chain halves
+    each round.
+    """
+    size = len(values)
+    index_type = np.int32 if size < 2**31 else np.int64
+    near = np.arange(step, size + step, dtype=index_type)
+    np.clip(near, 0, size - 1, out=near)
+    active = np.flatnonzero(values[near] > values).astype(index_type)
+    while active.size:
+        near[active] = near[near[active]]
+        active = active[values[near[active]] > values[active]]
+    return near[wanted].astype(np.int64)
 
 
 class _RangeMin:
-    """Sparse table: ``levels[e][x] = min(values[x : x + 2**e])``."""
+    """Range minima in ``O(n)`` memory: minima of blocks of :data:`_BLOCK` values with a sparse
+    table over them, each value's minimum to the end and from the start of its block, and a
+    sparse table of the first levels for ranges inside one block."""
 
     def __init__(self, values: _IntArray) -> None:
-        self.levels = [values]
-        span = 1
-        while 2 * span <= len(values):
-            previous = self.levels[-1]
-            self.levels.append(np.minimum(previous[:-span], previous[span:]))
-            span *= 2
+        dtype = np.int32 if len(values) < 2**31 and values.max(initial=0) < 2**31 else np.int64
+        self.values: npt.NDArray[np.integer[Any]] = values.astype(dtype)
+        self.near = _sparse_table(self.values, levels=_BLOCK_LEVELS)
+        n_blocks = -(-len(values) // _BLOCK)
+        padded: npt.NDArray[np.integer[Any]] = np.full(
+            n_blocks * _BLOCK, np.iinfo(dtype).max, dtype
+        )
+        padded[: len(values)] = self.values
+        blocks = padded.reshape(n_blocks, _BLOCK)
+        self.from_start = np.minimum.accumulate(blocks, axis=1).ravel()
+        self.to_end = np.minimum.accumulate(blocks[:, ::-1], axis=1)[:, ::-1].ravel()
+        self.blocks = _sparse_table(blocks.min(axis=1), levels=None)
 
     def query(self, first: _IntArray, last: _IntArray) -> _IntArray:
         """``min(values[first[x] : last[x] + 1])`` for every ``x`` (non-empty ranges)."""
-        length = last - first + 1
-        level = np.zeros(len(first), dtype=np.int64)
-        while True:  # level = floor(log2(length)), exact in integers
-            grow = (2 << level) <= length
-            if not grow.any():
-                break
-            level += grow
         result = np.empty(len(first), dtype=np.int64)
-        for value in np.unique(level):
-            chosen = level == value
-            table = self.levels[int(value)]
-            result[chosen] = np.minimum(
-                table[first[chosen]], table[last[chosen] - (1 << int(value)) + 1]
-            )
+        block_first, block_last = first // _BLOCK, last // _BLOCK
+        inside = block_first == block_last
+        result[inside] = _table_min(self.near, first[inside], last[inside])
+        across = ~inside
+        f, lst = first[across], last[across]
+        bf, bl = block_first[across], block_last[across]
+        best = np.minimum(self.to_end[f], self.from_start[lst]).astype(np.int64)
+        middle = bl - bf > 1
+        best[middle] = np.minimum(
+            best[middle], _table_min(self.blocks, bf[middle] + 1, bl[middle] - 1)
+        )
+        result[across] = best
         return result
+
+
+_BLOCK_LEVELS = 9
+_BLOCK = 1 << (_BLOCK_LEVELS - 1)
+"""Values per block of :class:`_RangeMin` (256): ranges inside a block use the first levels."""
+
+
+def _sparse_table(
+    values: npt.NDArray[np.integer[Any]], *, levels: int | None
+) -> list[npt.NDArray[np.integer[Any]]]:
+    """``table[e][x] = min(values[x : x + 2**e])`` for ``e`` below ``levels`` (all: None)."""
+    table = [values]
+    span = 1
+    while 2 * span <= len(values) and (levels is None or len(table) < levels):
+        previous = table[-1]
+        table.append(np.minimum(previous[:-span], previous[span:]))
+        span *= 2
+    return table
+
+
+def _table_min(
+    table: list[npt.NDArray[np.integer[Any]]], first: _IntArray, last: _IntArray
+) -> _IntArray:
+    """``min(values[first[x] : last[x] + 1])`` from a sparse table covering those lengths."""
+    length = last - first + 1
+    level = np.zeros(len(first), dtype=np.int64)
+    while True:  # level = floor(log2(length)), exact in integers
+        grow = (2 << level) <= length
+        if not grow.any():
+            break
+        level += grow
+    result = np.empty(len(first), dtype=np.int64)
+    for value in np.unique(level):
+        chosen = level == value
+        rows = table[int(value)]
+        result[chosen] = np.minimum(rows[first[chosen]], rows[last[chosen] - (1 << int(value)) + 1])
+    return result
 
 
 def _per_state(
