@@ -268,7 +268,7 @@ def test_range_minima_and_nearest_smaller_against_brute_force(values: list[int],
     first = rng.integers(0, len(array), 300)
     last = np.minimum(first + rng.integers(0, 1200, 300), len(array) - 1)
     found = _RangeMin(array).query(first, last)
-    assert found.tolist() == [min(values[f : l + 1]) for f, l in zip(first, last, strict=True)]
+    assert found.tolist() == [min(values[f : e + 1]) for f, e in zip(first, last, strict=True)]
     fenced = np.array([-1, *values, -1], dtype=np.int64)  # as boundary_lcp: -1 at both ends
     inner = np.arange(1, len(fenced) - 1)
     before = _nearest_at_most(fenced, inner, step=-1)
