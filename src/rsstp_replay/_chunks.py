@@ -13,6 +13,8 @@ import zlib
 from collections.abc import Callable
 from pathlib import Path
 
+import numpy as np
+import numpy.typing as npt
 import zstandard
 from mcap.opcode import Opcode
 
@@ -24,6 +26,7 @@ __all__ = [
     "chunk_records",
     "message_channels",
     "message_times",
+    "messages_at",
     "split_messages",
 ]
 
@@ -35,6 +38,38 @@ _MESSAGE = struct.Struct("<BQH")  # opcode, record length, channel id
 _MESSAGE_HEAD = 31  # opcode 1, length 8, channel 2, sequence 4, log_time 8, publish_time 8
 _CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
 _MESSAGE_OP = int(Opcode.MESSAGE)
+
+
+def messages_at(
+    path: Path, data: bytes, offsets: npt.NDArray[np.int64], channel: int, *, where: int
+) -> list[memoryview]:
+    """The data of the message records of ``channel`` that start at ``offsets`` in ``data``
+    (from the chunk's message index: no walk over the other records); each offset is checked
+    to hold a message record of that channel inside the chunk."""
+    size = len(data)
+    if len(offsets) and (int(offsets[0]) < 0 or int(offsets[-1]) + _MESSAGE_HEAD > size):
+        raise CorruptRecording(
+            f"{path}: the message index of the chunk at byte {where} points outside it"
+        )
+    raw = np.frombuffer(data, np.uint8)
+    head = raw[offsets[:, None] + np.arange(11)]  # opcode, length (8), channel (2)
+    lengths = head[:, 1:9].copy().view("<u8").ravel().astype(np.int64)
+    channels = head[:, 9:11].copy().view("<u2").ravel()
+    ends = offsets + 9 + lengths
+    if len(offsets) and (
+        (head[:, 0] != _MESSAGE_OP).any()
+        or (channels != channel).any()
+        or (lengths < _MESSAGE_HEAD - 9).any()
+        or int(ends.max()) > size
+    ):
+        raise CorruptRecording(
+            f"{path}: the message index of the chunk at byte {where} does not point at "
+            f"messages of channel {channel}"
+        )
+    view = memoryview(data)
+    return [
+        view[a:b] for a, b in zip((offsets + _MESSAGE_HEAD).tolist(), ends.tolist(), strict=True)
+    ]
 
 
 def split_messages(

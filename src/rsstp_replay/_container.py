@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO
 
+import numpy as np
+import numpy.typing as npt
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import McapError
 from mcap.opcode import Opcode
@@ -37,13 +39,15 @@ _PARSE_ERRORS = (McapError, struct.error, ValueError, UnicodeDecodeError, KeyErr
 @dataclass(frozen=True, slots=True)
 class ChunkRef:
     """Where a chunk record is (``offset`` of its opcode, ``length`` of the whole record), the
-    ``log_time`` range of its messages, and its channel ids (``None``: unknown)."""
+    ``log_time`` range of its messages, its channel ids (``None``: unknown) and, from a
+    finished file's chunk index, where each channel's message index record is."""
 
     offset: int
     length: int
     start_ns: int
     end_ns: int
     channels: frozenset[int] | None
+    indexes: dict[int, int] | None = None
 
 
 @dataclass(slots=True)
@@ -90,6 +94,33 @@ class Container:
                 f"{ref.length} bytes, the file ends after {len(raw)}"
             )
         return chunk_records(self.path, raw, ref.offset)
+
+    def message_offsets(self, stream: BinaryIO, ref: ChunkRef, channel: int) -> _Offsets | None:
+        """Where the messages of ``channel`` start in the chunk's records, in order, from the
+        chunk's message index (None when the file has none for it)."""
+        if ref.indexes is None or channel not in ref.indexes:
+            return None
+        at = ref.indexes[channel]
+        stream.seek(at)
+        head = stream.read(_INDEX_HEAD.size)
+        if len(head) != _INDEX_HEAD.size:
+            return None
+        opcode, _, found, size = _INDEX_HEAD.unpack(head)
+        if opcode != Opcode.MESSAGE_INDEX or found != channel or size % 16:
+            raise CorruptRecording(
+                f"{self.path}: the message index at byte {at} is not that of channel {channel} "
+                f"(opcode 0x{opcode:02x}, channel {found})"
+            )
+        body = stream.read(size)
+        if len(body) != size:
+            raise CorruptRecording(f"{self.path}: the message index at byte {at} is truncated")
+        entries = np.frombuffer(body, dtype=np.dtype([("log_time", "<u8"), ("offset", "<u8")]))
+        return np.sort(entries["offset"].astype(np.int64))
+
+
+_INDEX_HEAD = struct.Struct("<BQHI")
+"""A message index record's opcode, length, channel id and the byte length of its entries."""
+_Offsets = npt.NDArray[np.int64]
 
 
 def open_container(path: str | os.PathLike[str]) -> Container:
@@ -171,6 +202,7 @@ def _read_finished(path: Path, stream: BinaryIO, size: int, footer_at: int) -> C
                 index.message_start_time,
                 index.message_end_time,
                 frozenset(index.message_index_offsets) or None,
+                dict(index.message_index_offsets) or None,
             )
         )
     for attachment in summary.attachment_indexes:

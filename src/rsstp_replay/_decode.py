@@ -322,13 +322,19 @@ def pose_numbers(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Joint positions ``(B, n + 1, 2)`` and obstacle distances ``(B, n, m)`` of poses
     ``(B, n)``, computed as the recorder computes them."""
-    # A long run revisits its poses: each distinct pose is computed once (codes as the world's).
-    codes = angles_deg @ (360 ** np.arange(angles_deg.shape[1], dtype=np.int64))
-    _, first, index = np.unique(codes, return_index=True, return_inverse=True)
-    poses = angles_deg[first]
-    positions = joint_positions(poses, geometry.lengths)
-    distances = obstacle_distances(positions[:, 1:], geometry.centers, geometry.radii)
-    return positions[index], distances[index]
+    if len(angles_deg) > 1024:  # a long run revisits its poses: each distinct pose once
+        codes = angles_deg @ (360 ** np.arange(angles_deg.shape[1], dtype=np.int64))
+        _, first, index = np.unique(codes, return_index=True, return_inverse=True)
+        positions, distances = _pose_numbers(geometry, angles_deg[first])
+        return positions[index], distances[index]
+    return _pose_numbers(geometry, angles_deg)
+
+
+def _pose_numbers(
+    geometry: ArmGeometry, angles_deg: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    positions = joint_positions(angles_deg, geometry.lengths)
+    return positions, obstacle_distances(positions[:, 1:], geometry.centers, geometry.radii)
 
 
 def _nullable(values: list[int | None], first: int, nulls: list[int]) -> list[int] | Any:

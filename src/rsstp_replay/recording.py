@@ -30,7 +30,7 @@ import msgspec
 import numpy as np
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
-from rsstp_replay._chunks import message_times
+from rsstp_replay._chunks import message_times, messages_at
 from rsstp_replay._chunks import split_messages as _split
 from rsstp_replay._container import ChunkRef, Container, open_container
 from rsstp_replay._contract import (
@@ -338,11 +338,21 @@ class Recording:
                 if limit is not None and ref.start_ns >= limit:
                     break
                 data = self._container.chunk_data(stream, ref)
+                cut = limit if limit is not None and ref.end_ns >= limit else None
+                if topic == "/rsstp/step" and cut is None:
+                    offsets = self._container.message_offsets(stream, ref, channel)
+                    if offsets is not None:  # a finished file: its index says where they are
+                        yield (
+                            ref,
+                            data,
+                            messages_at(self.path, data, offsets, channel, where=ref.offset),
+                            [],
+                        )
+                        continue
                 parts: dict[int, list[memoryview]] = {channel: []}
                 times: dict[int, list[int]] | None = None
                 if topic != "/rsstp/step":
                     times = {channel: []}
-                cut = limit if limit is not None and ref.end_ns >= limit else None
                 _split(self.path, data, parts, where=ref.offset, limit_ns=cut, times=times)
                 yield ref, data, parts[channel], [] if times is None else times[channel]
 

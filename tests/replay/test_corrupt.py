@@ -419,3 +419,29 @@ def test_cli_prints_one_line_and_exits_with_2(
     assert lines[0].startswith("rsstp-replay: error: ")
     assert str(damaged[name]) in lines[0]
     assert re.search(CASES[name].match, lines[0]), lines[0]
+
+
+def test_a_message_index_that_points_elsewhere_is_refused(original: Path, tmp_path: Path) -> None:
+    """A finished file's steps are found through each chunk's message index; an index entry
+    that does not point at a step message (here: moved by one byte) is one clear error."""
+    from rsstp_replay._container import open_container
+
+    container = open_container(original)
+    ref = container.chunks[1]
+    with open_recording(original) as recording:
+        step_channel = recording._channels["/rsstp/step"]
+    assert ref.indexes is not None
+    at = ref.indexes[step_channel]
+    raw = bytearray(original.read_bytes())
+    entry = at + 15 + 8  # the first entry's offset field (after opcode, length, channel, size)
+    offset = int.from_bytes(raw[entry : entry + 8], "little")
+    raw[entry : entry + 8] = (offset + 1).to_bytes(8, "little")
+    bad = tmp_path / "moved-index.mcap"
+    bad.write_bytes(bytes(raw))
+    with open_recording(bad) as recording, pytest.raises(CorruptRecording) as caught:
+        recording.steps()
+    assert re.fullmatch(
+        rf"{re.escape(str(bad))}: the message index of the chunk at byte {ref.offset} does "
+        rf"not point at messages of channel {step_channel}",
+        str(caught.value),
+    )

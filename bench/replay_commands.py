@@ -1,0 +1,121 @@
+"""Replay commands end to end, as a user runs them: ``table``, ``audit``, ``audit --truth``.
+
+    python bench/replay_commands.py                  # 1,000,000 steps
+    python bench/replay_commands.py --steps 10000000 --only audit
+
+Each command runs in a fresh process (``rsstp-replay`` beside this interpreter), cold: its
+wall time includes starting Python and the imports. Peak memory is the child's maximum RSS
+(``resource.getrusage(RUSAGE_CHILDREN)`` of a fresh runner process per command). The recording
+is ``rsstp-sim record three-joint --strategy random --seed 1 --steps N``, made once and kept as
+``/tmp/rsstp-bench-three-joint-N.mcap``. The machine's load average is printed: these are
+wall-clock figures and other work slows them.
+
+Targets (issue "Speed where users feel it", point 5), a million steps: ``table`` to parquet
+<= 3 s, ``audit`` <= 5 s, ``audit --truth`` <= 10 s, each <= 1.5 GiB; ten million steps:
+``audit`` within 3 GiB.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+BIN = Path(sys.executable).parent
+TARGETS_1M = {"table": (3.0, 1.5), "audit": (5.0, 1.5), "audit --truth": (10.0, 1.5)}
+TARGET_10M_GIB = 3.0
+
+_RUNNER = """
+import resource, subprocess, sys, time
+began = time.perf_counter()
+done = subprocess.run(sys.argv[1:], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+seconds = time.perf_counter() - began
+peak_kib = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+print(done.returncode, seconds, peak_kib, done.stderr.decode().strip().replace(chr(10), " | "))
+"""
+
+
+def recording(steps: int) -> Path:
+    path = Path(tempfile.gettempdir()) / f"rsstp-bench-three-joint-{steps}.mcap"
+    if not path.exists():
+        partial = path.with_suffix(".partial.mcap")
+        print(f"recording {steps:,} steps to {path} (once)...", flush=True)
+        subprocess.run(
+            [
+                str(BIN / "rsstp-sim"),
+                "record",
+                "three-joint",
+                "--strategy",
+                "random",
+                "--seed",
+                "1",
+                "--steps",
+                str(steps),
+                "-o",
+                str(partial),
+                "--force",
+            ],
+            check=True,
+            stdout=subprocess.DEVNULL,
+        )
+        partial.rename(path)
+    return path
+
+
+def measure(command: list[str]) -> tuple[float, float]:
+    """Wall seconds and peak RSS (GiB) of ``command`` in a fresh process."""
+    done = subprocess.run(
+        [sys.executable, "-c", _RUNNER, *command], capture_output=True, text=True, check=True
+    )
+    code, seconds, peak_kib, stderr = done.stdout.split(" ", 3)
+    if int(code) not in (0, 1):  # audit exits 1 on a finding it was asked to gate on
+        sys.exit(f"{' '.join(command)} failed ({code}): {stderr}")
+    return float(seconds), int(peak_kib) / 2**20
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--steps", type=int, default=1_000_000)
+    parser.add_argument("--only", choices=sorted(TARGETS_1M), action="append")
+    parser.add_argument("--repeat", type=int, default=2)
+    args = parser.parse_args()
+    mcap = recording(args.steps)
+    replay = str(BIN / "rsstp-replay")
+    out = Path(tempfile.gettempdir()) / "rsstp-bench-table.parquet"
+    commands = {
+        "table": [replay, "table", str(mcap), "-o", str(out), "--force"],
+        "audit": [replay, "audit", str(mcap)],
+        "audit --truth": [replay, "audit", "--truth", str(mcap)],
+    }
+    print(
+        f"{args.steps:,} steps, {mcap.stat().st_size / 1e6:.1f} MB; load {os.getloadavg()[0]:.1f}"
+    )
+    for name in args.only or list(commands):
+        runs = [measure(commands[name]) for _ in range(args.repeat)]
+        seconds = [s for s, _ in runs]
+        peak = max(p for _, p in runs)
+        if args.steps == 1_000_000:
+            target_s, target_gib = TARGETS_1M[name]
+            verdict = (
+                f"(targets {target_s:g} s, {target_gib:g} GiB: "
+                f"{'met' if min(seconds) <= target_s and peak <= target_gib else 'NOT met'})"
+            )
+        elif args.steps == 10_000_000 and name == "audit":
+            verdict = (
+                f"(target {TARGET_10M_GIB:g} GiB: {'met' if peak <= TARGET_10M_GIB else 'NOT met'})"
+            )
+        else:
+            verdict = ""
+        shown = ", ".join(f"{s:.2f}" for s in seconds)
+        print(
+            f"{name:<14} cold, fresh process: {shown} s; peak {peak:.2f} GiB "
+            f"({peak * 2**30 / (args.steps + 1):.0f} bytes/step) {verdict}"
+        )
+    print(f"load {os.getloadavg()[0]:.1f}")
+
+
+if __name__ == "__main__":
+    main()
