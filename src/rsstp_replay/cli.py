@@ -112,7 +112,12 @@ def _cmd_table(args: argparse.Namespace) -> int:
     if not parent.is_dir():
         raise UsageError(f"{out}: the output directory {parent} does not exist")
     with _open(args.file) as recording:
-        table = recording.steps()
+        if args.truth:
+            from rsstp_replay.audits import truth_table
+
+            table = truth_table(recording)
+        else:
+            table = recording.steps()
     partial = out.with_name(f".{out.name}.partial")
     try:
         if out.suffix.lower() == ".parquet":
@@ -287,6 +292,13 @@ def _build_parser() -> Parser:
     p.add_argument("file", help="the .mcap recording")
     p.add_argument("-o", "--output", required=True, help="the table: .parquet or .csv")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.add_argument(
+        "--truth",
+        action="store_true",
+        help="add the ground truth of every step: true_class, pose (index among the reachable "
+        "poses) and aliased (its internal state stood for several true classes under its "
+        "model version)",
+    )
     p.set_defaults(func=_cmd_table)
 
     p = sub.add_parser("audit", help="consistency, determinism and summary audits")

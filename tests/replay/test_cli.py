@@ -19,7 +19,7 @@ import pandas as pd
 import pytest
 
 from rsstp_replay import open_recording
-from rsstp_replay.audits import compare, run_audits
+from rsstp_replay.audits import audit_truth, compare, run_audits
 from rsstp_replay.cli import main
 from rsstp_sim import AgentView, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording.recorder import record
@@ -118,6 +118,24 @@ def test_table_writes_parquet(
     assert printed == f"wrote 1,501 rows and 27 columns to {out}\n"
     expected = open_recording(run).steps()
     pd.testing.assert_frame_equal(pd.read_parquet(out), expected)
+
+
+def test_table_truth_adds_class_pose_and_aliasing(
+    run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "truth.parquet"
+    code, printed, err = run_cli(capsys, "table", str(run), "--truth", "-o", str(out))
+    assert (code, err) == (0, "")
+    assert printed == f"wrote 1,501 rows and 30 columns to {out}\n"
+    table = pd.read_parquet(out)
+    with open_recording(run) as recording:
+        findings = audit_truth(recording)
+        truth = recording.ground_truth()
+        pd.testing.assert_frame_equal(table.iloc[:, :27], recording.steps())
+    assert table["true_class"].tolist() == findings.true_class.tolist()
+    assert table["aliased"].tolist() == findings.aliased_step.tolist()
+    angles = table[[f"angle_deg_{j}" for j in range(truth.n_joints)]].to_numpy()
+    assert (truth.angles_deg[table["pose"].to_numpy()] == angles).all()
 
 
 def test_table_writes_csv(run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
