@@ -1,17 +1,25 @@
-"""Benchmark: a recording to a Rerun ``.rrd`` file, as ``rsstp-replay view FILE --save OUT`` does.
+"""Benchmark: recordings to Rerun ``.rrd`` files, as ``rsstp-replay view FILE --save OUT`` does.
 
-    python bench/viewer.py                       # 100,000 steps of three-joint, random, seed 1
-    python bench/viewer.py --steps 10000 --repeat 5
-    python bench/viewer.py --screenshot docs/viewer.png
+    python bench/viewer.py                        # the three cases of the issue's budgets
+    python bench/viewer.py --case learner --repeat 5
+    python bench/viewer.py --screenshot docs/viewer.png --rrd run.rrd [--wait 40]
 
-The recording is made first if ``--mcap`` does not exist (``rsstp-sim record three-joint
---strategy random --steps N --seed 1``). Each run prints the parts (reading the MCAP, audits and
-graph layout, Rerun: building and sending the columns and writing the file) and the total from
-``open_recording`` to the finished file; the target is 3 s for 100,000 steps.
+The cases (recordings made once under the temporary folder if missing):
 
-``--screenshot`` renders the web viewer on a saved ``.rrd`` in headless Chromium (software
-WebGL) and saves a PNG. Its recording is a short three-joint run of the tests' ``RandomRefiner``
-(random splits, merges, adds and deletes), so that the model has something to show.
+- ``splitter``: ``rsstp-sim record thesis-roulette --strategy splitter --steps 3000 --seed 0``
+  (1,695 model versions): <= 5 s, <= 500 MiB peak, .rrd <= 20 MB;
+- ``learner``: ``recordings/two-joint-30-learner.mcap`` (12,000 steps, 433 versions): <= 5 s;
+- ``random-1m``: ``rsstp-sim record three-joint --strategy random --steps 1000000 --seed 1``:
+  <= 10 s, <= 1 GiB peak, .rrd <= 1.5 x the .mcap.
+
+Each case is timed twice over: cold, end to end in a fresh process (``rsstp-replay view ...
+--save``, Python's start and imports included; the peak RSS is that process's), and in this
+process (``open_recording`` to the finished file, the parts printed). Wall-clock figures: the
+load average is printed with them.
+
+``--screenshot`` serves an ``.rrd`` with ``rerun --serve-web`` on 127.0.0.1, renders it in
+headless Chromium (Debian's ``chromium``, software WebGL) over the DevTools protocol, waits
+``--wait`` seconds for the viewer to load the file, and saves a PNG.
 """
 
 from __future__ import annotations
@@ -20,6 +28,7 @@ import argparse
 import base64
 import json
 import os
+import resource
 import shutil
 import signal
 import socket
@@ -34,70 +43,153 @@ from typing import Any
 
 from rsstp_replay.recording import open_recording
 from rsstp_replay.viewer import view
-from rsstp_sim.recording import record
-from rsstp_sim.scenario import load_scenario
-from rsstp_sim.strategies import RandomStrategy
 
-TARGET_S = 3.0
 ROOT = Path(__file__).resolve().parents[1]
+BIN = Path(sys.executable).parent
+TMP = Path(tempfile.gettempdir())
+CASES: dict[str, dict[str, Any]] = {
+    "splitter": {
+        "record": ["thesis-roulette", "--strategy", "splitter", "--steps", "3000", "--seed", "0"],
+        "seconds": 5.0,
+        "peak_mib": 500.0,
+        "rrd_mb": 20.0,
+    },
+    "learner": {"file": ROOT / "recordings" / "two-joint-30-learner.mcap", "seconds": 5.0},
+    "random-1m": {
+        "record": ["three-joint", "--strategy", "random", "--steps", "1000000", "--seed", "1"],
+        "seconds": 10.0,
+        "peak_mib": 1024.0,
+        "rrd_ratio": 1.5,
+    },
+}
+
+_RUNNER = """
+import resource, subprocess, sys, time
+began = time.perf_counter()
+done = subprocess.run(sys.argv[1:], capture_output=True, text=True)
+print(done.returncode, time.perf_counter() - began,
+      resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss, done.stderr.strip()[-300:])
+"""
 
 
-def bench(mcap: Path, steps: int, repeat: int) -> None:
-    if not mcap.exists():
-        began = time.perf_counter()
-        record(mcap, load_scenario("three-joint"), RandomStrategy(), steps=steps, seed=1)
-        print(f"recorded {steps} steps to {mcap} in {time.perf_counter() - began:.1f} s")
-    with tempfile.TemporaryDirectory() as folder:
-        out = Path(folder) / "bench.rrd"
-        for run in range(repeat):
-            began = time.perf_counter()
-            with open_recording(mcap) as recording:
-                result = view(
-                    recording, save=out, spawn=False, serve_web=False, start=None, end=None
-                )
-            total = time.perf_counter() - began
-            s = result.summary
-            print(
-                f"run {run + 1}: {s.last_step + 1} steps, {s.model_versions} model versions: "
-                f"read {s.seconds_read:.2f} s, audits and layout {s.seconds_prepare:.2f} s, "
-                f"Rerun {result.seconds_rerun:.2f} s; total {total:.2f} s "
-                f"(target {TARGET_S:.0f} s: {'met' if total <= TARGET_S else 'NOT met'}); "
-                f"{out.stat().st_size / 1e6:.1f} MB"
-            )
+def recording_of(name: str) -> Path:
+    case = CASES[name]
+    if "file" in case:
+        return Path(case["file"])
+    path = TMP / f"rsstp-bench-view-{name}.mcap"
+    if not path.exists():
+        print(f"recording {name} to {path} (once)...", flush=True)
+        partial = path.with_suffix(".partial.mcap")
+        subprocess.run(
+            [str(BIN / "rsstp-sim"), "record", *case["record"], "-o", str(partial), "--force"],
+            check=True,
+            stdout=subprocess.DEVNULL,
+        )
+        partial.rename(path)
+    return path
+
+
+def bench(name: str, repeat: int) -> None:
+    case = CASES[name]
+    mcap = recording_of(name)
+    out = TMP / f"rsstp-bench-view-{name}.rrd"
+    print(f"== {name}: {mcap} ({mcap.stat().st_size / 1e6:.1f} MB); load {os.getloadavg()[0]:.1f}")
+    for run in range(repeat):
+        done = subprocess.run(
+            [
+                sys.executable,
+                "-c",
+                _RUNNER,
+                str(BIN / "rsstp-replay"),
+                "view",
+                str(mcap),
+                "--save",
+                str(out),
+                "--force",
+            ],
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+        code, seconds, peak_kib, err = done.stdout.split(" ", 3)
+        if code != "0":
+            sys.exit(f"view failed: {err}")
+        size_mb = out.stat().st_size / 1e6
+        peak_mib = int(peak_kib) / 1024
+        checks = [("s", float(seconds), case["seconds"])]
+        if "peak_mib" in case:
+            checks.append(("MiB peak", peak_mib, case["peak_mib"]))
+        if "rrd_mb" in case:
+            checks.append(("MB .rrd", size_mb, case["rrd_mb"]))
+        if "rrd_ratio" in case:
+            ratio = out.stat().st_size / mcap.stat().st_size
+            checks.append(("x the .mcap", ratio, case["rrd_ratio"]))
+        shown = "; ".join(
+            f"{value:.2f} {unit} (target {target:g}: {'met' if value <= target else 'NOT met'})"
+            for unit, value, target in checks
+        )
+        print(
+            f"  cold, fresh process, run {run + 1}: {shown}; {peak_mib:.0f} MiB peak, "
+            f"{size_mb:.1f} MB .rrd"
+        )
+    began = time.perf_counter()
+    with open_recording(mcap) as recording:
+        result = view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+    total = time.perf_counter() - began
+    s = result.summary
+    print(
+        f"  in-process (warm imports): {total:.2f} s: read {s.seconds_read:.2f} s, audits and "
+        f"placing {s.seconds_prepare:.2f} s, Rerun {result.seconds_rerun:.2f} s; "
+        f"{s.model_versions} model versions, {sum(s.rows.values()):,} rows; load "
+        f"{os.getloadavg()[0]:.1f}; peak RSS so far "
+        f"{resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MiB"
+    )
 
 
 # ------------------------------------------------------------------------------ screenshot
 
 
-def screenshot(png: Path, *, wait_s: float) -> None:
-    for program in ("rerun", "chromium"):
-        if shutil.which(program) is None:
-            sys.exit(f"bench/viewer.py: {program!r} not found (Debian: apt-get install chromium)")
-    sys.path.insert(0, str(ROOT / "tests" / "replay"))
-    from fakes import RandomRefiner  # the tests' refining strategy
-
+def screenshot(png: Path, rrd: Path, *, wait_s: float) -> None:
+    """Serve ``rrd`` to the web viewer on 127.0.0.1, load it in headless Chromium, save a PNG."""
+    chromium = shutil.which("chromium")
+    if chromium is None:
+        sys.exit("bench/viewer.py: 'chromium' not found (Debian: apt-get install chromium)")
     with tempfile.TemporaryDirectory() as folder:
-        mcap, rrd = Path(folder) / "demo.mcap", Path(folder) / "demo.rrd"
-        strategy = RandomRefiner(split=0.03, max_states=4)
-        record(mcap, load_scenario("three-joint"), strategy, steps=300, seed=3)
-        with open_recording(mcap) as recording:
-            view(recording, save=rrd, spawn=False, serve_web=False, start=0, end=270)
+        web, grpc = _free_port(), _free_port()
         server = subprocess.Popen(
-            ["rerun", "--serve-web", "--web-viewer-port", "9090", "--port", "9877", str(rrd)],
+            [
+                str(BIN / "rerun"),
+                "--serve-web",
+                "--bind",
+                "127.0.0.1",
+                "--web-viewer-port",
+                str(web),
+                "--port",
+                str(grpc),
+                str(rrd),
+            ],
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
             start_new_session=True,
         )
         try:
-            _wait_for_port(9090)
-            url = "http://127.0.0.1:9090/?url=" + urllib.request.quote(
-                "rerun+http://localhost:9877/proxy", safe=""
+            _wait_for_port(web)
+            url = f"http://127.0.0.1:{web}/?url=" + urllib.request.quote(
+                f"rerun+http://127.0.0.1:{grpc}/proxy", safe=""
             )
-            png.write_bytes(_capture(url, Path(folder) / "profile", wait_s=wait_s))
+            began = time.perf_counter()
+            png.write_bytes(_capture(chromium, url, Path(folder) / "profile", wait_s=wait_s))
         finally:
             os.killpg(server.pid, signal.SIGTERM)
             server.wait()
-    print(f"saved {png}")
+    print(f"saved {png} ({time.perf_counter() - began:.0f} s after the page was opened)")
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
 
 
 def _wait_for_port(port: int, timeout_s: float = 20.0) -> None:
@@ -110,12 +202,13 @@ def _wait_for_port(port: int, timeout_s: float = 20.0) -> None:
     raise TimeoutError(f"nothing listens on port {port}")
 
 
-def _capture(url: str, profile: Path, *, wait_s: float) -> bytes:
+def _capture(chromium: str, url: str, profile: Path, *, wait_s: float) -> bytes:
     """Load ``url`` in headless Chromium, wait, and return a PNG of the page."""
     profile.mkdir()
+    devtools_port = _free_port()
     browser = subprocess.Popen(
         [
-            "chromium",
+            chromium,
             "--headless",
             "--no-sandbox",
             "--disable-gpu",
@@ -125,7 +218,8 @@ def _capture(url: str, profile: Path, *, wait_s: float) -> bytes:
             "--disable-component-update",
             "--disable-sync",
             f"--user-data-dir={profile}",
-            "--remote-debugging-port=9222",
+            "--use-angle=swiftshader",
+            f"--remote-debugging-port={devtools_port}",
             "--window-size=1600,1000",
             "about:blank",
         ],
@@ -134,8 +228,8 @@ def _capture(url: str, profile: Path, *, wait_s: float) -> bytes:
         start_new_session=True,
     )
     try:
-        _wait_for_port(9222)
-        pages = json.load(urllib.request.urlopen("http://127.0.0.1:9222/json/list"))
+        _wait_for_port(devtools_port)
+        pages = json.load(urllib.request.urlopen(f"http://127.0.0.1:{devtools_port}/json/list"))
         page = next(p for p in pages if p["type"] == "page")
         devtools = _DevTools(page["webSocketDebuggerUrl"])
         devtools.call(
@@ -219,17 +313,19 @@ class _DevTools:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--steps", type=int, default=100_000)
-    parser.add_argument("--mcap", type=Path, default=None, help="default: /tmp/rsstp-bench-N.mcap")
-    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--case", choices=sorted(CASES), action="append")
+    parser.add_argument("--repeat", type=int, default=2)
     parser.add_argument("--screenshot", type=Path, default=None, metavar="PNG")
-    parser.add_argument("--wait", type=float, default=25.0, help="seconds before the screenshot")
+    parser.add_argument("--rrd", type=Path, default=None, help="the .rrd to screenshot")
+    parser.add_argument("--wait", type=float, default=30.0, help="seconds before the screenshot")
     args = parser.parse_args()
     if args.screenshot is not None:
-        screenshot(args.screenshot, wait_s=args.wait)
+        if args.rrd is None:
+            parser.error("--screenshot needs --rrd")
+        screenshot(args.screenshot, args.rrd, wait_s=args.wait)
         return
-    mcap = args.mcap or Path(tempfile.gettempdir()) / f"rsstp-bench-{args.steps}.mcap"
-    bench(mcap, args.steps, args.repeat)
+    for name in args.case or list(CASES):
+        bench(name, args.repeat)
 
 
 if __name__ == "__main__":

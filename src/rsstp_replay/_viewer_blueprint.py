@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-
 import numpy as np
 import rerun.blueprint as rrb
 
@@ -12,29 +10,18 @@ from rsstp_sim.scenario import Scenario
 
 __all__ = ["default_blueprint"]
 
-_GRAPH_MARGIN = 60.0
-"""Room around the outermost states in the graph view (points: label nodes stick out)."""
 
-
-def default_blueprint(
-    scenario: Scenario,
-    *,
-    first: int,
-    last: int,
-    positions: Mapping[int, tuple[float, float]],
-) -> rrb.Blueprint:
-    """The 2D world and the model graph side by side; below them the plots (sensation and
-    feedback, obstacle distances, model size, their time axes linked and showing steps
-    ``first .. last``) and the audit log; the ``step`` timeline selected.
-
-    The world view frames the arm's reach and the obstacles; the graph view frames every
-    state of ``positions`` (the viewer's coordinates, y down).
-    """
+def default_blueprint(scenario: Scenario, *, first: int, last: int) -> rrb.Blueprint:
+    """Two 2D views side by side, both framing the arm's reach and the obstacles: the world
+    (the arm, obstacles, feedback points, sensor, blocked moves) and the model drawn on the
+    world (its states where the arm was, its transitions, the current state, over the
+    obstacles); below them the plots (sensation and feedback, obstacle distances, model size,
+    their time axes linked and showing steps ``first .. last``) and the audit log; the
+    ``step`` timeline selected."""
     reach = 1.1 * scenario.total_length
     for obstacle in scenario.obstacles:
         reach = max(reach, 1.05 * (float(np.hypot(*obstacle.center)) + obstacle.radius))
-    xs = [x for x, _ in positions.values()] or [0.0]
-    ys = [y for _, y in positions.values()] or [0.0]
+    bounds = rrb.VisualBounds2D(x_range=[-reach, reach], y_range=[-reach, reach])
     steps = rrb.TimeRange(
         start=rrb.TimeRangeBoundary.absolute(seq=first),
         end=rrb.TimeRangeBoundary.absolute(seq=max(last, first + 1)),
@@ -53,18 +40,19 @@ def default_blueprint(
                 rrb.Spatial2DView(
                     name="World",
                     origin="/",
-                    contents=["+ /world/**"],
-                    visual_bounds=rrb.VisualBounds2D(
-                        x_range=[-reach, reach], y_range=[-reach, reach]
-                    ),
+                    contents=["+ /world/**", "- /world/model/**"],
+                    visual_bounds=bounds,
                 ),
-                rrb.GraphView(
-                    name="Model",
-                    origin="/model",
-                    visual_bounds=rrb.VisualBounds2D(
-                        x_range=[min(xs) - _GRAPH_MARGIN, max(xs) + _GRAPH_MARGIN],
-                        y_range=[min(ys) - _GRAPH_MARGIN, max(ys) + _GRAPH_MARGIN],
-                    ),
+                rrb.Spatial2DView(
+                    name="Model on the world",
+                    origin="/",
+                    contents=[
+                        "+ /world",
+                        "+ /world/obstacles",
+                        "+ /world/feedback_points",
+                        "+ /world/model/**",
+                    ],
+                    visual_bounds=bounds,
                 ),
             ),
             rrb.Horizontal(

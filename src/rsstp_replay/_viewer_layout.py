@@ -1,8 +1,8 @@
-"""Where the viewer puts the model's states: one layout of every version at once.
+"""The thesis-style picture's layout: one Graphviz layout of every version at once.
 
-Positions are in points, y up (Graphviz's frame); the graph view draws y downwards, so the
-viewer logs ``(x, -y)`` (:func:`viewer_positions`), and
-:func:`rsstp_replay.viewer.render_graph` hands the same points to Graphviz.
+Positions are in points, y up (Graphviz's frame); :func:`rsstp_replay.viewer.render_graph`
+pins every state there, so a state has one place in the pictures of every step. (The viewer
+draws the model on the world instead: :mod:`._viewer_model`.)
 """
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ __all__ = [
     "ViewerWarning",
     "graph_positions",
     "union_model",
-    "viewer_positions",
 ]
 
 
@@ -136,8 +135,3 @@ def _circle(states: Sequence[int]) -> dict[int, tuple[float, float]]:
         )
         for i, s in enumerate(states)
     }
-
-
-def viewer_positions(positions: dict[int, tuple[float, float]]) -> dict[int, tuple[float, float]]:
-    """Graphviz's y-up points as the graph view's y-down coordinates."""
-    return {s: (x, -y) for s, (x, y) in positions.items()}

@@ -1,300 +1,349 @@
-"""The internal model for the viewer: the transition graph at every model version, with node
-positions that never move, and the current internal state at every step.
+"""The internal model drawn on the world: every state where the arm was while the agent was
+in it, its transitions as arrows coloured by action, the current state highlighted.
 
-Positions come from one layout of the union of every version (:mod:`._viewer_layout`).
+Placement: a state sits at the mean position of the arm's tip over the steps at which it was
+the current state in the last model version it belongs to (its final meaning: before a split
+the same id stood for more; when it was never current in that version, over all its steps),
+whatever range is shown; so a model that learned the world looks like the arm's workspace,
+and a state id (never reused) never moves. A state that was never current sits beside the
+state it was split from (states of the initial model that were never current: at the base).
+A state current at several distinct poses over those steps (aliasing, or a true class of
+several poses) gets a thin line to the tip of each, the :data:`POSE_LINES` most visited.
 
-Action labels: a Rerun graph edge carries no label, so each ``(s, t)`` state pair with at least
-one transition gets a small *label node* ``"s>t"`` whose text is the sorted actions (``"0,1"``,
-as a cell of the thesis's matrix), and the edge is drawn in two halves, ``s -> "s>t" -> t``.
-The label node sits beside the midpoint of the straight segment ``s t``, on the right of the
-direction ``s -> t`` (so ``s -> t`` and ``t -> s`` get their own nodes on either side); for a
-self-loop ``s -> s`` it sits above ``s`` and the two halves form a loop.
+Logging: one entity per state, ``world/model/state/{id}``, with a row only at the steps where
+that state appears or its transitions change (found by replaying each version's operations
+and marking the states they touch), and an :class:`rr.Clear` when it is deleted; so the data
+grows with the number of changes, not with versions times model size. At a row:
 
-Every version is logged whole (Rerun shows the latest row at or before the time cursor), so
-the data grows with the sum of the versions' sizes: a run of the splitter strategy with 1,695
-versions of up to 6,659 transitions makes 4.9 million nodes and 9.4 million edges. The columns
-are therefore built with numpy over all versions at once (:func:`graph_columns`);
-:func:`graph_frame` is the plain per-version definition they must agree with.
+- ``Points2D``: the state, labelled with its id;
+- ``Arrows2D``: one arrow per transition to another state, from the state towards the
+  target (stopping short of it), coloured by action (:data:`ACTION_COLORS`), several actions
+  to the same target side by side;
+- at ``world/model/state/{id}/loops``, ``Points2D``: one small marker per self-loop ``s -a->
+  s`` (a move the model says leaves the state: what a blocked move is), placed around the
+  state in the direction of its action's colour wheel slot, so they are told apart from
+  arrows; ``world/model/state/{id}/poses``, ``LineStrips2D``: the thin lines to its poses.
+
+The current state is ``world/model/current``: a ring at its place, with a row at each step at
+which it changes.
 """
 
 from __future__ import annotations
 
-import itertools
 import math
-import warnings
-from collections.abc import Iterable, Sequence
+from collections import defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
+import pandas as pd
 import rerun as rr
 
-from rsstp_replay._viewer_chunks import TIMELINE, send_rows
-from rsstp_replay._viewer_layout import ViewerWarning
+from rsstp_replay._viewer_chunks import TIMELINE
+from rsstp_replay.audits.contract import version_index
 from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = [
-    "GRAPH",
-    "STATE",
-    "GraphColumns",
-    "GraphFrame",
-    "graph_columns",
-    "graph_frame",
-    "label_node",
+    "ACTION_COLORS",
+    "CURRENT",
+    "MODEL",
+    "POSE_LINES",
+    "STATES",
+    "StatePlaces",
     "log_current_state",
     "log_model",
+    "state_path",
+    "state_places",
 ]
 
-GRAPH = "model/graph"
-STATE = "model/state"
+MODEL = "world/model"
+STATES = "world/model/state"
+CURRENT = "world/model/current"
+POSE_LINES = 32
+"""Thin lines drawn from a state to at most this many of its poses (the most visited)."""
 
-_STATE_COLOR = (40, 110, 200)
-_LABEL_COLOR = (120, 120, 120)
+ACTION_COLORS: tuple[tuple[int, int, int], ...] = (
+    (31, 119, 180),
+    (255, 127, 14),
+    (44, 160, 44),
+    (214, 39, 40),
+    (148, 103, 189),
+    (140, 86, 75),
+    (227, 119, 194),
+    (127, 127, 127),
+    (188, 189, 34),
+    (23, 190, 207),
+    (57, 59, 121),
+    (173, 73, 74),
+    (99, 121, 57),
+    (140, 109, 49),
+)
+"""Action ``a``'s colour is ``ACTION_COLORS[a % 14]`` (matplotlib's tab10, then more)."""
+
+_STATE_COLOR = (60, 60, 60)
 _CURRENT_COLOR = (235, 100, 0)
-_LOOP_RISE = 42.0
-"""How far above its state a self-loop's label node sits (points)."""
-_INSTANCES_PER_CHUNK = 200_000
-"""About how many nodes (or edges) one chunk of ``model/graph`` holds."""
-
-_Ints = npt.NDArray[np.int64]
-_Strings = npt.NDArray[np.str_]
+_POSE_COLOR = (150, 150, 150, 110)
 _Floats = npt.NDArray[np.float64]
-Positions = dict[int, tuple[float, float]]
 
 
-def label_node(s: int, t: int) -> str:
-    """The id of the label node of the state pair ``(s, t)``."""
-    return f"{s}>{t}"
-
-
-def _label_position(
-    source: tuple[float, float], target: tuple[float, float]
-) -> tuple[float, float]:
-    """Where the label node of ``source -> target`` goes, in the viewer's frame (y down)."""
-    (x0, y0), (x1, y1) = source, target
-    dx, dy = x1 - x0, y1 - y0
-    length = math.hypot(dx, dy)
-    if length == 0.0:
-        return x0, y0 - _LOOP_RISE
-    offset = min(30.0, max(12.0, 0.15 * length))
-    # The right-hand side of the direction, y pointing down: (-dy, dx) / length.
-    return (x0 + x1) / 2 - dy / length * offset, (y0 + y1) / 2 + dx / length * offset
+def state_path(state: int) -> str:
+    return f"{STATES}/{state}"
 
 
 @dataclass(frozen=True, slots=True)
-class GraphFrame:
-    """One model version as the viewer draws it: nodes (states, then label nodes in the order
-    of their pairs) and edges (two per label node)."""
+class StatePlaces:
+    """Where each state is drawn (world coordinates), its poses' tips and the drawing scale."""
 
-    node_ids: list[str]
-    positions: list[tuple[float, float]]
-    labels: list[str]
-    edges: list[tuple[str, str]]
+    places: dict[int, tuple[float, float]]
+    poses: dict[int, _Floats]
+    scale: float
 
 
-def graph_frame(
-    states: Sequence[int], transitions: Iterable[Sequence[int]], positions: Positions
-) -> GraphFrame:
-    """The nodes and edges of one version; ``positions`` are the viewer's (y down)."""
-    cells: dict[tuple[int, int], list[int]] = {}
-    for s, a, t in sorted(transitions, key=lambda sat: (sat[0], sat[2], sat[1])):
-        cells.setdefault((s, t), []).append(a)
-    frame = GraphFrame(
-        node_ids=[str(s) for s in states],
-        positions=[positions[s] for s in states],
-        labels=[str(s) for s in states],
-        edges=[],
+def state_places(
+    steps: pd.DataFrame, versions: Sequence[ModelRecord], *, n_joints: int, reach: float
+) -> StatePlaces:
+    """The place of every state of every version (see the module docstring); ``reach`` is the
+    arm's length, which sets the offsets."""
+    tips = steps[[f"joint{n_joints}_x", f"joint{n_joints}_y"]].to_numpy(np.float64)
+    states = steps["internal_state"].to_numpy(np.int64)
+    # A state means what its last version says: its steps in that version place it (the
+    # same id stood for more before a split), all its steps when it was not current there.
+    last_version: dict[int, int] = {}
+    for index, record in enumerate(versions):
+        for state in record.states:
+            last_version[state] = index
+    in_force = version_index(versions, steps["step"].to_numpy(np.int64))
+    ids = np.unique(states)
+    final = np.array([last_version.get(int(s), -1) for s in ids.tolist()], np.int64)
+    own = in_force == final[np.searchsorted(ids, states)]
+    has_own = np.zeros(len(ids), np.bool_)
+    has_own[np.searchsorted(ids, states[own])] = True
+    chosen = own | ~has_own[np.searchsorted(ids, states)]
+    kept_states, kept_tips = states[chosen], tips[chosen]
+    sums = np.zeros((len(ids), 2))
+    where = np.searchsorted(ids, kept_states)
+    np.add.at(sums, where, kept_tips)
+    counts = np.bincount(where, minlength=len(ids))
+    places = {
+        int(s): (float(x), float(y))
+        for s, (x, y) in zip(ids.tolist(), (sums / counts[:, None]).tolist(), strict=True)
+    }
+    scale = reach / 40.0
+    for record in versions:  # states never current: beside the state they came from
+        for operation in record.operations:
+            if operation.kind == "split" and operation.result is not None:
+                child = int(operation.result)
+                if child not in places:
+                    x, y = places.get(int(operation.args[0]), (0.0, 0.0))
+                    angle = 2.399963 * child  # golden angle: neighbours do not pile up
+                    places[child] = (
+                        x + 3 * scale * math.cos(angle),
+                        y + 3 * scale * math.sin(angle),
+                    )
+        for state in record.states:
+            places.setdefault(int(state), (0.0, 0.0))
+    angles = steps[[f"angle_deg_{j}" for j in range(n_joints)]].to_numpy(np.int64)[chosen]
+    return StatePlaces(places, _poses(kept_states, angles, kept_tips), scale)
+
+
+def _poses(
+    states: npt.NDArray[np.int64], angles: npt.NDArray[np.int64], tips: _Floats
+) -> dict[int, _Floats]:
+    """For every state seen at several poses, the tips of its :data:`POSE_LINES` most visited
+    poses."""
+    if not len(states):
+        return {}
+    n_joints = angles.shape[1]
+    codes = np.unique(angles @ (360 ** np.arange(n_joints, dtype=np.int64)), return_inverse=True)[1]
+    ids, inverse = np.unique(states, return_inverse=True)
+    n_codes = int(codes.max(initial=0)) + 1
+    pairs, first, seen = np.unique(
+        inverse.astype(np.int64) * n_codes + codes, return_index=True, return_counts=True
     )
-    for (s, t), actions in cells.items():
-        middle = label_node(s, t)
-        frame.node_ids.append(middle)
-        frame.positions.append(_label_position(positions[s], positions[t]))
-        frame.labels.append(",".join(map(str, actions)))
-        frame.edges.extend([(str(s), middle), (middle, str(t))])
-    return frame
+    owner = pairs // n_codes
+    order = np.lexsort((-seen, owner))  # by state, the most visited pose first
+    owner, first = owner[order], first[order]
+    starts = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+    sizes = np.diff(np.r_[starts, len(owner)])
+    poses: dict[int, _Floats] = {}
+    for start, size in zip(starts.tolist(), sizes.tolist(), strict=True):
+        if size > 1:
+            poses[int(ids[owner[start]])] = tips[first[start : start + min(size, POSE_LINES)]]
+    return poses
 
 
-@dataclass(frozen=True, slots=True)
-class GraphColumns:
-    """Every version's :class:`GraphFrame`, concatenated: version ``v`` owns
-    ``node_counts[v]`` consecutive nodes and ``edge_counts[v]`` consecutive edges."""
-
-    node_ids: _Strings
-    positions: _Floats
-    labels: _Strings
-    is_state: npt.NDArray[np.bool_]
-    node_counts: _Ints
-    edges: _Strings
-    edge_counts: _Ints
-
-
-def graph_columns(versions: Sequence[ModelRecord], positions: Positions) -> GraphColumns:
-    """The frames of all ``versions`` at once, with numpy (see the module docstring)."""
-    n = len(versions)
-    state_counts = np.array([len(record.states) for record in versions], np.int64)
-    state_ids = np.fromiter(
-        itertools.chain.from_iterable(record.states for record in versions),
-        np.int64,
-        count=int(state_counts.sum()),
-    )
-    state_version = np.repeat(np.arange(n), state_counts)
-    triples = np.fromiter(
-        itertools.chain.from_iterable(
-            itertools.chain.from_iterable(record.transitions) for record in versions
-        ),
-        np.int64,
-        count=3 * sum(len(record.transitions) for record in versions),
-    ).reshape(-1, 3)
-    triple_version = np.repeat(np.arange(n), [len(record.transitions) for record in versions])
-    s, a, t = triples[:, 0], triples[:, 1], triples[:, 2]
-    if len(a) and (int(a.min()) < 0 or int(a.max()) >= 62):
-        raise ValueError(f"actions {int(a.min())}..{int(a.max())}: the viewer handles 0 to 61")
-    # One cell per (version, s, t), its actions as a bit mask; sorted on one integer key.
-    base = int(max(state_ids.max(initial=0), triples.max(initial=0))) + 1
-    if n * base * base >= 2**62:
-        raise ValueError(f"{n} versions of states up to {base - 1}: too many for the viewer")
-    pair_key = s * base + t
-    order = np.argsort(triple_version * (base * base) + pair_key, kind="stable")
-    key, a, triple_version = pair_key[order], a[order], triple_version[order]
-    starts = np.flatnonzero(np.r_[True, (np.diff(triple_version) != 0) | (np.diff(key) != 0)])
-    masks = np.bitwise_or.reduceat(np.left_shift(np.int64(1), a), starts) if len(a) else a
-    cell_key, cell_version = key[starts], triple_version[starts]
-    pairs, pair_of_cell = np.unique(cell_key, return_inverse=True)
-    cell_s, cell_t = cell_key // base, cell_key % base
-    pair_ids = np.array(
-        [label_node(int(p), int(q)) for p, q in zip(pairs // base, pairs % base, strict=True)],
-        dtype=np.str_,
-    )
-    pair_places = np.array(
-        [
-            _label_position(positions[int(p)], positions[int(q)])
-            for p, q in zip(pairs // base, pairs % base, strict=True)
-        ],
-        np.float64,
-    ).reshape(-1, 2)
-    mask_values, mask_of_cell = np.unique(masks, return_inverse=True)
-    mask_labels = np.array([_mask_label(int(m)) for m in mask_values], dtype=np.str_)
-
-    states, state_of_node = np.unique(state_ids, return_inverse=True)
-    state_names = _names(states)
-    state_places = np.array([positions[int(q)] for q in states], np.float64).reshape(-1, 2)
-    # Gather strings once, by integer codes into small vocabularies (states, then pairs or
-    # action sets): numpy string arrays are slow to concatenate and reorder.
-    kinds = np.r_[np.zeros(len(state_ids), np.int64), np.ones(len(cell_key), np.int64)]
-    node_order = np.lexsort((kinds, np.r_[state_version, cell_version]))
-    id_codes = np.r_[state_of_node, len(states) + pair_of_cell][node_order]
-    label_codes = np.r_[state_of_node, len(states) + mask_of_cell][node_order]
-    ids = np.concatenate([state_names, pair_ids])
-    edge_codes = np.empty((2 * len(cell_key), 2), np.int64)
-    edge_codes[0::2, 0] = np.searchsorted(states, cell_s)
-    edge_codes[0::2, 1] = len(states) + pair_of_cell
-    edge_codes[1::2, 0] = len(states) + pair_of_cell
-    edge_codes[1::2, 1] = np.searchsorted(states, cell_t)
-    cells_per_version = np.bincount(cell_version, minlength=n).astype(np.int64)
-    return GraphColumns(
-        node_ids=ids[id_codes],
-        positions=np.concatenate([state_places, pair_places])[id_codes],
-        labels=np.concatenate([state_names, mask_labels])[label_codes],
-        is_state=kinds[node_order] == 0,
-        node_counts=state_counts + cells_per_version,
-        edges=ids[edge_codes],
-        edge_counts=2 * cells_per_version,
-    )
-
-
-def _names(values: _Ints) -> _Strings:
-    """The decimal names of ``values``, in a string array no wider than needed."""
-    return np.array([str(value) for value in values.tolist()], dtype=np.str_)
-
-
-def _mask_label(mask: int) -> str:
-    return ",".join(str(a) for a in range(mask.bit_length()) if mask >> a & 1)
+def _touched(model: TransitionSystem, record: ModelRecord) -> set[int]:
+    """Apply ``record``'s operations to ``model``; the states whose transitions out changed,
+    or that appeared or disappeared."""
+    touched: set[int] = set()
+    for operation in record.operations:
+        if not operation.changed:
+            continue
+        args = [int(a) for a in operation.args]
+        if operation.kind in ("add", "delete"):
+            touched.add(args[0])
+        elif operation.kind == "split":
+            s = args[0]
+            touched |= {s, *model.predecessors(s)}
+        elif operation.kind == "merge":
+            s, t = args[:2]
+            touched |= {s, t, *model.predecessors(t)}
+        model.apply(operation.to_operation())
+        if operation.kind == "split" and operation.result is not None:
+            touched.add(int(operation.result))
+    model.drain_operations()
+    return touched
 
 
 def log_model(
     stream: rr.RecordingStream,
     versions: Sequence[ModelRecord],
     steps: Sequence[int],
-    positions: Positions,
+    places: StatePlaces,
+) -> dict[str, int]:
+    """Every state of ``versions[0]`` at ``steps[0]``, then each later version's changes at its
+    step; returns rows per entity path (the per-state paths summed under :data:`STATES`)."""
+    rows: dict[int, list[tuple[int, tuple[tuple[int, int], ...] | None]]] = defaultdict(list)
+    model = TransitionSystem.from_snapshot(versions[0].snapshot(), version=versions[0].version)
+    for state in model.states:
+        rows[state].append((steps[0], _outs(model, state)))
+    for record, step in zip(versions[1:], steps[1:], strict=True):
+        for state in sorted(_touched(model, record)):
+            rows[state].append((step, _outs(model, state) if state in model else None))
+    count = 0
+    for state, changes in sorted(rows.items()):
+        count += _log_state(stream, state, changes, places)
+    return {STATES: count}
+
+
+def _outs(model: TransitionSystem, state: int) -> tuple[tuple[int, int], ...]:
+    """``(action, target)`` of every transition out of ``state``, sorted."""
+    return tuple((a, t) for a in model.actions for t in model.successors(state, a))
+
+
+def _log_state(
+    stream: rr.RecordingStream,
+    state: int,
+    changes: list[tuple[int, tuple[tuple[int, int], ...] | None]],
+    places: StatePlaces,
 ) -> int:
-    """The graph of each version in ``versions`` at the matching step of ``steps`` (one row
-    each); ``positions`` are the viewer's. Returns the rows logged."""
-    columns = graph_columns(versions, positions)
-    times = np.asarray(steps, np.int64)
-    colors = np.where(columns.is_state[:, None], _STATE_COLOR, _LABEL_COLOR).astype(np.uint8)
-    stream.log(GRAPH, rr.GraphEdges.from_fields(graph_type="directed"), static=True)
-    node_ends = np.cumsum(columns.node_counts)
-    edge_ends = np.cumsum(columns.edge_counts)
-    shown_edges = False  # an empty group of edges must still hide the edges before it
-    for first, last in _row_groups(np.maximum(columns.node_counts, columns.edge_counts)):
-        index = [rr.TimeColumn(TIMELINE, sequence=times[first:last])]
-        nodes = slice(int(node_ends[first] - columns.node_counts[first]), int(node_ends[last - 1]))
+    """The rows of one state's entity (and its loops), a clear where it was deleted."""
+    path = state_path(state)
+    x, y = places.places[state]
+    alive = [(step, outs) for step, outs in changes if outs is not None]
+    if alive:
+        times = np.array([step for step, _ in alive], np.int64)
+        origins, vectors, colors, arrow_counts = [], [], [], []
+        loops, loop_colors, loop_counts = [], [], []
+        for _, outs in alive:
+            arrows = [(a, t) for a, t in outs if t != state]
+            for slot, (a, t) in enumerate(arrows):
+                start, delta = _arrow((x, y), places.places[t], slot, len(arrows), places.scale)
+                origins.append(start)
+                vectors.append(delta)
+                colors.append(ACTION_COLORS[a % len(ACTION_COLORS)])
+            arrow_counts.append(len(arrows))
+            self_loops = [a for a, t in outs if t == state]
+            for a in self_loops:
+                angle = 2 * math.pi * (a % len(ACTION_COLORS)) / len(ACTION_COLORS)
+                loops.append(
+                    (x + places.scale * math.cos(angle), y + places.scale * math.sin(angle))
+                )
+                loop_colors.append(ACTION_COLORS[a % len(ACTION_COLORS)])
+            loop_counts.append(len(self_loops))
+        index = [rr.TimeColumn(TIMELINE, sequence=times)]
         stream.send_columns(
-            GRAPH,
+            path,
             indexes=index,
-            columns=rr.GraphNodes.columns(
-                node_ids=columns.node_ids[nodes],
-                positions=columns.positions[nodes],
-                labels=columns.labels[nodes],
-                colors=colors[nodes],
-            ).partition(columns.node_counts[first:last]),
-        )
-        edges = slice(int(edge_ends[first] - columns.edge_counts[first]), int(edge_ends[last - 1]))
-        if edges.stop > edges.start or shown_edges:
-            shown_edges = True
-            stream.send_columns(
-                GRAPH,
-                indexes=index,
-                columns=rr.GraphEdges.columns(edges=columns.edges[edges]).partition(
-                    columns.edge_counts[first:last]
+            columns=[
+                *rr.Points2D.columns(
+                    positions=np.tile([x, y], (len(times), 1)),
+                    labels=[str(state)] * len(times),
+                    colors=np.tile(_STATE_COLOR, (len(times), 1)).astype(np.uint8),
                 ),
+                *rr.Arrows2D.columns(
+                    origins=np.array(origins, np.float64).reshape(-1, 2),
+                    vectors=np.array(vectors, np.float64).reshape(-1, 2),
+                    colors=np.array(colors, np.uint8).reshape(-1, 3),
+                ).partition(np.array(arrow_counts, np.int64)),
+            ],
+        )
+        stream.send_columns(
+            f"{path}/loops",
+            indexes=index,
+            columns=rr.Points2D.columns(
+                positions=np.array(loops, np.float64).reshape(-1, 2),
+                colors=np.array(loop_colors, np.uint8).reshape(-1, 3),
+                radii=np.full(len(loops), -2.5, np.float32),  # ui points
+            ).partition(np.array(loop_counts, np.int64)),
+        )
+        poses = places.poses.get(state)
+        if poses is not None:
+            strips = np.stack([np.broadcast_to([x, y], poses.shape), poses], axis=1)
+            stream.send_columns(
+                f"{path}/poses",
+                indexes=[rr.TimeColumn(TIMELINE, sequence=times[:1])],
+                columns=rr.LineStrips2D.columns(
+                    strips=strips,
+                    colors=np.tile(_POSE_COLOR, (len(strips), 1)).astype(np.uint8),
+                    radii=np.full(len(strips), -0.5, np.float32),  # ui points
+                ).partition([len(strips)]),
             )
-    return len(versions)
+    for step, gone in changes:
+        if gone is None:
+            stream.set_time(TIMELINE, sequence=step)
+            stream.log(path, rr.Clear(recursive=True))
+    return len(changes)
 
 
-def _row_groups(sizes: _Ints) -> list[tuple[int, int]]:
-    """Consecutive rows ``[first, last)`` holding about :data:`_INSTANCES_PER_CHUNK`
-    instances each (at least one row)."""
-    groups: list[tuple[int, int]] = []
-    first, total = 0, 0
-    for row, size in enumerate(sizes.tolist()):
-        if row > first and total + size > _INSTANCES_PER_CHUNK:
-            groups.append((first, row))
-            first, total = row, 0
-        total += size
-    if len(sizes):
-        groups.append((first, len(sizes)))
-    return groups
+def _arrow(
+    source: tuple[float, float],
+    target: tuple[float, float],
+    slot: int,
+    slots: int,
+    scale: float,
+) -> tuple[tuple[float, float], tuple[float, float]]:
+    """An arrow from ``source`` towards ``target``, shortened at both ends, shifted sideways
+    by its slot so that arrows of several actions (and the way back) stay apart."""
+    (x0, y0), (x1, y1) = source, target
+    dx, dy = x1 - x0, y1 - y0
+    length = math.hypot(dx, dy)
+    if length == 0.0:  # two states at one place: a short arrow to the right
+        return (x0, y0), (2 * scale, 0.0)
+    ux, uy = dx / length, dy / length
+    side = 0.35 * scale * (slot - (slots - 1) / 2) + 0.25 * scale
+    gap = min(1.2 * scale, 0.3 * length)
+    start = (x0 + ux * gap - uy * side, y0 + uy * gap + ux * side)
+    return start, (dx - 2 * ux * gap, dy - 2 * uy * gap)
 
 
 def log_current_state(
     stream: rr.RecordingStream,
-    times: _Ints,
-    internal_states: _Ints,
-    positions: Positions,
+    times: npt.NDArray[np.int64],
+    internal_states: npt.NDArray[np.int64],
+    places: StatePlaces,
 ) -> int:
-    """The current internal state at every step: one node drawn over the state's node (same
-    id, same place, in orange). Returns the rows logged."""
-    states, inverse = np.unique(internal_states, return_inverse=True)
-    missing = [int(s) for s in states if int(s) not in positions]
-    if missing:
-        warnings.warn(
-            ViewerWarning(
-                f"internal states {missing[:10]} belong to no model version: drawn at the origin"
-            ),
-            stacklevel=2,
-        )
-    places = np.array([positions.get(int(s), (0.0, 0.0)) for s in states], np.float64)
-    names = states.astype(np.str_)
-    color = np.array(_CURRENT_COLOR, np.uint8)
-    return send_rows(
-        stream,
-        STATE,
-        times,
-        lambda rows: rr.GraphNodes.columns(
-            node_ids=names[inverse[rows]],
-            positions=places[inverse[rows]],
-            labels=names[inverse[rows]],
-            colors=np.tile(color, (len(inverse[rows]), 1)),
+    """The current state as a ring at its place, a row at the first step and at every step it
+    changes; returns the rows logged."""
+    if not len(times):
+        return 0
+    change = np.flatnonzero(np.r_[True, internal_states[1:] != internal_states[:-1]])
+    states = internal_states[change]
+    positions = np.array([places.places[int(s)] for s in states.tolist()], np.float64)
+    stream.log(
+        CURRENT,
+        rr.Points2D.from_fields(
+            radii=rr.Radius.ui_points(9.0), colors=_CURRENT_COLOR, draw_order=20.0
+        ),
+        static=True,
+    )
+    stream.send_columns(
+        CURRENT,
+        indexes=[rr.TimeColumn(TIMELINE, sequence=times[change])],
+        columns=rr.Points2D.columns(
+            positions=positions, labels=[f"now: {s}" for s in states.tolist()]
         ),
     )
+    return len(change)

@@ -1,8 +1,8 @@
 """Time series and the audit log for the viewer.
 
-Series (``rr.Scalars``, one row per step unless said): the sensation (0 or 1) and the float
-feedback, each obstacle sensor reading, and the model's size (rows only at the steps where the
-model changed, drawn as a step function).
+Series (``rr.Scalars``, drawn as step functions with a row only where the value changes): the
+sensation (0 or 1), the float feedback, the obstacle sensor readings (one entity, a series per
+tip and obstacle), and the model's size.
 
 The log (``rr.TextLog`` at ``log/audit``) holds, at their steps: every contradiction the
 consistency audit finds (the state, its shortest witness, the number of contradicting pairs),
@@ -35,7 +35,7 @@ __all__ = [
     "SENSATION",
     "LogLine",
     "audit_lines",
-    "distance_path",
+    "distance_name",
     "log_lines",
     "log_model_size",
     "log_series",
@@ -49,9 +49,9 @@ MODEL_TRANSITIONS = "plots/model/transitions"
 LOG = "log/audit"
 
 
-def distance_path(link: int, obstacle: int) -> str:
-    """The series of the distance from link ``link``'s tip to obstacle ``obstacle``."""
-    return f"{DISTANCE}/link{link}/obstacle{obstacle}"
+def distance_name(link: int, obstacle: int) -> str:
+    """The name of the series of the distance from link ``link``'s tip to ``obstacle``."""
+    return f"tip of link {link} to obstacle {obstacle}"
 
 
 def log_series(
@@ -61,25 +61,41 @@ def log_series(
     n_joints: int,
     n_obstacles: int,
 ) -> dict[str, int]:
-    """Sensation, feedback and the sensor readings, one row per step; returns rows per path."""
+    """Sensation, feedback and the sensor readings; returns rows per path.
+
+    A step's value holds until the next step, so every series is drawn as steps
+    (``StepAfter``) and has a row only where its value changes (and at the first and last
+    step): exact, and small on long runs (a sensation that is false for a million steps is
+    two rows). The distances are one entity with a series per tip and obstacle.
+    """
     times = steps["step"].to_numpy(np.int64)
-    series: list[tuple[str, str, npt.NDArray[np.float64]]] = [
-        (SENSATION, "sensation", steps["sensation"].to_numpy(np.float64)),
-        (FEEDBACK, "feedback", steps["feedback"].to_numpy(np.float64)),
+    series: list[tuple[str, list[str], npt.NDArray[np.float64]]] = [
+        (SENSATION, ["sensation"], steps[["sensation"]].to_numpy(np.float64)),
+        (FEEDBACK, ["feedback"], steps[["feedback"]].to_numpy(np.float64)),
     ]
-    for k in range(n_joints):
-        for j in range(n_obstacles):
-            series.append(
-                (
-                    distance_path(k, j),
-                    f"tip of link {k} to obstacle {j}",
-                    steps[f"dist_{k}_{j}"].to_numpy(np.float64),
-                )
+    if n_obstacles:
+        pairs = [(k, j) for k in range(n_joints) for j in range(n_obstacles)]
+        series.append(
+            (
+                DISTANCE,
+                [distance_name(k, j) for k, j in pairs],
+                steps[[f"dist_{k}_{j}" for k, j in pairs]].to_numpy(np.float64),
             )
+        )
     logged = {}
-    for path, name, values in series:
-        stream.log(path, rr.SeriesLines(names=name), static=True)
-        logged[path] = send_rows(stream, path, times, _scalars(values))
+    for path, names, values in series:
+        # A boolean drawn zoomed out: min and max per pixel, not their average (0.5 is no
+        # sensation the agent ever had).
+        aggregation = rr.components.AggregationPolicy.MinMax if path == SENSATION else None
+        stream.log(
+            path,
+            rr.SeriesLines(
+                names=names, interpolation_mode="StepAfter", aggregation_policy=aggregation
+            ),
+            static=True,
+        )
+        rows = _changes(values)
+        logged[path] = send_rows(stream, path, times[rows], _scalars(values[rows]))
     return logged
 
 
@@ -88,6 +104,15 @@ def _scalars(values: npt.NDArray[np.float64]) -> Callable[[slice], rr.ComponentC
         return rr.Scalars.columns(scalars=values[rows])
 
     return columns
+
+
+def _changes(values: npt.NDArray[np.float64]) -> npt.NDArray[np.int64]:
+    """The rows where any column differs from the row before, with the first and last row."""
+    if not len(values):
+        return np.zeros(0, np.int64)
+    differs = np.r_[True, (values[1:] != values[:-1]).any(axis=1)]
+    differs[-1] = True
+    return np.flatnonzero(differs)
 
 
 def log_model_size(

@@ -1,7 +1,8 @@
-"""The world for the viewer: the arm among its obstacles, in the plane, one row per step.
+"""The world for the viewer: the arm among its obstacles, in the plane.
 
-Everything here is logged with ``send_columns`` (one call per entity for the whole step
-range); the obstacles and the feedback points do not move and are logged as static data.
+Everything here is logged with ``send_columns``, a row only at the steps where what an entity
+shows changes; the obstacles and the feedback points do not move and are logged as static
+data.
 Coordinates are the recording's, in its length unit, in the world frame (x right, y up):
 the ``world`` entity carries a static transform that mirrors y, because Rerun's 2D views
 draw y downwards.
@@ -21,8 +22,8 @@ __all__ = [
     "ARM",
     "BLOCKED",
     "FEEDBACK_POINTS",
-    "JOINTS",
     "OBSTACLES",
+    "SENSOR_MAX_STEPS",
     "SENSOR",
     "WORLD",
     "joint_positions",
@@ -33,7 +34,6 @@ __all__ = [
 
 WORLD = "world"
 ARM = "world/arm"
-JOINTS = "world/joints"
 OBSTACLES = "world/obstacles"
 FEEDBACK_POINTS = "world/feedback_points"
 SENSOR = "world/sensor"
@@ -95,10 +95,6 @@ def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
     stream.log(
         ARM,
         rr.LineStrips2D.from_fields(radii=rr.Radius.ui_points(3.0), draw_order=5.0),
-        static=True,
-    )
-    stream.log(
-        JOINTS,
         rr.Points2D.from_fields(
             radii=rr.Radius.ui_points(4.0), colors=_JOINT_COLOR, draw_order=6.0
         ),
@@ -135,51 +131,61 @@ def sensor_segments(positions: _Floats, scenario: Scenario) -> _Floats:
     return np.stack([np.broadcast_to(tips, nearest.shape), nearest], axis=-2)
 
 
+SENSOR_MAX_STEPS = 250_000
+"""Above this many steps the sensor segments are left out (the distances stay as plots): on a
+long run they would be most of the file. ``--from``/``--to`` shows them for any window."""
+
+
 def log_world(
     stream: rr.RecordingStream,
     steps: pd.DataFrame,
     scenario: Scenario,
 ) -> dict[str, int]:
-    """The arm, its joints, the obstacle sensor and the blocked moves, one row per step of
-    ``steps``; returns the rows logged per entity path."""
+    """The arm with its joints, the obstacle sensor and the blocked moves over the steps of
+    ``steps``, a row only where something changed (the pose, or whether the move was
+    blocked): Rerun shows the latest row at the time cursor. Returns rows per entity path."""
     times = steps["step"].to_numpy(np.int64)
     n = scenario.n_joints
     positions = joint_positions(steps, n)
-    strips = positions.astype(np.float32)  # what Rerun stores
     blocked = steps["blocked"].to_numpy(np.bool_)
-    colors = np.where(blocked[:, None], _BLOCKED_COLOR, _ARM_COLOR).astype(np.uint8)
+    moved = np.r_[True, (positions[1:] != positions[:-1]).any(axis=(1, 2))]
+    arm_rows = np.flatnonzero(moved | np.r_[True, blocked[1:] != blocked[:-1]])
+    strips = positions[arm_rows].astype(np.float32)  # what Rerun stores
+    colors = np.where(blocked[arm_rows, None], _BLOCKED_COLOR, _ARM_COLOR).astype(np.uint8)
     logged = {
         ARM: send_rows(
             stream,
             ARM,
-            times,
-            lambda rows: rr.LineStrips2D.columns(strips=strips[rows], colors=colors[rows]),
-        ),
-        JOINTS: send_rows(
-            stream,
-            JOINTS,
-            times,
-            lambda rows: rr.Points2D.columns(positions=positions[rows].reshape(-1, 2)).partition(
-                np.full(len(times[rows]), n + 1)
-            ),
+            times[arm_rows],
+            lambda rows: [
+                *rr.LineStrips2D.columns(strips=strips[rows], colors=colors[rows]),
+                *rr.Points2D.columns(positions=strips[rows].reshape(-1, 2)).partition(
+                    np.full(len(strips[rows]), n + 1)
+                ),
+            ],
         ),
     }
     m = len(scenario.obstacles)
-    if m:
-        segments = sensor_segments(positions, scenario).astype(np.float32)
+    if m and len(times) <= SENSOR_MAX_STEPS:
+        pose_rows = np.flatnonzero(moved)
+        segments = sensor_segments(positions[pose_rows], scenario).astype(np.float32)
         logged[SENSOR] = send_rows(
             stream,
             SENSOR,
-            times,
+            times[pose_rows],
             lambda rows: rr.LineStrips2D.columns(strips=segments[rows].reshape(-1, 2, 2)).partition(
-                np.full(len(times[rows]), n * m)
+                np.full(len(segments[rows]), n * m)
             ),
         )
     if blocked.any():
         labels = ("blocked: " + steps["blocked_by"].astype(str)).to_numpy(object)
         tips = positions[:, -1, :]
+        rows_at = np.flatnonzero(blocked | np.r_[False, blocked[:-1]])
         logged[BLOCKED] = send_rows(
-            stream, BLOCKED, times, lambda rows: _blocked(tips, labels, blocked, rows)
+            stream,
+            BLOCKED,
+            times[rows_at],
+            lambda rows: _blocked(tips[rows_at], labels[rows_at], blocked[rows_at], rows),
         )
     return logged
 

@@ -268,8 +268,9 @@ def _cmd_graph(args: argparse.Namespace) -> int:
     out = Path(args.output)
     _check_output(out, force=args.force)
     with _open(args.file) as recording:
-        written = render_graph(recording, args.step, out)
-    print(f"wrote {written} (the model at step {args.step})")
+        written = render_graph(recording, args.step, out, on_world=args.on_world)
+    where = "on the world" if args.on_world else "laid out as in every version"
+    print(f"wrote {written} (the model at step {args.step}, {where})")
     return 0
 
 
@@ -335,6 +336,12 @@ def _build_parser() -> Parser:
     p.add_argument("--step", type=_integer, required=True, help="the step")
     p.add_argument("-o", "--output", required=True, help="output: .svg, .png, .pdf or .dot")
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.add_argument(
+        "--on-world",
+        action="store_true",
+        help="put every state where the arm's tip was while the agent was in it (as the viewer "
+        "does) instead of the thesis-style layout",
+    )
     p.set_defaults(func=_cmd_graph)
 
     p = sub.add_parser(

@@ -37,7 +37,7 @@ from rsstp_replay import _viewer_plots as plots_part
 from rsstp_replay import _viewer_world as world_part
 from rsstp_replay._viewer_blueprint import default_blueprint
 from rsstp_replay._viewer_chunks import TIMELINE
-from rsstp_replay._viewer_layout import ViewerWarning, graph_positions, viewer_positions
+from rsstp_replay._viewer_layout import ViewerWarning, graph_positions
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.errors import ReplayError, StepOutOfRange
@@ -73,21 +73,22 @@ WEB_PORT = 9090
 ENTITY_PATHS: tuple[str, ...] = (
     world_part.WORLD,
     world_part.ARM,
-    world_part.JOINTS,
     world_part.OBSTACLES,
     world_part.FEEDBACK_POINTS,
     world_part.SENSOR,
     world_part.BLOCKED,
-    model_part.GRAPH,
-    model_part.STATE,
+    model_part.STATES + "/{id}",
+    model_part.STATES + "/{id}/loops",
+    model_part.STATES + "/{id}/poses",
+    model_part.CURRENT,
     plots_part.SENSATION,
     plots_part.FEEDBACK,
-    plots_part.DISTANCE + "/link{k}/obstacle{j}",
+    plots_part.DISTANCE,
     plots_part.MODEL_STATES,
     plots_part.MODEL_TRANSITIONS,
     plots_part.LOG,
 )
-"""Every entity path the viewer writes (``{k}``, ``{j}``: link and obstacle indices)."""
+"""Every entity path the viewer writes (``{id}``: a state id)."""
 
 
 class ViewSource(Protocol):
@@ -214,9 +215,7 @@ def view(
         grpc_url = f"rerun+http://127.0.0.1:{SERVE_PORT}/proxy"
         rr.serve_web_viewer(web_port=WEB_PORT, open_browser=False, connect_to=grpc_url)
         web_url = f"http://127.0.0.1:{WEB_PORT}/?url={urllib.parse.quote(grpc_url, safe='')}"
-    blueprint = default_blueprint(
-        recording.scenario, first=first, last=last, positions=loaded.positions
-    )
+    blueprint = default_blueprint(recording.scenario, first=first, last=last)
     stream.set_sinks(*sinks, default_blueprint=blueprint)
     summary = _log(recording, loaded, stream, first, last)
     began = time.perf_counter()
@@ -255,14 +254,14 @@ def log_recording(
 
 @dataclass(frozen=True, slots=True)
 class _Loaded:
-    """A recording read once, audited, its graph laid out (viewer coordinates)."""
+    """A recording read once, audited, its states placed on the world."""
 
     steps: pd.DataFrame
     versions: list[ModelRecord]
     events: pd.DataFrame
     consistency: ConsistencyFindings | None
     determinism: DeterminismFindings | None
-    positions: dict[int, tuple[float, float]]
+    places: model_part.StatePlaces
     seconds_read: float
     seconds_prepare: float
 
@@ -274,14 +273,17 @@ def _load(recording: ViewSource) -> _Loaded:
     events = recording.events()
     read = time.perf_counter()
     consistency, determinism = _audits(steps, versions)
-    positions = viewer_positions(graph_positions(versions))
+    scenario = recording.scenario
+    places = model_part.state_places(
+        steps, versions, n_joints=scenario.n_joints, reach=scenario.total_length
+    )
     return _Loaded(
         steps,
         versions,
         events,
         consistency,
         determinism,
-        positions,
+        places,
         seconds_read=read - began,
         seconds_prepare=time.perf_counter() - read,
     )
@@ -300,13 +302,13 @@ def _log(
         stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
     )
     shown, times = _versions_in(loaded.versions, first, last)
-    rows[model_part.GRAPH] = model_part.log_model(stream, shown, times, loaded.positions)
+    rows |= model_part.log_model(stream, shown, times, loaded.places)
     rows |= plots_part.log_model_size(stream, shown, times, last)
-    rows[model_part.STATE] = model_part.log_current_state(
+    rows[model_part.CURRENT] = model_part.log_current_state(
         stream,
         window["step"].to_numpy(np.int64),
         window["internal_state"].to_numpy(np.int64),
-        loaded.positions,
+        loaded.places,
     )
     every_line = plots_part.audit_lines(
         loaded.versions,
@@ -330,17 +332,29 @@ def _log(
     )
 
 
-def render_graph(recording: ViewSource, step: int, path: Path) -> Path:
+def render_graph(recording: ViewSource, step: int, path: Path, *, on_world: bool = False) -> Path:
     """Draw the model at the end of step ``step`` with Graphviz (the format from the suffix:
-    ``.svg``, ``.png``, ``.pdf``, ``.dot``, ``.gv``), the current state filled, every state
-    where the Rerun view puts it (the same layout of all versions). Returns ``path``.
+    ``.svg``, ``.png``, ``.pdf``, ``.dot``, ``.gv``), the current state filled. Every state is
+    where the same layout of all versions puts it (the thesis-style picture), or, with
+    ``on_world``, where the viewer draws it on the world (the mean tip position while it was
+    current; 200 points to a length unit). Returns ``path``.
 
-    Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a bad step and
-    :class:`~rsstp_sim.errors.GraphvizMissing` when a picture format needs ``dot``.
+    Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a bad step,
+    :class:`~rsstp_sim.errors.GraphvizMissing` when a picture format needs ``dot`` and
+    :class:`~rsstp_sim.errors.GraphvizFailed` when Graphviz fails or crashes.
     """
     model = recording.model_at(step)
-    positions = graph_positions(recording.model_versions())
-    return graph.render(model, path, positions={s: positions[s] for s in model.states})
+    versions = recording.model_versions()
+    if on_world:
+        scenario = recording.scenario
+        places = model_part.state_places(
+            recording.steps(), versions, n_joints=scenario.n_joints, reach=scenario.total_length
+        ).places
+        positions = {s: (200.0 * places[s][0], 200.0 * places[s][1]) for s in model.states}
+    else:
+        layout = graph_positions(versions)
+        positions = {s: layout[s] for s in model.states}
+    return graph.render(model, path, positions=positions)
 
 
 # ------------------------------------------------------------------------------ helpers

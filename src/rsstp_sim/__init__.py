@@ -10,6 +10,7 @@ from rsstp_sim.coupling import Event, Runner, RunSummary, StepOutcome
 from rsstp_sim.env import ArmEnv, register_envs
 from rsstp_sim.errors import (
     ActionError,
+    GraphvizFailed,
     GraphvizMissing,
     MemoryRangeError,
     ModelError,
@@ -46,6 +47,7 @@ __all__ = [
     "CompareResult",
     "DeterminismReport",
     "Event",
+    "GraphvizFailed",
     "GraphvizMissing",
     "Memory",
     "MemoryEntry",

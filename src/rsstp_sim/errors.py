@@ -8,6 +8,7 @@ __all__ = [
     "ModelError",
     "MemoryRangeError",
     "StrategyError",
+    "GraphvizFailed",
     "GraphvizMissing",
     "RecordingError",
     "ActionError",
@@ -36,6 +37,10 @@ class StrategyError(RsstpError):
 
 class GraphvizMissing(RsstpError):
     """The Graphviz ``dot`` program is needed for SVG/PNG output and was not found."""
+
+
+class GraphvizFailed(RsstpError):
+    """Graphviz ran and failed (an error, or a crash such as a segmentation fault)."""
 
 
 class RecordingError(RsstpError):

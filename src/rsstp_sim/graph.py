@@ -22,12 +22,13 @@ otherwise).
 from __future__ import annotations
 
 import shutil
+import signal
 from collections.abc import Mapping
 from pathlib import Path
 
 import graphviz
 
-from rsstp_sim.errors import GraphvizMissing, ModelError, RsstpError
+from rsstp_sim.errors import GraphvizFailed, GraphvizMissing, ModelError, RsstpError
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["layout", "render", "to_dot"]
@@ -133,12 +134,37 @@ def render(
         return out
     _require_dot()
     data: bytes
-    if positions is None:
-        data = graphviz.Source(source, engine="dot").pipe(format=fmt)
-    else:
-        data = graphviz.Source(source, engine="neato").pipe(format=fmt, neato_no_op=2)
+    engine = "dot" if positions is None else "neato"
+    try:
+        if positions is None:
+            data = graphviz.Source(source, engine="dot").pipe(format=fmt)
+        else:
+            data = graphviz.Source(source, engine="neato").pipe(format=fmt, neato_no_op=2)
+    except graphviz.CalledProcessError as exc:
+        raise GraphvizFailed(
+            f"render: Graphviz ({engine}) {_failure(exc.returncode)} drawing a model of "
+            f"{len(model)} states and {len(model.transitions())} transitions"
+            + (f": {_first_line(exc.stderr)}" if _first_line(exc.stderr) else "")
+            + "; write .dot instead to keep the graph"
+        ) from None
     out.write_bytes(data)
     return out
+
+
+def _failure(returncode: int) -> str:
+    """``crashed (SIGSEGV)`` for a signal, ``failed (exit status N)`` otherwise."""
+    if returncode < 0:
+        try:
+            return f"crashed ({signal.Signals(-returncode).name})"
+        except ValueError:
+            return f"crashed (signal {-returncode})"
+    return f"failed (exit status {returncode})"
+
+
+def _first_line(stderr: bytes | str | None) -> str:
+    text = stderr.decode(errors="replace") if isinstance(stderr, bytes) else stderr or ""
+    lines = [line.strip() for line in text.splitlines() if line.strip()]
+    return lines[0][:200] if lines else ""
 
 
 def _require_dot() -> None:

@@ -223,6 +223,13 @@ class TransitionSystem:
         except KeyError:
             raise ModelError(f"successors: unknown state {s!r}") from None
 
+    def predecessors(self, s: int) -> set[int]:
+        """The states with a transition into ``s`` (any action, ``s`` itself included)."""
+        try:
+            return {u for sources in self._in[s].values() for u in sources}
+        except KeyError:
+            raise ModelError(f"predecessors: unknown state {s!r}") from None
+
     def is_deterministic(self) -> bool:
         """Every (state, action) has at most one successor (O(1), kept incrementally)."""
         return self._n_nondeterministic == 0

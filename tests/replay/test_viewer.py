@@ -6,6 +6,7 @@ from __future__ import annotations
 import re
 import shutil
 import subprocess
+import sys
 from collections import defaultdict
 from collections.abc import Iterator
 from pathlib import Path
@@ -18,7 +19,8 @@ from fakes import RandomRefiner
 from rerun.chunk import Chunk, RrdReader
 
 from rsstp_replay import _viewer_layout, viewer
-from rsstp_replay._viewer_model import graph_columns, graph_frame
+from rsstp_replay._viewer_model import ACTION_COLORS, POSE_LINES, state_places
+from rsstp_replay.audits.contract import version_index
 from rsstp_replay.errors import ReplayError, StepOutOfRange
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_replay.viewer import ViewerWarning, graph_positions, render_graph, view
@@ -26,16 +28,7 @@ from rsstp_sim.recording import record
 from rsstp_sim.scenario import load_scenario
 
 REFERENCE = Path(__file__).parents[2] / "recordings" / "three-joint-random.mcap"
-PER_STEP = (
-    "world/arm",
-    "world/joints",
-    "world/sensor",
-    "world/blocked",
-    "model/state",
-    "plots/agent/sensation",
-    "plots/agent/feedback",
-    *(f"plots/distance/link{k}/obstacle{j}" for k in range(3) for j in range(2)),
-)
+LEARNER = Path(__file__).parents[2] / "recordings" / "two-joint-30-learner.mcap"
 
 
 class Rrd:
@@ -61,10 +54,15 @@ class Rrd:
                 found += zip(steps, batch.column(component).to_pylist(), strict=True)
         return sorted(found, key=lambda row: row[0])
 
-    def at(self, path: str, component: str, step: int) -> Any:
-        """The value of ``component`` at ``path`` in force at ``step`` (latest at or before)."""
+    def at(self, path: str, component: str, step: int, default: Any = None) -> Any:
+        """The value of ``component`` at ``path`` in force at ``step`` (latest at or before;
+        ``default`` when there is none)."""
         rows = [value for at, value in self.column(path, component) if at <= step]
-        return rows[-1]
+        return rows[-1] if rows else default
+
+    def cleared_at(self, path: str) -> list[int]:
+        """The steps of the ``Clear`` rows logged at ``path``."""
+        return [step for step, _ in self.column(path, "Clear:is_recursive")]
 
 
 @pytest.fixture(scope="module")
@@ -102,40 +100,72 @@ def refined(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Recordin
 # ------------------------------------------------------------------ paths and row counts
 
 
+def _changes(values: np.ndarray) -> list[int]:
+    """The rows where a value differs from the row before, with the first and the last."""
+    values = values.reshape(len(values), -1)
+    differs = np.r_[True, (values[1:] != values[:-1]).any(axis=1)]
+    differs[-1] = True
+    return np.flatnonzero(differs).tolist()
+
+
 def test_entity_paths_and_rows_match_the_recording(reference: tuple[Recording, Rrd]) -> None:
+    """Rows only where something changed: the arm when it moved or its blocked flag changed,
+    each series when its value changed (and at the first and last step), the one state of
+    the random strategy's model once, the current state once."""
     recording, rrd = reference
-    n = recording.n_steps + 1
+    table = recording.steps()
     assert set(rrd.temporal) == {
-        *PER_STEP,
-        "model/graph",
+        "world/arm",
+        "world/sensor",
+        "world/blocked",
+        "world/model/current",
+        "world/model/state/0",
+        "world/model/state/0/loops",
+        "world/model/state/0/poses",
+        "plots/agent/sensation",
+        "plots/agent/feedback",
+        "plots/distance",
         "plots/model/states",
         "plots/model/transitions",
         "log/audit",
     }
     assert {"world", "world/obstacles", "world/feedback_points"} <= set(rrd.static)
-    first = {
-        "world/arm": "LineStrips2D:strips",
-        "world/joints": "Points2D:positions",
-        "world/sensor": "LineStrips2D:strips",
-        "world/blocked": "Points2D:positions",
-        "model/state": "GraphNodes:node_ids",
-    }
-    for path in PER_STEP:
-        component = first.get(path, "Scalars:scalars")
-        steps = [step for step, _ in rrd.column(path, component)]
-        assert steps == list(range(n)), path
-    versions = recording.model_versions()
-    assert len(rrd.column("model/graph", "GraphNodes:node_ids")) == len(versions)
+    positions = table[[f"joint{k}_{a}" for k in range(4) for a in "xy"]].to_numpy()
+    blocked = table["blocked"].to_numpy()
+    moved = np.r_[True, (positions[1:] != positions[:-1]).any(axis=1)]
+    arm = np.flatnonzero(moved | np.r_[True, blocked[1:] != blocked[:-1]]).tolist()
+    assert [step for step, _ in rrd.column("world/arm", "LineStrips2D:strips")] == arm
+    assert len(arm) < len(table)  # blocked moves do not move the arm
+    for path, columns in (
+        ("plots/agent/sensation", ["sensation"]),
+        ("plots/agent/feedback", ["feedback"]),
+        ("plots/distance", [f"dist_{k}_{j}" for k in range(3) for j in range(2)]),
+    ):
+        expected = _changes(table[columns].to_numpy(np.float64))
+        assert [step for step, _ in rrd.column(path, "Scalars:scalars")] == expected, path
+    assert [step for step, _ in rrd.column("world/model/current", "Points2D:positions")] == [0]
+    assert [step for step, _ in rrd.column("world/model/state/0", "Points2D:positions")] == [0]
 
 
-def test_model_versions_each_have_a_row(refined: tuple[Recording, Rrd]) -> None:
+def test_the_sensation_is_a_step_plot_that_never_averages(
+    reference: tuple[Recording, Rrd],
+) -> None:
+    _, rrd = reference
+    batch = rrd.static["plots/agent/sensation"][0].to_record_batch()
+    step_after = rr.components.InterpolationMode.StepAfter.value
+    min_max = rr.components.AggregationPolicy.MinMax.value
+    assert batch.column("SeriesLines:interpolation_mode").to_pylist() == [[step_after]]
+    assert batch.column("SeriesLines:aggregation_policy").to_pylist() == [[min_max]]
+    distances = rrd.static["plots/distance"][0].to_record_batch()
+    assert distances.column("SeriesLines:names").to_pylist()[0] == [
+        f"tip of link {k} to obstacle {j}" for k in range(3) for j in range(2)
+    ]
+
+
+def test_model_versions_each_have_a_size_row(refined: tuple[Recording, Rrd]) -> None:
     recording, rrd = refined
     versions = recording.model_versions()
     assert len(versions) > 50
-    nodes = rrd.column("model/graph", "GraphNodes:node_ids")
-    edges = rrd.column("model/graph", "GraphEdges:edges")
-    assert [step for step, _ in nodes] == [record.step for record in versions]
-    assert [step for step, _ in edges] == [record.step for record in versions]
     sizes = rrd.column("plots/model/states", "Scalars:scalars")
     assert [step for step, _ in sizes][:-1] == [record.step for record in versions]
     assert sizes[-1] == (recording.n_steps, [float(len(versions[-1].states))])
@@ -153,7 +183,7 @@ def test_joint_positions_at_a_step(reference: tuple[Recording, Rrd]) -> None:
         ]
         strip = rrd.at("world/arm", "LineStrips2D:strips", step)
         np.testing.assert_allclose(strip, [expected], rtol=1e-6, atol=1e-6)  # float32 in Rerun
-        joints = rrd.at("world/joints", "Points2D:positions", step)
+        joints = rrd.at("world/arm", "Points2D:positions", step)
         np.testing.assert_allclose(joints, expected, rtol=1e-6, atol=1e-6)
 
 
@@ -184,19 +214,22 @@ def test_blocked_moves_are_marked(reference: tuple[Recording, Rrd]) -> None:
     blocked = np.flatnonzero(table["blocked"].to_numpy())
     free = np.flatnonzero(~table["blocked"].to_numpy())
     assert len(blocked) > 100
-    labels = dict(rrd.column("world/blocked", "Points2D:labels"))
-    points = dict(rrd.column("world/blocked", "Points2D:positions"))
-    colors = dict(rrd.column("world/arm", "LineStrips2D:colors"))
-    red = colors[int(blocked[0])]
+    red = None
     for step in blocked[:20].tolist():
-        assert labels[step] == [f"blocked: {table.at[step, 'blocked_by']}"]
+        assert rrd.at("world/blocked", "Points2D:labels", step) == [
+            f"blocked: {table.at[step, 'blocked_by']}"
+        ]
         np.testing.assert_allclose(
-            points[step], [[table.at[step, "joint3_x"], table.at[step, "joint3_y"]]], rtol=1e-6
+            rrd.at("world/blocked", "Points2D:positions", step),
+            [[table.at[step, "joint3_x"], table.at[step, "joint3_y"]]],
+            rtol=1e-6,
         )
-        assert colors[step] == red
+        color = rrd.at("world/arm", "LineStrips2D:colors", step)
+        assert red is None or color == red
+        red = color
     for step in free[:20].tolist():
-        assert points[step] == []
-        assert colors[step] != red
+        assert rrd.at("world/blocked", "Points2D:positions", step, default=[]) == []
+        assert rrd.at("world/arm", "LineStrips2D:colors", step) != red
 
 
 def test_obstacles_and_feedback_points_are_static(reference: tuple[Recording, Rrd]) -> None:
@@ -213,69 +246,135 @@ def test_obstacles_and_feedback_points_are_static(reference: tuple[Recording, Rr
 # ---------------------------------------------------------------------------- the model
 
 
-def test_graph_nodes_at_a_version_are_its_states_and_cells(refined: tuple[Recording, Rrd]) -> None:
+def test_states_sit_where_the_arm_was_in_their_last_version(refined: tuple[Recording, Rrd]) -> None:
+    """A state's place: the mean tip position over the steps it was current in the last
+    version it belongs to; it never moves."""
+    recording, rrd = refined
+    table = recording.steps()
+    versions = recording.model_versions()
+    in_force = version_index(versions, table["step"].to_numpy())
+    last = {s: i for i, record in enumerate(versions) for s in record.states}
+    tips = table[["joint3_x", "joint3_y"]].to_numpy()
+    states = table["internal_state"].to_numpy()
+    checked = 0
+    for state in sorted(set(states.tolist())):
+        mine = (states == state) & (in_force == last[state])
+        if not mine.any():
+            mine = states == state
+        rows = rrd.column(f"world/model/state/{state}", "Points2D:positions")
+        assert rows, state
+        for _, place in rows:
+            np.testing.assert_allclose(place, [tips[mine].mean(axis=0)], rtol=1e-5, atol=1e-5)
+        checked += 1
+    assert checked >= 3
+
+
+def _outs(record: Any) -> dict[int, list[tuple[int, int]]]:
+    outs: dict[int, list[tuple[int, int]]] = {s: [] for s in record.states}
+    for s, a, t in sorted(record.transitions, key=lambda sat: (sat[0], sat[1], sat[2])):
+        outs[s].append((a, t))
+    return outs
+
+
+def test_a_state_has_a_row_where_it_changed_and_a_clear_where_it_went(
+    refined: tuple[Recording, Rrd],
+) -> None:
+    """Rows against a brute force over the versions: a state gets a row at the step of every
+    version in which it appears or its transitions out differ from the version before, and a
+    clear at the step of the version that deletes it."""
     recording, rrd = refined
     versions = recording.model_versions()
-    nodes = rrd.column("model/graph", "GraphNodes:node_ids")
-    labels = rrd.column("model/graph", "GraphNodes:labels")
-    edges = rrd.column("model/graph", "GraphEdges:edges")
-    for index in (0, len(versions) // 2, len(versions) - 1):
-        record_ = versions[index]
-        ids = nodes[index][1]
-        assert [node for node in ids if ">" not in node] == [str(s) for s in record_.states]
-        cells: dict[str, list[int]] = defaultdict(list)
-        for s, a, t in record_.transitions:
-            cells[f"{s}>{t}"].append(a)
-        shown = dict(zip(ids, labels[index][1], strict=True))
-        assert {node for node in ids if ">" in node} == set(cells)
-        for node, actions in cells.items():
-            assert shown[node] == ",".join(map(str, sorted(actions)))
-        expected_edges = set()
-        for node in cells:
-            s, t = node.split(">")
-            expected_edges |= {(s, node), (node, t)}
-        assert {(e["first"], e["second"]) for e in edges[index][1]} == expected_edges
+    expected_rows: dict[int, list[int]] = defaultdict(list)
+    expected_clears: dict[int, list[int]] = defaultdict(list)
+    previous: dict[int, list[tuple[int, int]]] = {}
+    for version in versions:
+        now = _outs(version)
+        for state, outs in now.items():
+            if previous.get(state) != outs:
+                expected_rows[state].append(version.step)
+        for state in set(previous) - set(now):
+            expected_clears[state].append(version.step)
+        previous = now
+    assert sum(map(len, expected_clears.values())) > 0  # the refiner merges states away
+    for state in set(expected_rows) | set(expected_clears):
+        path = f"world/model/state/{state}"
+        steps = sorted({step for step, _ in rrd.column(path, "Points2D:positions")})
+        assert steps == sorted(set(expected_rows[state])), state
+        assert rrd.cleared_at(path) == expected_clears[state], state
 
 
-def test_state_positions_never_move(refined: tuple[Recording, Rrd]) -> None:
+def test_arrows_are_coloured_by_action_and_self_loops_are_markers(
+    refined: tuple[Recording, Rrd],
+) -> None:
     recording, rrd = refined
-    layout = graph_positions(recording.model_versions())
-    seen: dict[str, list[float]] = {}
-    for (_, ids), (_, places) in zip(
-        rrd.column("model/graph", "GraphNodes:node_ids"),
-        rrd.column("model/graph", "GraphNodes:positions"),
-        strict=True,
-    ):
-        for node, place in zip(ids, places, strict=True):
-            assert seen.setdefault(node, place) == place
-            if ">" not in node:  # the viewer's frame is Graphviz's with y down
-                x, y = layout[int(node)]
-                assert place == pytest.approx([x, -y], abs=1e-3)
+    final = recording.model_versions()[-1]
+    step = recording.n_steps
+    places = state_places(
+        recording.steps(), recording.model_versions(), n_joints=3, reach=6.0
+    ).places
+    for state, outs in _outs(final).items():
+        path = f"world/model/state/{state}"
+        arrows = [(a, t) for a, t in outs if t != state]
+        loops = [a for a, t in outs if t == state]
+        colors = rrd.at(path, "Arrows2D:colors", step, default=[])
+        assert len(colors) == len(arrows)
+        for (a, t), color, vector in zip(
+            arrows, colors, rrd.at(path, "Arrows2D:vectors", step, default=[]), strict=True
+        ):
+            assert _rgb(color) == ACTION_COLORS[a % len(ACTION_COLORS)]
+            towards = np.subtract(places[t], places[state])
+            if np.hypot(*towards) > 0:  # points from the state towards its target
+                assert np.dot(vector, towards) > 0
+        loop_colors = rrd.at(f"{path}/loops", "Points2D:colors", step, default=[])
+        assert sorted(_rgb(c) for c in loop_colors) == sorted(
+            ACTION_COLORS[a % len(ACTION_COLORS)] for a in loops
+        )
+
+
+def _rgb(packed: int) -> tuple[int, int, int]:
+    return (packed >> 24 & 255, packed >> 16 & 255, packed >> 8 & 255)
 
 
 def test_current_state_at_every_step(refined: tuple[Recording, Rrd]) -> None:
     recording, rrd = refined
     states = recording.steps()["internal_state"].tolist()
-    current = rrd.column("model/state", "GraphNodes:node_ids")
-    assert [ids for _, ids in current] == [[str(s)] for s in states]
+    changes = [0] + [t for t in range(1, len(states)) if states[t] != states[t - 1]]
+    labels = rrd.column("world/model/current", "Points2D:labels")
+    assert [step for step, _ in labels] == changes
+    for step in range(0, len(states), 37):
+        assert rrd.at("world/model/current", "Points2D:labels", step) == [f"now: {states[step]}"]
 
 
-def test_vectorised_graph_matches_the_per_version_definition(
-    refined: tuple[Recording, Rrd],
-) -> None:
-    recording, _ = refined
-    versions = recording.model_versions()
-    positions = {s: (x, -y) for s, (x, y) in graph_positions(versions).items()}
-    columns = graph_columns(versions, positions)
-    node_end, edge_end = np.cumsum(columns.node_counts), np.cumsum(columns.edge_counts)
-    for index, record_ in enumerate(versions):
-        frame = graph_frame(record_.states, record_.transitions, positions)
-        nodes = slice(node_end[index] - columns.node_counts[index], node_end[index])
-        edges = slice(edge_end[index] - columns.edge_counts[index], edge_end[index])
-        assert columns.node_ids[nodes].tolist() == frame.node_ids
-        assert columns.labels[nodes].tolist() == frame.labels
-        assert columns.positions[nodes].tolist() == [list(p) for p in frame.positions]
-        assert [tuple(edge) for edge in columns.edges[edges].tolist()] == frame.edges
+def test_an_aliased_state_has_lines_to_its_poses(reference: tuple[Recording, Rrd]) -> None:
+    """The random strategy's one state stands for every pose the arm visited: thin lines to
+    the tips of the most visited of them."""
+    recording, rrd = reference
+    table = recording.steps()
+    (_, strips), *_ = rrd.column("world/model/state/0/poses", "LineStrips2D:strips")
+    assert len(strips) == POSE_LINES
+    tips = {(round(x, 4), round(y, 4)) for x, y in table[["joint3_x", "joint3_y"]].to_numpy()}
+    place = np.array(strips[0][0])
+    np.testing.assert_allclose(place, table[["joint3_x", "joint3_y"]].mean(), rtol=1e-5)
+    for start, end in strips:
+        np.testing.assert_allclose(start, place, rtol=1e-6)
+        assert (round(end[0], 4), round(end[1], 4)) in tips
+
+
+def test_a_learned_model_looks_like_the_world() -> None:
+    """The learner's final model: every state of it sits on the pose of its true class (the
+    model is minimal, so one pose each), with no line to any other pose."""
+    with open_recording(LEARNER) as recording:
+        table = recording.steps(truth=True)
+        versions = recording.model_versions()
+        places = state_places(table, versions, n_joints=2, reach=3.0)
+    final = versions[-1]
+    last_steps = table.loc[table["step"] >= final.step]
+    for state in final.states:
+        seen = last_steps.loc[last_steps["internal_state"] == state]
+        if len(seen):
+            tip = seen[["joint2_x", "joint2_y"]].to_numpy()
+            np.testing.assert_allclose(places.places[state], tip[0], atol=1e-9)
+            assert state not in places.poses
 
 
 # ------------------------------------------------------------------ plots and the audit log
@@ -284,10 +383,16 @@ def test_vectorised_graph_matches_the_per_version_definition(
 def test_series_values(reference: tuple[Recording, Rrd]) -> None:
     recording, rrd = reference
     table = recording.steps()
-    feedback = rrd.column("plots/agent/feedback", "Scalars:scalars")
-    assert [value[0] for _, value in feedback] == table["feedback"].tolist()
-    distance = rrd.column("plots/distance/link2/obstacle1", "Scalars:scalars")
-    assert [value[0] for _, value in distance] == table["dist_2_1"].tolist()
+    for step in (0, 17, 999, recording.n_steps):
+        assert rrd.at("plots/agent/feedback", "Scalars:scalars", step) == [
+            table.at[step, "feedback"]
+        ]
+        assert rrd.at("plots/distance", "Scalars:scalars", step) == [
+            table.at[step, f"dist_{k}_{j}"] for k in range(3) for j in range(2)
+        ]
+        assert rrd.at("plots/agent/sensation", "Scalars:scalars", step) == [
+            float(table.at[step, "sensation"])
+        ]
 
 
 def test_audit_log_lines_at_their_steps(
@@ -345,13 +450,16 @@ def test_a_step_range(refined: tuple[Recording, Rrd], tmp_path: Path) -> None:
     result = view(recording, save=out, spawn=False, serve_web=False, start=100, end=250)
     assert (result.summary.first_step, result.summary.last_step) == (100, 250)
     rrd = Rrd(out)
-    assert [s for s, _ in rrd.column("world/arm", "LineStrips2D:strips")] == list(range(100, 251))
-    graph = rrd.column("model/graph", "GraphNodes:node_ids")
-    versions = [r for r in recording.model_versions() if r.step <= 250]
-    in_force = [r for r in versions if r.step <= 100][-1]
-    assert graph[0][0] == 100
-    assert [n for n in graph[0][1] if ">" not in n] == [str(s) for s in in_force.states]
-    assert [s for s, _ in graph[1:]] == [r.step for r in versions if r.step > 100]
+    arm = [s for s, _ in rrd.column("world/arm", "LineStrips2D:strips")]
+    assert arm[0] == 100 and arm[-1] <= 250
+    in_force = [r for r in recording.model_versions() if r.step <= 100][-1]
+    first_rows = {
+        path.rsplit("/", 1)[1]: min(step for step, _ in rrd.column(path, "Points2D:positions"))
+        for path in rrd.temporal
+        if path.startswith("world/model/state/") and path.count("/") == 3
+    }
+    assert {int(s) for s, step in first_rows.items() if step == 100} == set(in_force.states)
+    assert all(100 <= step <= 250 for step in first_rows.values())
     assert all(100 <= step <= 250 for step, _ in rrd.column("log/audit", "TextLog:text"))
     assert "steps 100..250" in result.to_text()
 
@@ -374,13 +482,17 @@ def test_bad_arguments_raise(refined: tuple[Recording, Rrd], tmp_path: Path) -> 
     assert not (tmp_path / "x.rrd").exists()
 
 
-@pytest.mark.skipif(shutil.which("rerun") is None, reason="the rerun CLI is not installed")
+RERUN = shutil.which("rerun", path=str(Path(sys.executable).parent)) or shutil.which("rerun")
+
+
+@pytest.mark.skipif(RERUN is None, reason="the rerun program (from rerun-sdk) is not installed")
 def test_rerun_verifies_the_files(
     reference: tuple[Recording, Rrd], refined: tuple[Recording, Rrd]
 ) -> None:
+    assert RERUN is not None
     for _, rrd in (reference, refined):
         done = subprocess.run(
-            ["rerun", "rrd", "verify", str(rrd.path)],
+            [RERUN, "rrd", "verify", str(rrd.path)],
             capture_output=True,
             text=True,
             timeout=120,
@@ -424,23 +536,32 @@ def test_without_graphviz_the_states_go_on_a_circle(
 
 
 @pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz is not installed")
-def test_render_graph_uses_the_viewer_positions(
+def test_render_graph_thesis_layout_and_on_the_world(
     refined: tuple[Recording, Rrd], tmp_path: Path
 ) -> None:
-    recording, rrd = refined
+    recording, _ = refined
     step = 200
     model = recording.model_at(step)
-    source = render_graph(recording, step, tmp_path / "model.dot").read_text()
-    places = {
-        int(m[1]): (float(m[2]), float(m[3]))
-        for m in re.finditer(r'\t(\d+) \[.*?pos="([-\d.]+),([-\d.]+)!"', source)
-    }
+
+    def pinned(source: str) -> dict[int, tuple[float, float]]:
+        return {
+            int(m[1]): (float(m[2]), float(m[3]))
+            for m in re.finditer(r'\t(\d+) \[.*?pos="([-\d.]+),([-\d.]+)!"', source)
+        }
+
+    layout = graph_positions(recording.model_versions())
+    places = pinned(render_graph(recording, step, tmp_path / "model.dot").read_text())
     assert set(places) == set(model.states)
-    nodes = rrd.at("model/graph", "GraphNodes:node_ids", step)
-    shown = rrd.at("model/graph", "GraphNodes:positions", step)
-    for node, (x, y) in zip(nodes, shown, strict=True):
-        if ">" not in node:
-            assert places[int(node)] == pytest.approx((x, -y), abs=0.01)
+    for state, place in places.items():
+        assert place == pytest.approx(layout[state], abs=0.01)
+    world = state_places(recording.steps(), recording.model_versions(), n_joints=3, reach=6.0)
+    on_world = pinned(
+        render_graph(recording, step, tmp_path / "world.dot", on_world=True).read_text()
+    )
+    for state, (x, y) in on_world.items():
+        assert (x, y) == pytest.approx(
+            (200 * world.places[state][0], 200 * world.places[state][1]), abs=0.01
+        )
     svg = render_graph(recording, step, tmp_path / "model.svg")
     assert svg.read_text().startswith("<?xml")
     with pytest.raises(StepOutOfRange):
