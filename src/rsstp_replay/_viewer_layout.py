@@ -13,7 +13,7 @@ import subprocess
 import warnings
 from collections.abc import Iterable, Sequence
 
-from rsstp_sim.errors import ModelError
+from rsstp_sim.graph import graphviz_failed
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -114,7 +114,9 @@ def _run_layout(
         [engine, "-Tplain"], input=source, capture_output=True, text=True, timeout=timeout
     )
     if done.returncode != 0:
-        raise ModelError(f"graph layout: {engine} failed: {done.stderr.strip()}")
+        raise graphviz_failed(
+            engine, done.returncode, done.stderr, what="the layout of every model version"
+        )
     positions: dict[int, tuple[float, float]] = {}
     for line in done.stdout.splitlines():
         fields = line.split()

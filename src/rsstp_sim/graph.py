@@ -31,7 +31,7 @@ import graphviz
 from rsstp_sim.errors import GraphvizFailed, GraphvizMissing, ModelError, RsstpError
 from rsstp_sim.transition_system import TransitionSystem
 
-__all__ = ["layout", "render", "to_dot"]
+__all__ = ["graphviz_failed", "layout", "render", "to_dot"]
 
 _IMAGE_FORMATS = ("svg", "png", "pdf")
 _SOURCE_FORMATS = ("dot", "gv")
@@ -141,30 +141,34 @@ def render(
         else:
             data = graphviz.Source(source, engine="neato").pipe(format=fmt, neato_no_op=2)
     except graphviz.CalledProcessError as exc:
-        raise GraphvizFailed(
-            f"render: Graphviz ({engine}) {_failure(exc.returncode)} drawing a model of "
-            f"{len(model)} states and {len(model.transitions())} transitions"
-            + (f": {_first_line(exc.stderr)}" if _first_line(exc.stderr) else "")
-            + "; write .dot instead to keep the graph"
+        raise graphviz_failed(
+            engine,
+            exc.returncode,
+            exc.stderr,
+            what=f"a model of {len(model)} states and {len(model.transitions())} transitions",
         ) from None
     out.write_bytes(data)
     return out
 
 
-def _failure(returncode: int) -> str:
-    """``crashed (SIGSEGV)`` for a signal, ``failed (exit status N)`` otherwise."""
+def graphviz_failed(
+    engine: str, returncode: int, stderr: bytes | str | None, *, what: str
+) -> GraphvizFailed:
+    """The one-line error for a Graphviz program that failed (exit status) or crashed
+    (signal, e.g. SIGSEGV) drawing ``what``."""
     if returncode < 0:
         try:
-            return f"crashed ({signal.Signals(-returncode).name})"
+            how = f"crashed ({signal.Signals(-returncode).name})"
         except ValueError:
-            return f"crashed (signal {-returncode})"
-    return f"failed (exit status {returncode})"
-
-
-def _first_line(stderr: bytes | str | None) -> str:
+            how = f"crashed (signal {-returncode})"
+    else:
+        how = f"failed (exit status {returncode})"
     text = stderr.decode(errors="replace") if isinstance(stderr, bytes) else stderr or ""
     lines = [line.strip() for line in text.splitlines() if line.strip()]
-    return lines[0][:200] if lines else ""
+    detail = f": {lines[0][:200]}" if lines else ""
+    return GraphvizFailed(
+        f"Graphviz ({engine}) {how} drawing {what}{detail}; write .dot instead to keep the graph"
+    )
 
 
 def _require_dot() -> None:

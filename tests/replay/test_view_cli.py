@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -10,6 +11,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 REFERENCE = ROOT / "recordings" / "thesis-roulette-script.mcap"
+LEARNER = ROOT / "recordings" / "two-joint-30-learner.mcap"
 
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
@@ -62,3 +64,46 @@ def test_graph_draws_the_model_at_a_step(tmp_path: Path) -> None:
     assert out.read_text().lstrip().startswith(("<?xml", "<svg", "<!DOCTYPE"))
     bad = run_cli("graph", str(REFERENCE), "--step", "1000", "-o", str(tmp_path / "m.svg"))
     assert bad.returncode == 2 and "out of range" in bad.stderr
+
+
+@pytest.mark.parametrize(
+    ("extra", "engine", "what"),
+    [((), "sfdp", "the layout of every model version"), (("--on-world",), "neato", "a model of")],
+)
+def test_a_graphviz_crash_is_one_line(
+    tmp_path: Path, extra: tuple[str, ...], engine: str, what: str
+) -> None:
+    """Graphviz programs that die of SIGSEGV (fakes first on PATH; the learner's union of
+    versions has over 400 state pairs, so sfdp lays it out): one line naming the
+    program and the signal, exit 2, nothing written."""
+    fakes = tmp_path / "bin"
+    fakes.mkdir()
+    for program in ("dot", "neato", "sfdp"):
+        fake = fakes / program
+        fake.write_text("#!/bin/sh\nkill -SEGV $$\n")
+        fake.chmod(0o755)
+    out = tmp_path / "model.svg"
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "rsstp_replay",
+            "graph",
+            str(LEARNER),
+            "--step",
+            "9000",
+            "-o",
+            str(out),
+            *extra,
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PATH": f"{fakes}:{os.environ['PATH']}"},
+    )
+    assert done.returncode == 2, done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr
+    assert lines[0].startswith(f"rsstp-replay: error: Graphviz ({engine}) crashed (SIGSEGV) ")
+    assert what in lines[0] and lines[0].endswith("write .dot instead to keep the graph")
+    assert not out.exists()
