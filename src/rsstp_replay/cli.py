@@ -237,20 +237,33 @@ def _check_output(out: Path, *, force: bool) -> None:
 
 
 def _cmd_view(args: argparse.Namespace) -> int:
+    from rsstp_replay._viewer_serve import check_port, has_display
     from rsstp_replay.viewer import ViewerWarning, view
 
     save = Path(args.save) if args.save is not None else None
+    spawn = args.spawn or (save is None and not args.serve_web)
+    if spawn and not has_display():
+        raise UsageError(
+            "view: no display for a native viewer (neither DISPLAY nor WAYLAND_DISPLAY is set): "
+            "write a file with --save OUT.rrd, or serve the web viewer with --serve-web"
+        )
     if save is not None:
         _check_output(save, force=args.force)
+    if args.serve_web:  # before anything is read: a port in use is one line
+        check_port(args.bind, args.web_port, option="--web-port")
+        check_port(args.bind, args.grpc_port, option="--grpc-port")
     with _open(args.file) as recording, warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ViewerWarning)
         result = view(
             recording,
             save=save,
-            spawn=args.spawn or (save is None and not args.serve_web),
+            spawn=spawn,
             serve_web=args.serve_web,
             start=args.start,
             end=args.end,
+            bind=args.bind,
+            web_port=args.web_port,
+            grpc_port=args.grpc_port,
         )
     for warning in caught:
         print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
@@ -258,7 +271,9 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if save is not None:
         print(f"open it with: rerun {save}")
     if args.serve_web:
+        print(f"serving on {args.bind} until Ctrl-C", flush=True)
         result.serve_forever()
+        print("stopped serving")
     return 0
 
 
@@ -325,7 +340,17 @@ def _build_parser() -> Parser:
         "--save", metavar="OUT.rrd", help="write an .rrd file (open it with: rerun OUT.rrd)"
     )
     p.add_argument("--spawn", action="store_true", help="open the native viewer")
-    p.add_argument("--serve-web", action="store_true", help="serve the web viewer on localhost")
+    p.add_argument(
+        "--serve-web", action="store_true", help="serve the web viewer (on 127.0.0.1 by default)"
+    )
+    p.add_argument(
+        "--bind",
+        default="127.0.0.1",
+        metavar="ADDR",
+        help="the address --serve-web listens on (default 127.0.0.1; 0.0.0.0 for every interface)",
+    )
+    p.add_argument("--web-port", type=_integer, default=9090, help="the web page's port")
+    p.add_argument("--grpc-port", type=_integer, default=9877, help="the data's port")
     p.add_argument("--from", dest="start", type=_integer, metavar="STEP", help="first step")
     p.add_argument("--to", dest="end", type=_integer, metavar="STEP", help="last step (inclusive)")
     p.add_argument("--force", action="store_true", help="overwrite an existing .rrd file")

@@ -19,8 +19,8 @@ spawned) is reported as a :class:`ViewerWarning` and the rest is still shown. Ba
 from __future__ import annotations
 
 import bisect
+import tempfile
 import time
-import urllib.parse
 import uuid
 import warnings
 from collections.abc import Sequence
@@ -38,6 +38,7 @@ from rsstp_replay import _viewer_world as world_part
 from rsstp_replay._viewer_blueprint import default_blueprint
 from rsstp_replay._viewer_chunks import TIMELINE
 from rsstp_replay._viewer_layout import ViewerWarning, graph_positions
+from rsstp_replay._viewer_serve import DEFAULT_BIND, WebServer, check_port
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.errors import ReplayError, StepOutOfRange
@@ -67,8 +68,9 @@ APPLICATION_ID = "rsstp"
 SPAWN_PORT = 9876
 """The port of a spawned native viewer (Rerun's default)."""
 SERVE_PORT = 9877
-"""The gRPC port of ``serve_web``'s server (the web page itself is on 9090)."""
+"""The default gRPC port of ``serve_web``'s server (the data; the web page is on 9090)."""
 WEB_PORT = 9090
+"""The default port of the web viewer's page."""
 
 ENTITY_PATHS: tuple[str, ...] = (
     world_part.WORLD,
@@ -128,15 +130,16 @@ class LogSummary:
 @dataclass(slots=True)
 class ViewResult:
     """The outcome of :func:`view`. ``seconds_rerun`` includes flushing the sinks (writing
-    the ``.rrd``). With ``web_url`` set, a gRPC server holds the data for the web viewer
-    until :meth:`close` (or the end of :meth:`serve_forever`)."""
+    the ``.rrd``). With ``web_url`` set, a web server serves the view until :meth:`close`
+    (or the end of :meth:`serve_forever`)."""
 
     summary: LogSummary
     saved: Path | None
     spawned: bool
     web_url: str | None
     seconds_rerun: float
-    _stream: rr.RecordingStream | None = field(default=None, repr=False)
+    _server: WebServer | None = field(default=None, repr=False)
+    _folder: tempfile.TemporaryDirectory[str] | None = field(default=None, repr=False)
 
     def to_text(self) -> str:
         """One line for the command line."""
@@ -149,25 +152,26 @@ class ViewResult:
         return (
             f"steps {s.first_step}..{s.last_step}: {len(s.rows)} entities, "
             f"{s.model_versions} model versions, {s.log_lines} log lines; read "
-            f"{s.seconds_read:.2f} s, audits and layout {s.seconds_prepare:.2f} s, Rerun "
+            f"{s.seconds_read:.2f} s, audits and placing {s.seconds_prepare:.2f} s, Rerun "
             f"{self.seconds_rerun:.2f} s" + ("; " + ", ".join(where) if where else "")
         )
 
     def serve_forever(self) -> None:
         """Keep serving the web viewer until interrupted (Ctrl-C), then stop."""
         try:
-            while self.web_url is not None and self._stream is not None:
-                time.sleep(0.5)
-        except KeyboardInterrupt:
-            pass
+            if self._server is not None:
+                self._server.wait()
         finally:
             self.close()
 
     def close(self) -> None:
-        """Stop serving (if serving) and release the stream."""
-        if self._stream is not None:
-            self._stream.disconnect()
-            self._stream = None
+        """Stop serving (if serving) and remove the file served when it was a temporary one."""
+        if self._server is not None:
+            self._server.close()
+            self._server = None
+        if self._folder is not None:
+            self._folder.cleanup()
+            self._folder = None
 
 
 def view(
@@ -178,14 +182,19 @@ def view(
     serve_web: bool,
     start: int | None,
     end: int | None,
+    bind: str = DEFAULT_BIND,
+    web_port: int = WEB_PORT,
+    grpc_port: int = SERVE_PORT,
 ) -> ViewResult:
     """Stream steps ``start .. end`` (inclusive; default: all) of ``recording`` to Rerun.
 
     ``save``: write an ``.rrd`` file (the default blueprint inside); ``spawn``: send to a native
-    viewer, started if none listens on port 9876; ``serve_web``: host a web viewer
-    (``web_url``; keep the process alive with :meth:`ViewResult.serve_forever`). With none of
-    them a native viewer is spawned. Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a
-    bad range and :class:`~rsstp_replay.errors.ReplayError` for an unwritable ``save``.
+    viewer, started if none listens on port 9876; ``serve_web``: serve the web viewer on
+    ``bind`` (127.0.0.1 by default), the page on ``web_port``, the data on ``grpc_port``, from
+    the ``.rrd`` (``save``, or a temporary file) by the ``rerun`` program (``web_url``; keep
+    the process alive with :meth:`ViewResult.serve_forever`). With none of them a native
+    viewer is spawned. Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a bad range and
+    :class:`~rsstp_replay.errors.ReplayError` for an unwritable ``save`` or a port in use.
     """
     first, last = _step_range(recording, start, end)
     if save is not None:
@@ -194,11 +203,18 @@ def view(
             raise ReplayError(f"cannot write {save}: the folder {save.parent} does not exist")
     if save is None and not spawn and not serve_web:
         spawn = True
+    folder = None
+    if serve_web:
+        check_port(bind, web_port, option="--web-port")
+        check_port(bind, grpc_port, option="--grpc-port")
+        if save is None:
+            folder = tempfile.TemporaryDirectory(prefix="rsstp-view-")
+    target = save if folder is None else Path(folder.name) / "view.rrd"
     loaded = _load(recording)
     stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
-    sinks: list[rr.FileSink | rr.GrpcSink | rr.GrpcServerSink] = []
-    if save is not None:
-        sinks.append(rr.FileSink(save))
+    sinks: list[rr.FileSink | rr.GrpcSink] = []
+    if target is not None:
+        sinks.append(rr.FileSink(target))
     spawned = False
     if spawn:
         try:
@@ -208,13 +224,6 @@ def view(
         else:
             sinks.append(rr.GrpcSink(f"rerun+http://127.0.0.1:{SPAWN_PORT}/proxy"))
             spawned = True
-    web_url = None
-    if serve_web:
-        server = rr.GrpcServerSink(port=SERVE_PORT)
-        sinks.append(server)
-        grpc_url = f"rerun+http://127.0.0.1:{SERVE_PORT}/proxy"
-        rr.serve_web_viewer(web_port=WEB_PORT, open_browser=False, connect_to=grpc_url)
-        web_url = f"http://127.0.0.1:{WEB_PORT}/?url={urllib.parse.quote(grpc_url, safe='')}"
     blueprint = default_blueprint(recording.scenario, first=first, last=last)
     stream.set_sinks(*sinks, default_blueprint=blueprint)
     summary = _log(recording, loaded, stream, first, last)
@@ -224,16 +233,25 @@ def view(
     except RuntimeError as exc:  # a spawned viewer that never listened: the file is still whole
         warnings.warn(ViewerWarning(f"the Rerun viewer could not be reached: {exc}"), stacklevel=2)
         spawned = False
-    if web_url is None:
-        stream.disconnect()  # finishes the file (its footer) and the connection
+    stream.disconnect()  # finishes the file (its footer) and the connection
     seconds = summary.seconds_rerun + time.perf_counter() - began
+    server = None
+    if serve_web:
+        assert target is not None
+        try:
+            server = WebServer(target, bind=bind, web_port=web_port, grpc_port=grpc_port)
+        except ReplayError:
+            if folder is not None:
+                folder.cleanup()
+            raise
     return ViewResult(
         summary=summary,
         saved=save,
         spawned=spawned,
-        web_url=web_url,
+        web_url=None if server is None else server.url,
         seconds_rerun=seconds,
-        _stream=stream if web_url is not None else None,
+        _server=server,
+        _folder=folder,
     )
 
 

@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import os
+import signal
+import socket
 import subprocess
 import sys
+import time
+import urllib.request
 from pathlib import Path
 
 import pytest
@@ -107,3 +111,98 @@ def test_a_graphviz_crash_is_one_line(
     assert lines[0].startswith(f"rsstp-replay: error: Graphviz ({engine}) crashed (SIGSEGV) ")
     assert what in lines[0] and lines[0].endswith("write .dot instead to keep the graph")
     assert not out.exists()
+
+
+# ------------------------------------------------------------------- headless and the web
+
+
+def test_view_without_a_display_says_what_to_do_at_once() -> None:
+    """No DISPLAY (as in CI): no wait for a viewer that cannot start, one line, exit 2."""
+    for extra in ((), ("--spawn",)):
+        done = run_cli("view", str(REFERENCE), *extra)  # run_cli's environment has no display
+        assert done.returncode == 2
+        assert done.stderr.strip() == (
+            "rsstp-replay: error: view: no display for a native viewer (neither DISPLAY nor "
+            "WAYLAND_DISPLAY is set): write a file with --save OUT.rrd, or serve the web viewer "
+            "with --serve-web"
+        )
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
+
+
+def test_serve_web_refuses_a_port_in_use_in_one_line() -> None:
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        for option, other in (("--web-port", "--grpc-port"), ("--grpc-port", "--web-port")):
+            done = run_cli(
+                "view", str(REFERENCE), "--serve-web", option, str(port), other, str(_free_port())
+            )
+            assert done.returncode == 2
+            assert done.stderr.strip() == (
+                f"rsstp-replay: error: port {port} on 127.0.0.1 is in use: choose another with "
+                f"{option} N"
+            )
+
+
+def _listening(port: int) -> set[str]:
+    """The local addresses (hex, as in /proc/net/tcp) listening on ``port``."""
+    found = set()
+    for table in ("/proc/net/tcp", "/proc/net/tcp6"):
+        if not Path(table).exists():
+            continue
+        for line in Path(table).read_text().splitlines()[1:]:
+            fields = line.split()
+            address, hex_port = fields[1].rsplit(":", 1)
+            if fields[3] == "0A" and int(hex_port, 16) == port:
+                found.add(address)
+    return found
+
+
+@pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
+def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(tmp_path: Path) -> None:
+    """A real server: the page answers on 127.0.0.1, nothing listens on another address,
+    SIGINT stops it with exit 0 and removes the temporary file it served."""
+    web, grpc = _free_port(), _free_port()
+    server = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "rsstp_replay",
+            "view",
+            str(REFERENCE),
+            "--serve-web",
+            "--web-port",
+            str(web),
+            "--grpc-port",
+            str(grpc),
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env={**os.environ, "TMPDIR": str(tmp_path)},
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and not _listening(web):
+            assert server.poll() is None, server.communicate()[1]
+            time.sleep(0.2)
+        assert _listening(web) == {"0100007F"}  # 127.0.0.1 only
+        assert _listening(grpc) == {"0100007F"}
+        page = urllib.request.urlopen(f"http://127.0.0.1:{web}/", timeout=10).read()
+        assert b"<html" in page.lower()
+        assert list(tmp_path.glob("rsstp-view-*/view.rrd"))
+    finally:
+        server.send_signal(signal.SIGINT)
+        out, err = server.communicate(timeout=60)
+    assert server.returncode == 0, err
+    assert "serving the web viewer at http://127.0.0.1:" in out and "stopped serving" in out
+    assert "Traceback" not in err
+    assert not list(tmp_path.glob("rsstp-view-*"))
+    assert not _listening(web)
