@@ -1,4 +1,5 @@
-"""``rsstp-replay``: look into a recording: ``info``, ``check``, ``table``, ``audit``, ``compare``.
+"""``rsstp-replay``: look into a recording: ``info``, ``check``, ``table``, ``events``,
+``audit``, ``compare``, ``view``, ``graph``.
 
 Bad input (a missing or damaged file, a file from another tool, a schema version this reader
 does not know, a step out of range) gets one line on stderr naming the file and the problem,
@@ -16,10 +17,14 @@ import sys
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_sim.commandline import Parser, UsageError, run_command
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["main"]
 
@@ -97,27 +102,19 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_table(args: argparse.Namespace) -> int:
-    out = Path(args.output)
+def _check_table_output(out: Path, *, force: bool) -> None:
+    """One line for a table path we cannot or must not write (before reading anything)."""
     if out.suffix.lower() not in _TABLE_FORMATS:
         raise UsageError(
             f"{out}: unknown table format {out.suffix or '(no suffix)'!r}: expected "
             f"{' or '.join(_TABLE_FORMATS)}"
         )
-    if out.is_dir():
-        raise UsageError(f"{out}: is a directory, not an output file")
-    if out.exists() and not args.force:
-        raise UsageError(f"{out}: already exists (use --force to overwrite)")
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir():
-        raise UsageError(f"{out}: the output directory {parent} does not exist")
-    with _open(args.file) as recording:
-        if args.truth:
-            from rsstp_replay.audits import truth_table
+    _check_output(out, force=force)
 
-            table = truth_table(recording)
-        else:
-            table = recording.steps()
+
+def _write_table(table: pd.DataFrame, out: Path) -> None:
+    """Write ``table`` (Parquet or CSV by the suffix) to a side file, then rename it into
+    place: a failed write leaves no partial table and the old one untouched."""
     partial = out.with_name(f".{out.name}.partial")
     try:
         if out.suffix.lower() == ".parquet":
@@ -132,6 +129,37 @@ def _cmd_table(args: argparse.Namespace) -> int:
         partial.unlink(missing_ok=True)
         raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
     print(f"wrote {len(table):,} rows and {len(table.columns)} columns to {out}")
+
+
+def _cmd_table(args: argparse.Namespace) -> int:
+    out = Path(args.output)
+    _check_table_output(out, force=args.force)
+    with _open(args.file) as recording:
+        if args.truth:
+            from rsstp_replay.audits import truth_table
+
+            table = truth_table(recording)
+        else:
+            table = recording.steps()
+    _write_table(table, out)
+    return 0
+
+
+def _cmd_events(args: argparse.Namespace) -> int:
+    from rsstp_replay.recording import EVENT_KINDS
+
+    out = Path(args.output)
+    _check_table_output(out, force=args.force)
+    unknown = sorted(set(args.kind or ()) - set(EVENT_KINDS))
+    if unknown:
+        raise UsageError(
+            f"events: unknown kind {unknown[0]!r}: expected one of {', '.join(EVENT_KINDS)}"
+        )
+    with _open(args.file) as recording:
+        table = recording.events()
+    if args.kind:
+        table = table.loc[table["kind"].isin(args.kind)].reset_index(drop=True)
+    _write_table(table, out)
     return 0
 
 
@@ -316,6 +344,19 @@ def _build_parser() -> Parser:
         "model version)",
     )
     p.set_defaults(func=_cmd_table)
+
+    p = sub.add_parser("events", help="write the events table (one row per event)")
+    p.add_argument("file", help="the .mcap recording")
+    p.add_argument("-o", "--output", required=True, help="the table: .parquet or .csv")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.add_argument(
+        "--kind",
+        action="append",
+        metavar="KIND",
+        help="only events of this kind (repeatable): blocked, no_transition, split, merge, add, "
+        "delete, note, contradiction",
+    )
+    p.set_defaults(func=_cmd_events)
 
     p = sub.add_parser("audit", help="consistency, determinism and summary audits")
     p.add_argument("file", help="the .mcap recording")
