@@ -138,7 +138,7 @@ def _cmd_table(args: argparse.Namespace) -> int:
         if args.truth:
             from rsstp_replay.audits import truth_table
 
-            table = truth_table(recording)
+            table = truth_table(recording, truth=recording.ground_truth())
         else:
             table = recording.steps()
     _write_table(table, out)

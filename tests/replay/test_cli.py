@@ -129,8 +129,8 @@ def test_table_truth_adds_class_pose_and_aliasing(
     assert printed == f"wrote 1,501 rows and 30 columns to {out}\n"
     table = pd.read_parquet(out)
     with open_recording(run) as recording:
-        findings = audit_truth(recording)
         truth = recording.ground_truth()
+        findings = audit_truth(recording, truth=truth)
         pd.testing.assert_frame_equal(table.iloc[:, :27], recording.steps())
     assert table["true_class"].tolist() == findings.true_class.tolist()
     assert table["aliased"].tolist() == findings.aliased_step.tolist()
