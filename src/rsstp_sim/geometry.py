@@ -344,38 +344,57 @@ def move_blockers(
     link = np.arange(n)
     moving = link[None, :] >= joint[:, None]  # (B, n)
 
-    # Moving links against obstacles: centres turned the opposite way.
+    # Moving links against obstacles: centres turned the opposite way. Turning keeps every
+    # point's distance to the pivot, so a link sweeps only the ring between its nearest and
+    # farthest distance from the pivot; an obstacle disk off that ring cannot be met, and the
+    # exact arc test runs only for the (move, link, obstacle) triples on it.
     if geo.m:
-        dist = arc_segment_distance(
-            pivot[:, None, None],
-            geo.centers[None, None],
-            -delta_rad[:, None, None],
-            a[:, :, None],
-            b[:, :, None],
+        reach = geo.radii + geo.eps
+        slack = reach + geo.eps  # the ring test is a filter: it must never miss a contact
+        near = point_segment_distance(pivot[:, None, :], a, b)  # (B, n)
+        far = np.maximum(
+            np.hypot(*np.moveaxis(a - pivot[:, None, :], -1, 0)),
+            np.hypot(*np.moveaxis(b - pivot[:, None, :], -1, 0)),
         )
-        obstacle = (dist <= geo.radii + geo.eps) & moving[:, :, None]
+        centre = np.hypot(*np.moveaxis(geo.centers[None] - pivot[:, None, :], -1, 0))  # (B, m)
+        ring = (
+            moving[:, :, None]
+            & (centre[:, None, :] + slack >= near[:, :, None])
+            & (centre[:, None, :] - slack <= far[:, :, None])
+        )
+        at_row, at_link, at_obstacle = np.nonzero(ring)
+        obstacle = np.zeros((batch, n, geo.m), dtype=bool)
+        if len(at_row):
+            dist = arc_segment_distance(
+                pivot[at_row],
+                geo.centers[at_obstacle],
+                -delta_rad[at_row],
+                a[at_row, at_link],
+                b[at_row, at_link],
+            )
+            obstacle[at_row, at_link, at_obstacle] = dist <= reach[at_obstacle]
     else:
         obstacle = np.zeros((batch, n, 0), dtype=bool)
 
     # Moving link j against fixed link i (i < j - 1): ends of the moving link on
     # the fixed one, or ends of the fixed link (turned back) on the moving one.
     pi, pj = geo._pairs()
-    if pi.size:
-        pv = pivot[:, None]
-        d = delta_rad[:, None]
-        fixed_a, fixed_b, move_a, move_b = a[:, pi], b[:, pi], a[:, pj], b[:, pj]
-        contact = np.minimum.reduce(
-            [
-                arc_segment_distance(pv, move_a, d, fixed_a, fixed_b),
-                arc_segment_distance(pv, move_b, d, fixed_a, fixed_b),
-                arc_segment_distance(pv, fixed_a, -d, move_a, move_b),
-                arc_segment_distance(pv, fixed_b, -d, move_a, move_b),
-            ]
-        )
-        relevant = (pi[None, :] < joint[:, None]) & (pj[None, :] >= joint[:, None])
-        links = (contact <= geo.eps) & relevant
-    else:
-        links = np.zeros((batch, 0), dtype=bool)
+    links = np.zeros((batch, pi.size), dtype=bool)
+    if pi.size:  # only the pairs of a fixed link and a moving one can meet
+        rows, pairs = np.nonzero((pi[None, :] < joint[:, None]) & (pj[None, :] >= joint[:, None]))
+        if len(rows):
+            pv, d = pivot[rows], delta_rad[rows]
+            fixed_a, fixed_b = a[rows, pi[pairs]], b[rows, pi[pairs]]
+            move_a, move_b = a[rows, pj[pairs]], b[rows, pj[pairs]]
+            contact = np.minimum.reduce(
+                [
+                    arc_segment_distance(pv, move_a, d, fixed_a, fixed_b),
+                    arc_segment_distance(pv, move_b, d, fixed_a, fixed_b),
+                    arc_segment_distance(pv, fixed_a, -d, move_a, move_b),
+                    arc_segment_distance(pv, fixed_b, -d, move_a, move_b),
+                ]
+            )
+            links[rows, pairs] = contact <= geo.eps
     return _first_codes(geo, fold, obstacle, links, fold_joint)
 
 

@@ -108,6 +108,11 @@ class World:
         codes, first = np.unique(codes, return_index=True)
         box = box[first]
         fresh = np.array([c not in self._moves for c in codes.tolist()], dtype=bool)
+        # A pose that is itself invalid (a link in an obstacle, links crossing, a fold) is
+        # never reached (a move into it is blocked): its moves are not computed, which
+        # saves the most expensive part, the swept checks, for about half of a box near
+        # obstacles. The pose asked for is always computed.
+        fresh &= (geometry.pose_blockers(self.geometry, box) == 0) | (codes == code)
         box, codes = box[fresh], codes[fresh]
 
         n_actions = len(self._action_joint)
