@@ -24,6 +24,8 @@ import sys
 import tempfile
 from pathlib import Path
 
+from _recordings import random_three_joint
+
 BIN = Path(sys.executable).parent
 TARGETS_1M = {"table": (3.0, 1.5), "audit": (5.0, 1.5), "audit --truth": (10.0, 1.5)}
 TARGET_10M_GIB = 3.0
@@ -36,33 +38,6 @@ seconds = time.perf_counter() - began
 peak_kib = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
 print(done.returncode, seconds, peak_kib, done.stderr.decode().strip().replace(chr(10), " | "))
 """
-
-
-def recording(steps: int) -> Path:
-    path = Path(tempfile.gettempdir()) / f"rsstp-bench-three-joint-{steps}.mcap"
-    if not path.exists():
-        partial = path.with_suffix(".partial.mcap")
-        print(f"recording {steps:,} steps to {path} (once)...", flush=True)
-        subprocess.run(
-            [
-                str(BIN / "rsstp-sim"),
-                "record",
-                "three-joint",
-                "--strategy",
-                "random",
-                "--seed",
-                "1",
-                "--steps",
-                str(steps),
-                "-o",
-                str(partial),
-                "--force",
-            ],
-            check=True,
-            stdout=subprocess.DEVNULL,
-        )
-        partial.rename(path)
-    return path
 
 
 def measure(command: list[str]) -> tuple[float, float]:
@@ -82,7 +57,7 @@ def main() -> None:
     parser.add_argument("--only", choices=sorted(TARGETS_1M), action="append")
     parser.add_argument("--repeat", type=int, default=2)
     args = parser.parse_args()
-    mcap = recording(args.steps)
+    mcap = random_three_joint(args.steps)
     replay = str(BIN / "rsstp-replay")
     out = Path(tempfile.gettempdir()) / "rsstp-bench-table.parquet"
     commands = {

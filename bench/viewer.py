@@ -41,6 +41,8 @@ import urllib.request
 from pathlib import Path
 from typing import Any
 
+from _recordings import recorded
+from rsstp_replay._viewer_serve import WebServer
 from rsstp_replay.recording import open_recording
 from rsstp_replay.viewer import view
 
@@ -76,17 +78,7 @@ def recording_of(name: str) -> Path:
     case = CASES[name]
     if "file" in case:
         return Path(case["file"])
-    path = TMP / f"rsstp-bench-view-{name}.mcap"
-    if not path.exists():
-        print(f"recording {name} to {path} (once)...", flush=True)
-        partial = path.with_suffix(".partial.mcap")
-        subprocess.run(
-            [str(BIN / "rsstp-sim"), "record", *case["record"], "-o", str(partial), "--force"],
-            check=True,
-            stdout=subprocess.DEVNULL,
-        )
-        partial.rename(path)
-    return path
+    return recorded(f"view-{name}", *case["record"])
 
 
 def bench(name: str, repeat: int) -> None:
@@ -155,33 +147,12 @@ def screenshot(png: Path, rrd: Path, *, wait_s: float) -> None:
     if chromium is None:
         sys.exit("bench/viewer.py: 'chromium' not found (Debian: apt-get install chromium)")
     with tempfile.TemporaryDirectory() as folder:
-        web, grpc = _free_port(), _free_port()
-        server = subprocess.Popen(
-            [
-                str(BIN / "rerun"),
-                "--serve-web",
-                "--bind",
-                "127.0.0.1",
-                "--web-viewer-port",
-                str(web),
-                "--port",
-                str(grpc),
-                str(rrd),
-            ],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-            start_new_session=True,
-        )
+        server = WebServer(rrd, bind="127.0.0.1", web_port=_free_port(), grpc_port=_free_port())
         try:
-            _wait_for_port(web)
-            url = f"http://127.0.0.1:{web}/?url=" + urllib.request.quote(
-                f"rerun+http://127.0.0.1:{grpc}/proxy", safe=""
-            )
             began = time.perf_counter()
-            png.write_bytes(_capture(chromium, url, Path(folder) / "profile", wait_s=wait_s))
+            png.write_bytes(_capture(chromium, server.url, Path(folder) / "profile", wait_s=wait_s))
         finally:
-            os.killpg(server.pid, signal.SIGTERM)
-            server.wait()
+            server.close()
     print(f"saved {png} ({time.perf_counter() - began:.0f} s after the page was opened)")
 
 

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import argparse
 import hashlib
-import subprocess
 import sys
 import tempfile
 import time
@@ -30,6 +29,8 @@ from pathlib import Path
 
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
+
+from _recordings import random_three_joint
 
 BIN = Path(sys.executable).parent
 CHUNK = 1024 * 1024
@@ -61,26 +62,7 @@ class CountingFile:
 
 
 def messages_of(steps: int) -> tuple[list[Message], dict[str, tuple[str, bytes]]]:
-    path = Path(tempfile.gettempdir()) / f"rsstp-bench-writers-{steps}.mcap"
-    if not path.exists():
-        subprocess.run(
-            [
-                str(BIN / "rsstp-sim"),
-                "record",
-                "three-joint",
-                "--strategy",
-                "random",
-                "--seed",
-                "1",
-                "--steps",
-                str(steps),
-                "-o",
-                str(path),
-                "--force",
-            ],
-            check=True,
-            stdout=subprocess.DEVNULL,
-        )
+    path = random_three_joint(steps)
     found: list[Message] = []
     schemas: dict[str, tuple[str, bytes]] = {}
     with open(path, "rb") as stream:

@@ -17,7 +17,7 @@ import sys
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
@@ -324,6 +324,15 @@ def _integer(text: str) -> int:
         raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
 
 
+def _table_parser(sub: Any, name: str, description: str) -> Parser:
+    """A subcommand that writes a table: the recording, ``-o`` and ``--force``."""
+    p: Parser = sub.add_parser(name, help=description)
+    p.add_argument("file", help="the .mcap recording")
+    p.add_argument("-o", "--output", required=True, help="the table: .parquet or .csv")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    return p
+
+
 def _build_parser() -> Parser:
     parser = Parser(prog=PROG, description="Read, export and audit RSSTP recordings (MCAP).")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
@@ -332,10 +341,7 @@ def _build_parser() -> Parser:
     p.add_argument("file", help="the .mcap recording")
     p.set_defaults(func=_cmd_info)
 
-    p = sub.add_parser("table", help="write the steps table (one row per step)")
-    p.add_argument("file", help="the .mcap recording")
-    p.add_argument("-o", "--output", required=True, help="the table: .parquet or .csv")
-    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p = _table_parser(sub, "table", "write the steps table (one row per step)")
     p.add_argument(
         "--truth",
         action="store_true",
@@ -345,10 +351,7 @@ def _build_parser() -> Parser:
     )
     p.set_defaults(func=_cmd_table)
 
-    p = sub.add_parser("events", help="write the events table (one row per event)")
-    p.add_argument("file", help="the .mcap recording")
-    p.add_argument("-o", "--output", required=True, help="the table: .parquet or .csv")
-    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p = _table_parser(sub, "events", "write the events table (one row per event)")
     p.add_argument(
         "--kind",
         action="append",
