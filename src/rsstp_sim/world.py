@@ -19,6 +19,12 @@ from rsstp_sim.scenario import Scenario
 
 __all__ = ["Pose", "World"]
 
+_FIRST_BOX = 350
+"""Lattice poses computed together at the first cache miss (a cube around the pose)."""
+_BOX_GROWTH = 1.5
+_LAST_BOX = 4096
+"""The cube grows by :data:`_BOX_GROWTH` at every miss, up to this many poses."""
+
 
 @dataclass(frozen=True, slots=True, eq=False)
 class Pose:
@@ -62,6 +68,7 @@ class World:
         actions = np.asarray(scenario.actions, dtype=np.int64)
         self._action_joint = actions // 2
         self._action_delta = np.where(actions % 2 == 0, scenario.step_deg, -scenario.step_deg)
+        self._box_poses = _FIRST_BOX
         self._offsets = self._box_offsets()
         self._blockers: dict[int, Blocker] = {}
         self._poses: dict[int, Pose] = {}
@@ -88,9 +95,10 @@ class World:
         return pose
 
     def _box_offsets(self) -> IntArray:
-        """Angle offsets of the poses computed together on a cache miss (about 350)."""
+        """Angle offsets of the poses computed together on a cache miss: a cube of about
+        ``self._box_poses`` lattice poses around the pose missed."""
         n = self.scenario.n_joints
-        radius = max(1, int(round((350 ** (1.0 / n) - 1) / 2)))
+        radius = max(1, int(round((self._box_poses ** (1.0 / n) - 1) / 2)))
         span = np.arange(-radius, radius + 1, dtype=np.int64) * self.scenario.step_deg
         grid = np.stack(np.meshgrid(*([span] * n), indexing="ij"), axis=-1)
         return grid.reshape(-1, n)
@@ -114,6 +122,11 @@ class World:
         # obstacles. The pose asked for is always computed.
         fresh &= (geometry.pose_blockers(self.geometry, box) == 0) | (codes == code)
         box, codes = box[fresh], codes[fresh]
+        # A run that keeps missing is a long one that will visit most poses: each miss makes
+        # the next box larger, so numpy's cost per call is spread over more poses.
+        if self._box_poses < _LAST_BOX:
+            self._box_poses = min(_LAST_BOX, int(self._box_poses * _BOX_GROWTH))
+            self._offsets = self._box_offsets()
 
         n_actions = len(self._action_joint)
         starts = np.repeat(box, n_actions, axis=0)
