@@ -27,7 +27,7 @@ from rsstp_sim.errors import ActionError, StrategyError
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import Scenario
-from rsstp_sim.strategies import AgentView, Strategy
+from rsstp_sim.strategies import AgentView, Strategy, StrategyBase
 from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.world import World
 
@@ -124,6 +124,11 @@ class Runner:
         self.no_transition = 0
         self._step = 0
         self.strategy.reset(self.agent)
+        self._choose = self.strategy.choose_action
+        # A strategy that keeps StrategyBase's refine does not refine: no call, and no check
+        # for a re-localised state after each step.
+        refine = getattr(type(self.strategy), "refine", None)
+        self._refine = None if refine is StrategyBase.refine else self.strategy.refine
         if self.model.current != self.memory.last_state:
             self.memory.relocate_last(self.model.current)
         self._version = self.model.version
@@ -147,7 +152,7 @@ class Runner:
     def step(self) -> StepOutcome:
         """One coupled step (see the module docstring)."""
         model = self.model
-        action = self.strategy.choose_action(self.agent)
+        action = self._choose(self.agent)
         try:
             blocker = self.world.move(action)
         except ActionError as exc:
@@ -179,11 +184,13 @@ class Runner:
                         f"the internal state stays",
                     )
                 )
-        self.strategy.refine(self.agent)
-        now = model.current
-        if now != after:
-            self.memory.relocate_last(now)
-        if model.version != self._version:
+        now = after
+        if self._refine is not None:
+            self._refine(self.agent)
+            now = model.current
+            if now != after:
+                self.memory.relocate_last(now)
+        if model.version != self._version:  # (a strategy might change it in choose_action)
             self._flush_model()
         return StepOutcome(self._step, action, before, now, blocker, empty, after)
 
