@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
-from rsstp_sim.commandline import Parser, UsageError, run_command
+from rsstp_sim.commandline import Parser, UsageError, progress, run_command
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -171,10 +171,21 @@ def _cmd_audit(args: argparse.Namespace) -> int:
     needs_truth = fail_on & set(_TRUTH_GATES)
     if needs_truth and not args.truth:
         raise UsageError(f"--fail-on {sorted(needs_truth)[0]} needs --truth")
-    with _open(args.file) as recording:
+    stages = 3 if args.truth else 2
+    with (
+        _open(args.file) as recording,
+        progress(stages, "reading", unit="stage", quiet=args.quiet) as bar,
+    ):
         loaded = load(recording)  # the steps decoded once for every audit
+        bar.to(1)
+        bar.stage("auditing")
         report = run_audits(loaded)
-        truth = audit_truth(loaded, within_versions=report.within_versions) if args.truth else None
+        bar.to(2)
+        truth = None
+        if args.truth:
+            bar.stage("comparing with the truth")
+            truth = audit_truth(loaded, within_versions=report.within_versions)
+            bar.to(3)
     if args.json:
         document = report.to_json()
         if truth is not None:
@@ -280,7 +291,11 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if args.serve_web:  # before anything is read: a port in use is one line
         check_port(args.bind, args.web_port, option="--web-port")
         check_port(args.bind, args.grpc_port, option="--grpc-port")
-    with _open(args.file) as recording, warnings.catch_warnings(record=True) as caught:
+    with (
+        _open(args.file) as recording,
+        warnings.catch_warnings(record=True) as caught,
+        progress(1, "reading, auditing, logging to Rerun", unit="view", quiet=args.quiet) as bar,
+    ):
         warnings.simplefilter("always", ViewerWarning)
         result = view(
             recording,
@@ -293,6 +308,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
             web_port=args.web_port,
             grpc_port=args.grpc_port,
         )
+        bar.to(1)
     for warning in caught:
         print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
     print(result.to_text())
@@ -363,6 +379,7 @@ def _build_parser() -> Parser:
 
     p = sub.add_parser("audit", help="consistency, determinism and summary audits")
     p.add_argument("file", help="the .mcap recording")
+    p.add_argument("--quiet", action="store_true", help="no progress bar (none when piped)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.add_argument(
         "--truth",
@@ -380,6 +397,7 @@ def _build_parser() -> Parser:
 
     p = sub.add_parser("view", help="stream a recording to the Rerun viewer or an .rrd file")
     p.add_argument("file", help="the .mcap recording")
+    p.add_argument("--quiet", action="store_true", help="no progress bar (none when piped)")
     p.add_argument(
         "--save", metavar="OUT.rrd", help="write an .rrd file (open it with: rerun OUT.rrd)"
     )

@@ -11,12 +11,12 @@ import json
 import signal
 import sys
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from rsstp_sim import graph
-from rsstp_sim.commandline import Parser, UsageError, run_command
+from rsstp_sim.commandline import Parser, UsageError, progress, run_command
 from rsstp_sim.coupling import Runner
 from rsstp_sim.scenario import builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
@@ -43,6 +43,9 @@ def _parse_params(items: Sequence[str]) -> dict[str, Any]:
 
 def _add_run_arguments(parser: argparse.ArgumentParser, *, steps_default: int) -> None:
     parser.add_argument("scenario", help="a built-in scenario name or a scenario .toml file")
+    parser.add_argument(
+        "--quiet", action="store_true", help="no progress bar (none is shown when piped either)"
+    )
     parser.add_argument(
         "--strategy",
         default="random",
@@ -98,7 +101,8 @@ def _cmd_scenarios(args: argparse.Namespace) -> int:
 def _cmd_run(args: argparse.Namespace) -> int:
     runner = _runner(args)
     started = time.perf_counter()
-    summary = runner.run(args.steps)
+    with progress(args.steps, "running", quiet=args.quiet) as bar:
+        summary = runner.run(args.steps, progress=bar.to)
     seconds = time.perf_counter() - started
     print(f"scenario: {runner.scenario.name}  strategy: {args.strategy}  seed: {args.seed}")
     print(summary.to_text())
@@ -153,14 +157,12 @@ def _cmd_record(args: argparse.Namespace) -> int:
         recorder.request_stop()
 
     previous = {sig: signal.signal(sig, stop) for sig in (signal.SIGINT, signal.SIGTERM)}
-    show = _progress_printer(args.steps) if sys.stderr.isatty() else None
     try:
-        result = recorder.run(args.steps, progress=show)
+        with progress(args.steps, "recording", quiet=args.quiet) as bar:
+            result = recorder.run(args.steps, progress=bar.to)
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-        if show is not None:
-            print(file=sys.stderr)
     counts = ", ".join(f"{topic} {count}" for topic, count in result.messages.items())
     if result.interrupted:
         name = signal.Signals(received[0]).name if received else "a stop request"
@@ -183,19 +185,6 @@ def _cmd_truth(args: argparse.Namespace) -> int:
     else:
         print(format_truth(truth))
     return 0
-
-
-def _progress_printer(total: int) -> Callable[[int], None]:
-    def show(done: int) -> None:
-        percent = 100.0 * done / total if total else 100.0
-        print(
-            f"\rrecording: {done:,}/{total:,} steps ({percent:.0f}%)",
-            end="",
-            file=sys.stderr,
-            flush=True,
-        )
-
-    return show
 
 
 def _build_parser() -> Parser:

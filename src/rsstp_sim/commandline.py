@@ -1,7 +1,9 @@
-"""What both command-line programs share: one-line errors and their exit codes.
+"""What both command-line programs share: one-line errors and their exit codes, progress.
 
 Bad input is one line on stderr and exit code 2, never a traceback; a reader
 that goes away (``| head``) ends the program quietly; Ctrl-C is exit code 130.
+A long command shows a progress bar (tqdm) on stderr when stderr is a terminal,
+and nothing when it is piped or redirected, or with ``--quiet``.
 """
 
 from __future__ import annotations
@@ -10,11 +12,11 @@ import argparse
 import os
 import sys
 from collections.abc import Callable, Sequence
-from typing import NoReturn
+from typing import Any, NoReturn
 
 from rsstp_sim.errors import RsstpError
 
-__all__ = ["Parser", "UsageError", "run_command"]
+__all__ = ["Parser", "Progress", "UsageError", "progress", "run_command"]
 
 
 class UsageError(RsstpError):
@@ -26,6 +28,40 @@ class Parser(argparse.ArgumentParser):
 
     def error(self, message: str) -> NoReturn:
         raise UsageError(message)
+
+
+class Progress:
+    """A progress bar on stderr, or nothing. ``to(done)`` moves it to ``done`` units; ``stage``
+    names what it is doing. Use it as a context manager: it closes (a finished bar stays)."""
+
+    def __init__(self, total: int, what: str, unit: str, *, shown: bool) -> None:
+        self._bar: Any = None
+        if shown:
+            from tqdm import tqdm
+
+            self._bar = tqdm(
+                total=total, desc=what, unit=unit, unit_scale=True, file=sys.stderr, leave=False
+            )
+
+    def to(self, done: int) -> None:
+        if self._bar is not None:
+            self._bar.update(done - self._bar.n)
+
+    def stage(self, text: str) -> None:
+        if self._bar is not None:
+            self._bar.set_description_str(text)
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def __exit__(self, *_: object) -> None:
+        if self._bar is not None:
+            self._bar.close()
+
+
+def progress(total: int, what: str, *, unit: str = "step", quiet: bool = False) -> Progress:
+    """A bar of ``total`` units when stderr is a terminal and not ``quiet``; else nothing."""
+    return Progress(total, what, unit, shown=not quiet and sys.stderr.isatty())
 
 
 def run_command(prog: str, parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> int:

@@ -194,13 +194,23 @@ class Runner:
             self._flush_model()
         return StepOutcome(self._step, action, before, now, blocker, empty, after)
 
-    def run(self, steps: int) -> RunSummary:
-        """Take ``steps`` more steps and summarise the run so far."""
+    def run(self, steps: int, *, progress: Callable[[int], None] | None = None) -> RunSummary:
+        """Take ``steps`` more steps and summarise the run so far; ``progress`` is called with
+        the steps done every 65,536 steps."""
         if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
             raise StrategyError(f"steps must be an integer >= 0, got {steps!r}")
         step = self.step
-        for _ in range(steps):
-            step()
+        if progress is None:
+            for _ in range(steps):
+                step()
+            return self.summary()
+        done = 0
+        while done < steps:
+            block = min(1 << 16, steps - done)
+            for _ in range(block):
+                step()
+            done += block
+            progress(done)
         return self.summary()
 
     def summary(self) -> RunSummary:

@@ -12,7 +12,6 @@ import io
 import json
 import os
 import re
-import select
 import signal
 import struct
 import subprocess
@@ -197,45 +196,6 @@ def test_record_prints_a_summary_line_and_no_progress(tmp_path: Path) -> None:
     assert counts["/rsstp/step"] == 5001
     expected = ", ".join(f"{topic} {count}" for topic, count in counts.items())
     assert done.stdout == f"recorded 5000 steps to {out} ({expected})\n"
-
-
-def test_progress_on_a_tty(tmp_path: Path) -> None:
-    out = tmp_path / "out.mcap"
-    leader, follower = os.openpty()
-    try:
-        proc = subprocess.Popen(
-            [sys.executable, "-m", "rsstp_sim", "record", "one-joint-10", "--steps", "9000"]
-            + ["-o", str(out)],
-            env=cli_env(),
-            stdout=subprocess.PIPE,
-            stderr=follower,
-        )
-        os.close(follower)
-        follower = -1
-        shown = bytearray()
-        deadline = time.monotonic() + TIMEOUT_S
-        while time.monotonic() < deadline:
-            ready, _, _ = select.select([leader], [], [], 0.1)
-            if ready:
-                try:
-                    chunk = os.read(leader, 4096)
-                except OSError:  # the child closed the terminal
-                    break
-                if not chunk:
-                    break
-                shown += chunk
-            elif proc.poll() is not None:
-                break
-        stdout, _ = proc.communicate(timeout=TIMEOUT_S)
-    finally:
-        if follower >= 0:
-            os.close(follower)
-        os.close(leader)
-    assert proc.returncode == 0
-    text = shown.decode()
-    assert "recording: 4,096/9,000 steps (46%)" in text
-    assert "recording: 8,192/9,000 steps (91%)" in text
-    assert stdout.decode().startswith("recorded 9000 steps to ")
 
 
 def test_same_bytes_across_processes_and_hash_seeds(tmp_path: Path) -> None:
