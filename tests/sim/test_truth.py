@@ -459,3 +459,30 @@ def test_random_cycles(
         assert replay_fails(model, labels, truth, 0, found)
         if len(found) <= 10:
             assert found == brute_force_counterexample(model, labels, truth, len(found))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    poses=st.integers(1, 60),
+    actions=st.integers(1, 4),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_refinement_is_the_coarsest_stable_partition(poses: int, actions: int, seed: int):
+    """The packed-word refinement against plain Python Moore refinement on random machines:
+    the same partition (pose p and q in one class exactly when they are in one class)."""
+    from rsstp_sim.truth import _refine
+
+    rng = np.random.default_rng(seed)
+    next_pose = rng.integers(0, poses, size=(poses, actions)).astype(np.int64)
+    sensation = rng.random(poses) < 0.3
+    found = _refine(next_pose, sensation)
+    classes = [int(s) for s in sensation]
+    while True:
+        signatures = [(classes[p], *(classes[int(q)] for q in next_pose[p])) for p in range(poses)]
+        numbering = {sig: i for i, sig in enumerate(sorted(set(signatures)))}
+        refined = [numbering[sig] for sig in signatures]
+        if len(set(refined)) == len(set(classes)):
+            break
+        classes = refined
+    same = {(p, q) for p in range(poses) for q in range(poses) if classes[p] == classes[q]}
+    assert same == {(p, q) for p in range(poses) for q in range(poses) if found[p] == found[q]}
