@@ -351,6 +351,9 @@ def _table_parser(sub: Any, name: str, description: str) -> Parser:
 
 def _build_parser() -> Parser:
     parser = Parser(prog=PROG, description="Read, export and audit RSSTP recordings (MCAP).")
+    from rsstp_sim import __version__
+
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("info", help="what a recording holds: scenario, strategy, steps, topics")

@@ -36,7 +36,17 @@ from rsstp_sim.world import Pose, World
 
 register_envs()
 
-__version__ = "0.1.0"
+def _version() -> str:
+    from importlib import metadata
+
+    try:
+        return metadata.version("rsstp")
+    except metadata.PackageNotFoundError:  # run from a source tree that was never installed
+        return "0+unknown"
+
+
+__version__ = _version()
+"""The installed distribution's version (pyproject.toml's), from the package metadata."""
 
 __all__ = [
     "ActionError",

@@ -189,6 +189,9 @@ def _cmd_truth(args: argparse.Namespace) -> int:
 
 def _build_parser() -> Parser:
     parser = Parser(prog=PROG, description="RSSTP simulator: scenarios, strategies, models.")
+    from rsstp_sim import __version__
+
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
 
     p = sub.add_parser("scenarios", help="list the built-in scenarios")
