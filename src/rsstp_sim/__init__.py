@@ -36,6 +36,7 @@ from rsstp_sim.world import Pose, World
 
 register_envs()
 
+
 def _version() -> str:
     from importlib import metadata
 
