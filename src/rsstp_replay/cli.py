@@ -62,7 +62,12 @@ def _cmd_info(args: argparse.Namespace) -> int:
         record = recording.scenario_record
         scenario = recording.scenario
         size = os.path.getsize(recording.path)
-        state = "finished" if recording.finished else "NOT finished (recovered from its chunks)"
+        chunks = recording.verify_chunks()  # a chunk that fails its CRC is an error, not "finished"
+        state = (
+            f"finished, {chunks:,} chunks checked"
+            if recording.finished
+            else f"NOT finished (recovered from its {chunks:,} complete chunks)"
+        )
         print(f"file: {recording.path} ({size:,} bytes, {state})")
         print(f"scenario: {record.name} ({record.description})")
         lengths = ", ".join(f"{length:g}" for length in record.lengths)

@@ -262,6 +262,15 @@ class Recording:
             }
         )
 
+    def verify_chunks(self) -> int:
+        """Read, decompress and CRC-check every chunk; the number of chunks. Raises
+        :class:`~rsstp_replay.errors.CorruptRecording` naming the first that fails."""
+        self._check_open()
+        with self._container.open() as stream:
+            for ref in self._container.chunks:
+                self._container.chunk_data(stream, ref)
+        return len(self._container.chunks)
+
     # -- the model ---------------------------------------------------------------------------
 
     def model_versions(self) -> tuple[ModelRecord, ...]:

@@ -445,3 +445,21 @@ def test_a_message_index_that_points_elsewhere_is_refused(original: Path, tmp_pa
         rf"not point at messages of channel {step_channel}",
         str(caught.value),
     )
+
+
+def test_info_never_calls_a_file_with_a_failing_chunk_finished(damaged: dict[str, Path]) -> None:
+    """A finished file whose middle chunk fails its CRC: `info` reads every chunk, so it is
+    one line and exit 2, not "finished"."""
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_replay", "info", str(damaged["chunk-flip"])],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 2
+    assert "finished" not in done.stdout
+    assert re.fullmatch(
+        r"rsstp-replay: error: .*chunk-flip\.mcap: the chunk at byte \d+ "
+        r"(fails its CRC check|does not decompress).*\n",
+        done.stderr,
+    )
