@@ -49,7 +49,8 @@ def _add_run_arguments(parser: argparse.ArgumentParser, *, steps_default: int) -
     parser.add_argument(
         "--strategy",
         default="random",
-        help=f"strategy name ({', '.join(builtin_strategies())}); default random",
+        help=f"a built-in strategy ({', '.join(builtin_strategies())}), an installed plugin "
+        "(see: rsstp-sim strategies) or package.module:Class; default random",
     )
     parser.add_argument(
         "--param",
@@ -95,6 +96,20 @@ def _cmd_scenarios(args: argparse.Namespace) -> int:
     width = max(map(len, scenarios))
     for name, description in scenarios.items():
         print(f"{name:<{width}}  {description}")
+    return 0
+
+
+def _cmd_strategies(args: argparse.Namespace) -> int:
+    from rsstp_sim.strategies import ENTRY_POINT_GROUP, plugin_strategies
+
+    for name in builtin_strategies():
+        print(f"{name:<12} built-in")
+    for name, origin in plugin_strategies().items():
+        print(f"{name:<12} {origin}")
+    print(
+        f"(a plugin declares [project.entry-points.{ENTRY_POINT_GROUP!r}] name = "
+        f'"package.module:Class"; any class is also --strategy package.module:Class)'
+    )
     return 0
 
 
@@ -196,6 +211,9 @@ def _build_parser() -> Parser:
 
     p = sub.add_parser("scenarios", help="list the built-in scenarios")
     p.set_defaults(func=_cmd_scenarios)
+
+    p = sub.add_parser("strategies", help="list the built-in and installed strategies")
+    p.set_defaults(func=_cmd_strategies)
 
     p = sub.add_parser("run", help="run a strategy and print a summary")
     _add_run_arguments(p, steps_default=1000)

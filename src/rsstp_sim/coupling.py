@@ -152,11 +152,16 @@ class Runner:
     def step(self) -> StepOutcome:
         """One coupled step (see the module docstring)."""
         model = self.model
-        action = self._choose(self.agent)
+        try:
+            action = self._choose(self.agent)
+        except Exception as exc:  # the strategy's own code: name it, and the step
+            raise self._failed("choose_action", exc) from None
         try:
             blocker = self.world.move(action)
         except ActionError as exc:
-            raise StrategyError(f"strategy {self.strategy.name!r}: {exc}") from None
+            raise StrategyError(
+                f"strategy {self.strategy.name!r} at step {self._step + 1}: {exc}"
+            ) from None
         self._step += 1
         before = model.current
         successors = model.successors(before, action)
@@ -186,13 +191,24 @@ class Runner:
                 )
         now = after
         if self._refine is not None:
-            self._refine(self.agent)
+            try:
+                self._refine(self.agent)
+            except Exception as exc:  # the strategy's own code (a model operation included)
+                raise self._failed("refine", exc) from None
             now = model.current
             if now != after:
                 self.memory.relocate_last(now)
         if model.version != self._version:  # (a strategy might change it in choose_action)
             self._flush_model()
         return StepOutcome(self._step, action, before, now, blocker, empty, after)
+
+    def _failed(self, method: str, exc: Exception) -> StrategyError:
+        """One line for an exception out of the strategy's ``method`` at this step."""
+        step = self._step + (1 if method == "choose_action" else 0)
+        return StrategyError(
+            f"strategy {self.strategy.name!r} failed in {method} at step {step}: "
+            f"{type(exc).__name__}: {exc}"
+        )
 
     def run(self, steps: int, *, progress: Callable[[int], None] | None = None) -> RunSummary:
         """Take ``steps`` more steps and summarise the run so far; ``progress`` is called with

@@ -1,8 +1,18 @@
-"""Strategies: the protocol, and the built-in strategies by name."""
+"""Strategies: the protocol, the built-in strategies by name, and the user's own.
+
+``make_strategy(name)`` takes a built-in name (``random``, ``learner``, ...), the name of an
+entry point in the group ``rsstp.strategies`` (a package declares one in its
+``pyproject.toml``: ``[project.entry-points."rsstp.strategies"] mine =
+"my_package.module:MyStrategy"``), or an import path ``package.module:Class`` (a module on
+``sys.path``, e.g. beside the scenario file, with ``PYTHONPATH``). What it finds must be a
+class whose instances have the :class:`Strategy` methods.
+"""
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Callable, Mapping
+from importlib import metadata
 from typing import Any
 
 from rsstp_sim.errors import StrategyError
@@ -22,8 +32,10 @@ __all__ = [
     "SplitterStrategy",
     "Strategy",
     "StrategyBase",
+    "ENTRY_POINT_GROUP",
     "builtin_strategies",
     "make_strategy",
+    "plugin_strategies",
 ]
 
 _BUILTIN: dict[str, Callable[..., Strategy]] = {
@@ -35,20 +47,75 @@ _BUILTIN: dict[str, Callable[..., Strategy]] = {
 }
 
 
+ENTRY_POINT_GROUP = "rsstp.strategies"
+"""The entry-point group in which a distribution declares its strategies."""
+
+
 def builtin_strategies() -> tuple[str, ...]:
     return tuple(sorted(_BUILTIN))
 
 
+def plugin_strategies() -> dict[str, str]:
+    """The strategies declared by installed distributions: name -> ``module:Class (dist
+    version)``."""
+    found: dict[str, str] = {}
+    for entry in metadata.entry_points(group=ENTRY_POINT_GROUP):
+        dist = entry.dist
+        origin = f" ({dist.name} {dist.version})" if dist is not None else ""
+        found.setdefault(entry.name, f"{entry.value}{origin}")
+    return dict(sorted(found.items()))
+
+
 def make_strategy(name: str, params: Mapping[str, Any] | None = None) -> Strategy:
-    """Build a built-in strategy by name with keyword parameters."""
-    factory = _BUILTIN.get(name)
-    if factory is None:
-        raise StrategyError(
-            f"unknown strategy {name!r} (built-in: {', '.join(builtin_strategies())})"
-        )
+    """Build a strategy by name (built-in, entry point, or ``package.module:Class``) with
+    keyword parameters; :class:`StrategyError` names what could not be found or built."""
+    factory = _BUILTIN.get(name) or _plugin(name)
     try:
-        return factory(**dict(params or {}))
+        strategy = factory(**dict(params or {}))
     except TypeError as exc:
         raise StrategyError(
             f"strategy {name!r}: invalid parameters {dict(params or {})}: {exc}"
         ) from None
+    if not isinstance(strategy, Strategy):
+        missing = [m for m in _METHODS if not callable(getattr(strategy, m, None))]
+        raise StrategyError(
+            f"strategy {name!r}: {type(strategy).__name__} is not a strategy (missing "
+            f"{', '.join(missing) or 'name'}; subclass rsstp_sim.StrategyBase)"
+        )
+    return strategy
+
+
+_METHODS = ("params", "initial_model", "reset", "choose_action", "refine")
+
+
+def _plugin(name: str) -> Callable[..., Strategy]:
+    """The class behind an entry point or an import path."""
+    if ":" in name:
+        module_name, _, attribute = name.partition(":")
+        try:
+            module = importlib.import_module(module_name)
+        except Exception as exc:  # the user's module: any error while importing it
+            raise StrategyError(
+                f"strategy {name!r}: cannot import {module_name!r}: {type(exc).__name__}: {exc}"
+            ) from None
+        found = getattr(module, attribute, None)
+        if found is None:
+            raise StrategyError(f"strategy {name!r}: {module_name!r} has no {attribute!r}")
+    else:
+        entries = [e for e in metadata.entry_points(group=ENTRY_POINT_GROUP) if e.name == name]
+        if not entries:
+            plugins = ", ".join(plugin_strategies()) or "none installed"
+            raise StrategyError(
+                f"unknown strategy {name!r} (built-in: {', '.join(builtin_strategies())}; "
+                f"plugins: {plugins}; or give package.module:Class)"
+            )
+        try:
+            found = entries[0].load()
+        except Exception as exc:  # the plugin's module: any error while importing it
+            raise StrategyError(
+                f"strategy {name!r}: cannot load {entries[0].value!r}: {type(exc).__name__}: {exc}"
+            ) from None
+    if not callable(found):
+        raise StrategyError(f"strategy {name!r}: {found!r} is not a class")
+    factory: Callable[..., Strategy] = found
+    return factory

@@ -1,0 +1,128 @@
+"""Strategies from outside the package: ``package.module:Class`` and the ``rsstp.strategies``
+entry points of installed distributions; a strategy that fails stops the run in one line."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rsstp_replay import open_recording
+
+STRATEGIES = """
+from rsstp_sim import AgentView, StrategyBase
+
+
+class Clockwise(StrategyBase):
+    name = "clockwise"
+
+    def choose_action(self, agent: AgentView) -> int:
+        return agent.actions[-1]
+
+
+class Breaks(StrategyBase):
+    name = "breaks"
+
+    def choose_action(self, agent: AgentView) -> int:
+        if agent.step == 6:
+            raise RuntimeError("boom")
+        return agent.actions[0]
+
+
+class Wanders(StrategyBase):
+    name = "wanders"
+
+    def choose_action(self, agent: AgentView) -> int:
+        return 99
+
+
+class NotOne:
+    pass
+"""
+
+
+def cli(program: str, *args: str, path: Path) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, "-m", program, *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PYTHONPATH": f"{path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"},
+    )
+
+
+@pytest.fixture
+def mine(tmp_path: Path) -> Path:
+    """A module of strategies, and a distribution declaring one as an entry point (found by
+    importlib.metadata on the path, as an installed one is)."""
+    (tmp_path / "my_strategies.py").write_text(STRATEGIES)
+    info = tmp_path / "my_strategies-1.2.dist-info"
+    info.mkdir()
+    (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-strategies\nVersion: 1.2\n")
+    (info / "entry_points.txt").write_text(
+        "[rsstp.strategies]\nclockwise = my_strategies:Clockwise\n"
+    )
+    return tmp_path
+
+
+def test_a_class_by_its_import_path_records_and_audits(mine: Path) -> None:
+    out = mine / "run.mcap"
+    done = cli(
+        "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Clockwise",
+        "--steps", "20", "-o", str(out), path=mine,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    with open_recording(out) as recording:
+        assert recording.strategy == "clockwise"
+        assert recording.n_steps == 20
+    assert cli("rsstp_replay", "audit", str(out), path=mine).returncode == 0
+
+
+def test_an_entry_point_is_listed_and_runs_by_name(mine: Path) -> None:
+    listed = cli("rsstp_sim", "strategies", path=mine)
+    assert listed.returncode == 0
+    assert "clockwise    my_strategies:Clockwise (my-strategies 1.2)" in listed.stdout
+    ran = cli("rsstp_sim", "run", "thesis-roulette", "--strategy", "clockwise", "--steps", "8",
+              path=mine)  # fmt: skip
+    assert ran.returncode == 0, ran.stderr
+    assert "sensations seen: false: 6, true: 3" in ran.stdout  # the start, then every 4 moves
+
+
+def test_a_failing_strategy_stops_in_one_line_and_keeps_a_valid_file(mine: Path) -> None:
+    out = mine / "broken.mcap"
+    done = cli(
+        "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Breaks",
+        "--steps", "50", "-o", str(out), path=mine,
+    )  # fmt: skip
+    assert done.returncode == 2
+    assert done.stderr.strip() == (
+        "rsstp-sim: error: strategy 'breaks' failed in choose_action at step 7: RuntimeError: boom"
+    )
+    with open_recording(out) as recording:
+        assert recording.finished and recording.n_steps == 6
+    assert cli("rsstp_replay", "check", str(out), path=mine).returncode == 0
+
+
+@pytest.mark.parametrize(
+    ("strategy", "message"),
+    [
+        (
+            "my_strategies:Wanders",
+            "strategy 'wanders' at step 1: action 99 is not one of the scenario's actions [0]",
+        ),
+        ("my_strategies:NotOne", "strategy 'my_strategies:NotOne': NotOne is not a strategy"),
+        ("my_strategies:Nowhere", "strategy 'my_strategies:Nowhere': 'my_strategies' has no"),
+        ("no_such_module:X", "strategy 'no_such_module:X': cannot import 'no_such_module'"),
+        ("nameless", "unknown strategy 'nameless' (built-in: learner, random, roulette"),
+    ],
+)
+def test_a_strategy_that_cannot_run_is_one_line(mine: Path, strategy: str, message: str) -> None:
+    done = cli("rsstp_sim", "run", "thesis-roulette", "--strategy", strategy, "--steps", "5",
+               path=mine)  # fmt: skip
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "Traceback" not in done.stderr
+    assert message in lines[0]
