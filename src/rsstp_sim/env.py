@@ -32,12 +32,15 @@ from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario, load_scenario
 from rsstp_sim.world import Pose, World
 
-__all__ = ["ENV_ID", "ArmEnv", "register_envs"]
+__all__ = ["ENV_ID", "MAX_EPISODE_STEPS", "ArmEnv", "register_envs"]
 
 ENV_ID = "rsstp/Arm-v0"
 """The id under which :func:`register_envs` registers :class:`ArmEnv`."""
 
 _ENTRY_POINT = "rsstp_sim.env:ArmEnv"
+MAX_EPISODE_STEPS = 1000
+"""The time limit ``gymnasium.make(ENV_ID)`` puts on an episode (steps)."""
+_REWARDS = ("none", "sensation")
 
 ArmObs = int | NDArray[np.float32]
 """An observation: ``0``/``1`` in boolean feedback mode, a ``(1,)`` float32 array in float mode."""
@@ -83,8 +86,11 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
 
     ## Rewards
 
-    Always ``0.0``: the platform studies what an agent can learn from
-    sensations, not reward maximisation. Wrap the environment to add one.
+    ``reward="none"`` (the default): always ``0.0``; the platform studies what an
+    agent can learn from sensations, not reward maximisation.
+    ``reward="sensation"``: ``1.0`` at a step that ends with the sensation true (every
+    tip at its feedback point), minus ``step_cost`` at every step (default ``0.0``; e.g.
+    ``0.01`` rewards reaching the point soon).
 
     ## Starting State
 
@@ -93,8 +99,10 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
 
     ## Episode End
 
-    Never: ``terminated`` and ``truncated`` are always ``False``. Use
-    ``gymnasium.wrappers.TimeLimit`` (or ``make(..., max_episode_steps=...)``).
+    The environment itself never ends an episode (``terminated`` is ``False``: the
+    arm has no terminal pose). ``gymnasium.make("rsstp/Arm-v0")`` wraps it in a
+    ``TimeLimit`` of :data:`MAX_EPISODE_STEPS` steps (``truncated`` then); pass
+    ``max_episode_steps=N`` to change it, or build ``ArmEnv`` directly for no limit.
 
     ## Information (ground truth)
 
@@ -118,6 +126,7 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
     - ``render_mode``: ``None`` or ``"rgb_array"`` (a ``(400, 400, 3)`` uint8 picture
       drawn with numpy: obstacles grey, feedback points green, the arm blue, or
       orange just after a blocked move).
+    - ``reward``: ``"none"`` or ``"sensation"``, and ``step_cost`` (see Rewards).
 
     An ``ArmEnv`` built directly carries the same :class:`~gymnasium.envs.registration.EnvSpec`
     that ``gymnasium.make(ENV_ID, scenario=...)`` gives it, so ``env.spec.make()``
@@ -127,13 +136,24 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 10}
 
     def __init__(
-        self, scenario: Scenario | str | Path = "three-joint", *, render_mode: str | None = None
+        self,
+        scenario: Scenario | str | Path = "three-joint",
+        *,
+        render_mode: str | None = None,
+        reward: str = "none",
+        step_cost: float = 0.0,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
+        if reward not in _REWARDS:
+            raise ValueError(f"reward must be one of {list(_REWARDS)}, got {reward!r}")
+        if isinstance(step_cost, bool) or not isinstance(step_cost, int | float):
+            raise ValueError(f"step_cost must be a number, got {step_cost!r}")
+        self._reward = reward
+        self._step_cost = float(step_cost)
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
         self.render_mode = render_mode
         self.world = World(self.scenario)
@@ -149,7 +169,12 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
         self.spec = EnvSpec(
             id=ENV_ID,
             entry_point=_ENTRY_POINT,
-            kwargs={"scenario": scenario, "render_mode": render_mode},
+            kwargs={
+                "scenario": scenario,
+                "render_mode": render_mode,
+                "reward": reward,
+                "step_cost": step_cost,
+            },
         )
         self._last_blocker: Blocker | None = None
         self._canvas: _Canvas | None = None
@@ -173,7 +198,10 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
         blocker = self.world.move(action_id)
         self._last_blocker = blocker
         pose = self.world.current
-        return self._observe(pose), 0.0, False, False, self._info(pose, action_id, blocker)
+        reward = 0.0
+        if self._reward == "sensation":
+            reward = (1.0 if pose.sensation else 0.0) - self._step_cost
+        return self._observe(pose), reward, False, False, self._info(pose, action_id, blocker)
 
     def render(self) -> NDArray[np.uint8] | None:  # type: ignore[override]
         """The current picture (``rgb_array`` mode), or ``None`` without a render mode."""
@@ -223,9 +251,10 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
 
 
 def register_envs() -> None:
-    """Register :class:`ArmEnv` as ``rsstp/Arm-v0`` with Gymnasium (idempotent)."""
+    """Register :class:`ArmEnv` as ``rsstp/Arm-v0`` with Gymnasium (idempotent), with a
+    :data:`MAX_EPISODE_STEPS` time limit."""
     if ENV_ID not in gymnasium.registry:
-        gymnasium.register(id=ENV_ID, entry_point=_ENTRY_POINT)
+        gymnasium.register(id=ENV_ID, entry_point=_ENTRY_POINT, max_episode_steps=MAX_EPISODE_STEPS)
 
 
 # -- rgb_array drawing, numpy only ---------------------------------------------------------

@@ -10,7 +10,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from rsstp_sim import env as env_module
-from rsstp_sim.env import ENV_ID, ArmEnv, register_envs
+from rsstp_sim.env import ENV_ID, MAX_EPISODE_STEPS, ArmEnv, register_envs
 from rsstp_sim.errors import ActionError, ScenarioError
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 
@@ -257,3 +257,46 @@ def test_bad_constructor_arguments() -> None:
         ArmEnv("three-joint", render_mode="human")
     with pytest.raises(ScenarioError, match="no-such-scenario"):
         ArmEnv("no-such-scenario")
+
+
+def test_the_sensation_reward_with_a_step_cost() -> None:
+    """thesis-roulette senses its point every 4 moves: 1 - cost there, -cost elsewhere."""
+    env = ArmEnv("thesis-roulette", reward="sensation", step_cost=0.25)
+    env.reset(seed=0)
+    rewards = [env.step(0)[1] for _ in range(8)]
+    assert rewards == [-0.25, -0.25, -0.25, 0.75, -0.25, -0.25, -0.25, 0.75]
+    assert [ArmEnv("thesis-roulette").step(0)[1] for _ in range(2)] == [0.0, 0.0]
+    check_env(ArmEnv("thesis-algo", reward="sensation", step_cost=0.01), skip_render_check=True)
+    with pytest.raises(ValueError, match="reward must be one of"):
+        ArmEnv("thesis-roulette", reward="distance")
+
+
+def test_make_puts_a_time_limit_on_an_episode() -> None:
+    env = gymnasium.make(ENV_ID, scenario="thesis-roulette")
+    env.reset(seed=0)
+    truncated = [env.step(0)[3] for _ in range(MAX_EPISODE_STEPS)]
+    assert truncated == [False] * (MAX_EPISODE_STEPS - 1) + [True]
+    short = gymnasium.make(ENV_ID, scenario="thesis-roulette", max_episode_steps=3)
+    short.reset(seed=0)
+    assert [short.step(0)[3] for _ in range(3)] == [False, False, True]
+
+
+def test_make_with_the_module_prefix_in_a_fresh_interpreter() -> None:
+    """Gymnasium 1.x has no plugin entry points: ``rsstp_sim:`` imports us first."""
+    import subprocess
+    import sys
+
+    done = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            "import gymnasium\n"
+            "env = gymnasium.make('rsstp_sim:rsstp/Arm-v0', scenario='thesis-roulette')\n"
+            "print(env.reset(seed=0)[0], env.spec.max_episode_steps)",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["1", str(MAX_EPISODE_STEPS)]
