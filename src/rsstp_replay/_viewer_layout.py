@@ -13,7 +13,7 @@ import subprocess
 import warnings
 from collections.abc import Iterable, Sequence
 
-from rsstp_sim.graph import graphviz_failed
+from rsstp_sim.graph import plain_positions, run_graphviz
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -91,7 +91,6 @@ DOT_MAX_PAIRS = 400
 """Above this many state pairs the union is laid out by ``sfdp`` rather than ``dot``."""
 DOT_TIMEOUT_S = 10.0
 """How long ``dot`` may take before ``sfdp`` takes over."""
-_POINTS_PER_INCH = 72.0
 
 
 def _layout_source(states: Sequence[int], pairs: Sequence[tuple[int, int]]) -> str:
@@ -110,22 +109,10 @@ def _run_layout(
     engine: str, source: str, *, timeout: float | None
 ) -> dict[int, tuple[float, float]]:
     """Node centres in points from Graphviz's ``plain`` output."""
-    done = subprocess.run(
-        [engine, "-Tplain"], input=source, capture_output=True, text=True, timeout=timeout
+    plain = run_graphviz(
+        engine, source, ["-Tplain"], what="the layout of every model version", timeout=timeout
     )
-    if done.returncode != 0:
-        raise graphviz_failed(
-            engine, done.returncode, done.stderr, what="the layout of every model version"
-        )
-    positions: dict[int, tuple[float, float]] = {}
-    for line in done.stdout.splitlines():
-        fields = line.split()
-        if fields and fields[0] == "node":
-            positions[int(fields[1])] = (
-                round(float(fields[2]) * _POINTS_PER_INCH, 2),
-                round(float(fields[3]) * _POINTS_PER_INCH, 2),
-            )
-    return positions
+    return plain_positions(plain.decode())
 
 
 def _circle(states: Sequence[int]) -> dict[int, tuple[float, float]]:

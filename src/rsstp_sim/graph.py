@@ -23,7 +23,8 @@ from __future__ import annotations
 
 import shutil
 import signal
-from collections.abc import Mapping
+import subprocess
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import graphviz
@@ -31,12 +32,13 @@ import graphviz
 from rsstp_sim.errors import GraphvizFailed, GraphvizMissing, ModelError, RsstpError
 from rsstp_sim.transition_system import TransitionSystem
 
-__all__ = ["graphviz_failed", "layout", "render", "to_dot"]
+__all__ = ["graphviz_failed", "layout", "plain_positions", "render", "run_graphviz", "to_dot"]
 
 _IMAGE_FORMATS = ("svg", "png", "pdf")
 _SOURCE_FORMATS = ("dot", "gv")
 _MISSING = (
-    "Graphviz 'dot' not found: install it (Debian: apt-get install graphviz) or write .dot instead"
+    "Graphviz {program!r} not found: install it (Debian: apt-get install graphviz) "
+    "or write .dot instead"
 )
 _POINTS_PER_INCH = 72.0
 
@@ -93,18 +95,53 @@ def to_dot(
 
 def layout(model: TransitionSystem) -> dict[int, tuple[float, float]]:
     """Node centres in points, computed by ``dot``; the same model gives the same positions."""
-    _require_dot()
-    plain: str = graphviz.Source(to_dot(model)).pipe(format="plain", encoding="utf-8")
+    plain = run_graphviz("dot", to_dot(model), ["-Tplain"], what=_describe(model))
+    return plain_positions(plain.decode())
+
+
+def plain_positions(plain: str) -> dict[int, tuple[float, float]]:
+    """Node centres in points from Graphviz's ``-Tplain`` output (inches, y up)."""
     positions: dict[int, tuple[float, float]] = {}
     for line in plain.splitlines():
         fields = line.split()
         if fields and fields[0] == "node":
-            x, y = float(fields[2]), float(fields[3])
             positions[int(fields[1])] = (
-                round(x * _POINTS_PER_INCH, 2),
-                round(y * _POINTS_PER_INCH, 2),
+                round(float(fields[2]) * _POINTS_PER_INCH, 2),
+                round(float(fields[3]) * _POINTS_PER_INCH, 2),
             )
     return positions
+
+
+def run_graphviz(
+    engine: str,
+    source: str,
+    arguments: Sequence[str],
+    *,
+    what: str,
+    timeout: float | None = None,
+) -> bytes:
+    """Run the Graphviz program ``engine`` on ``source`` and return what it wrote.
+
+    A missing program is :class:`GraphvizMissing`; one that fails or crashes (even
+    before reading its input) is one :class:`GraphvizFailed` line naming ``what``.
+    ``timeout`` (seconds) raises :class:`subprocess.TimeoutExpired`.
+    """
+    if shutil.which(engine) is None:
+        raise GraphvizMissing(_MISSING.format(program=engine))
+    done = subprocess.run(
+        [engine, *arguments],
+        input=source.encode(),
+        capture_output=True,
+        timeout=timeout,
+        check=False,
+    )
+    if done.returncode != 0:
+        raise graphviz_failed(engine, done.returncode, done.stderr, what=what)
+    return done.stdout
+
+
+def _describe(model: TransitionSystem) -> str:
+    return f"a model of {len(model)} states and {len(model.transitions())} transitions"
 
 
 def render(
@@ -132,21 +169,10 @@ def render(
     if fmt in _SOURCE_FORMATS:
         out.write_text(source, encoding="utf-8")
         return out
-    _require_dot()
-    data: bytes
-    engine = "dot" if positions is None else "neato"
-    try:
-        if positions is None:
-            data = graphviz.Source(source, engine="dot").pipe(format=fmt)
-        else:
-            data = graphviz.Source(source, engine="neato").pipe(format=fmt, neato_no_op=2)
-    except graphviz.CalledProcessError as exc:
-        raise graphviz_failed(
-            engine,
-            exc.returncode,
-            exc.stderr,
-            what=f"a model of {len(model)} states and {len(model.transitions())} transitions",
-        ) from None
+    if positions is None:
+        data = run_graphviz("dot", source, [f"-T{fmt}"], what=_describe(model))
+    else:
+        data = run_graphviz("neato", source, ["-n2", f"-T{fmt}"], what=_describe(model))
     out.write_bytes(data)
     return out
 
@@ -169,11 +195,6 @@ def graphviz_failed(
     return GraphvizFailed(
         f"Graphviz ({engine}) {how} drawing {what}{detail}; write .dot instead to keep the graph"
     )
-
-
-def _require_dot() -> None:
-    if shutil.which("dot") is None:
-        raise GraphvizMissing(_MISSING)
 
 
 def _edge_labels(model: TransitionSystem) -> dict[tuple[int, int], list[int]]:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from rsstp_sim.errors import GraphvizMissing, ModelError, RsstpError
+from rsstp_sim.errors import GraphvizFailed, GraphvizMissing, ModelError, RsstpError
 from rsstp_sim.graph import layout, render, to_dot
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -149,3 +149,27 @@ def test_render_refuses_unknown_formats(model: TransitionSystem, tmp_path: Path)
         render(model, tmp_path / "model.txt")
     with pytest.raises(RsstpError, match=r"got 'no suffix'"):
         render(model, tmp_path / "model")
+
+
+@pytest.mark.parametrize("positions", [False, True])
+def test_a_program_that_dies_before_reading_is_one_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, positions: bool
+) -> None:
+    """A Graphviz program that crashes before reading its input (source larger than a
+    pipe's buffer, so writing it would break the pipe) is GraphvizFailed naming the
+    signal, never a broken pipe; nothing is written."""
+    for program in ("dot", "neato"):
+        fake = tmp_path / program
+        fake.write_text("#!/bin/sh\nkill -SEGV $$\n")
+        fake.chmod(0o755)
+    monkeypatch.setenv("PATH", str(tmp_path))
+    n = 3000
+    big = TransitionSystem.from_matrix(
+        [[[0] if t in (s, (s + 1) % n) else [] for t in range(n)] for s in range(n)]
+    )
+    assert len(to_dot(big)) > 1 << 16
+    places = {s: (float(s), 0.0) for s in big.states} if positions else None
+    out = tmp_path / "model.svg"
+    with pytest.raises(GraphvizFailed, match=r"crashed \(SIGSEGV\) drawing a model of 3000 states"):
+        render(big, out, positions=places)
+    assert not out.exists()
