@@ -344,23 +344,34 @@ def move_blockers(
     link = np.arange(n)
     moving = link[None, :] >= joint[:, None]  # (B, n)
 
+    # Every point of a moving link stays within ``sweep`` (its farthest distance from the
+    # pivot times the turn) of where it starts, and a link lies within half its length of
+    # its midpoint. Contacts that these bounds rule out are never tested exactly: the
+    # bounds are filters, with slack, and must never miss a contact.
+    near = point_segment_distance(pivot[:, None, :], a, b)  # (B, n)
+    far = np.maximum(
+        np.hypot(*np.moveaxis(a - pivot[:, None, :], -1, 0)),
+        np.hypot(*np.moveaxis(b - pivot[:, None, :], -1, 0)),
+    )
+    sweep = far * np.abs(delta_rad)[:, None] + 2 * geo.eps  # (B, n)
+    mid = (a + b) * 0.5
+    half = geo.lengths * 0.5
+
     # Moving links against obstacles: centres turned the opposite way. Turning keeps every
     # point's distance to the pivot, so a link sweeps only the ring between its nearest and
-    # farthest distance from the pivot; an obstacle disk off that ring cannot be met, and the
-    # exact arc test runs only for the (move, link, obstacle) triples on it.
+    # farthest distance from the pivot; an obstacle disk off that ring, or farther from the
+    # link than its sweep, cannot be met. The exact arc test runs only for the (move, link,
+    # obstacle) triples that pass both.
     if geo.m:
         reach = geo.radii + geo.eps
-        slack = reach + geo.eps  # the ring test is a filter: it must never miss a contact
-        near = point_segment_distance(pivot[:, None, :], a, b)  # (B, n)
-        far = np.maximum(
-            np.hypot(*np.moveaxis(a - pivot[:, None, :], -1, 0)),
-            np.hypot(*np.moveaxis(b - pivot[:, None, :], -1, 0)),
-        )
+        slack = reach + geo.eps
         centre = np.hypot(*np.moveaxis(geo.centers[None] - pivot[:, None, :], -1, 0))  # (B, m)
+        to_mid = np.hypot(*np.moveaxis(geo.centers[None, None] - mid[:, :, None], -1, 0))
         ring = (
             moving[:, :, None]
             & (centre[:, None, :] + slack >= near[:, :, None])
             & (centre[:, None, :] - slack <= far[:, :, None])
+            & (to_mid - half[None, :, None] <= slack + sweep[:, :, None])
         )
         at_row, at_link, at_obstacle = np.nonzero(ring)
         obstacle = np.zeros((batch, n, geo.m), dtype=bool)
@@ -377,15 +388,20 @@ def move_blockers(
         obstacle = np.zeros((batch, n, 0), dtype=bool)
 
     # Moving link j against fixed link i (i < j - 1): ends of the moving link on
-    # the fixed one, or ends of the fixed link (turned back) on the moving one.
+    # the fixed one, or ends of the fixed link (turned back) on the moving one. Only the
+    # pairs of a fixed link and a moving one within the moving link's sweep can meet.
     pi, pj = geo._pairs()
     links = np.zeros((batch, pi.size), dtype=bool)
-    if pi.size:  # only the pairs of a fixed link and a moving one can meet
+    if pi.size:
         rows, pairs = np.nonzero((pi[None, :] < joint[:, None]) & (pj[None, :] >= joint[:, None]))
+        fixed, moved = pi[pairs], pj[pairs]
+        gap = np.hypot(*np.moveaxis(mid[rows, fixed] - mid[rows, moved], -1, 0))
+        close = gap - half[fixed] - half[moved] <= sweep[rows, moved] + geo.eps
+        rows, pairs, fixed, moved = rows[close], pairs[close], fixed[close], moved[close]
         if len(rows):
             pv, d = pivot[rows], delta_rad[rows]
-            fixed_a, fixed_b = a[rows, pi[pairs]], b[rows, pi[pairs]]
-            move_a, move_b = a[rows, pj[pairs]], b[rows, pj[pairs]]
+            fixed_a, fixed_b = a[rows, fixed], b[rows, fixed]
+            move_a, move_b = a[rows, moved], b[rows, moved]
             contact = np.minimum.reduce(
                 [
                     arc_segment_distance(pv, move_a, d, fixed_a, fixed_b),
