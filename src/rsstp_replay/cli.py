@@ -314,14 +314,21 @@ def _cmd_view(args: argparse.Namespace) -> int:
             grpc_port=args.grpc_port,
         )
         bar.to(1)
-    for warning in caught:
-        print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
-    print(result.to_text())
-    if save is not None:
-        print(f"open it with: rerun {save}")
+    try:  # the server runs from here: Ctrl-C at any moment stops it and removes its file
+        for warning in caught:
+            print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
+        print(result.to_text())
+        if save is not None:
+            print(f"open it with: rerun {save}")
+        if args.serve_web:
+            print(f"serving on {args.bind} until Ctrl-C", flush=True)
+            result.serve_forever()
+    except KeyboardInterrupt:
+        if not args.serve_web:
+            raise
+    finally:
+        result.close()
     if args.serve_web:
-        print(f"serving on {args.bind} until Ctrl-C", flush=True)
-        result.serve_forever()
         print("stopped serving")
     return 0
 
