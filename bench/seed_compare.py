@@ -11,7 +11,8 @@ The setup is its ``tests/external_test.py`` fixture: 3 joints of lengths [3, 2, 
 [330, 3, 357], obstacles at (1.5, 1) and (1.5, -1.5) of radius 0.5, 5-degree steps, feedback
 points at the start pose; actions drawn by ``random.Random(12345)`` from 0..5, the same
 sequence for both. Every figure is measured in a fresh Python process (cold: imports done,
-nothing cached), the warm ones after the same actions once more in that process:
+nothing cached, the world built inside the timing), the warm ones after the same actions once
+more in that process:
 
 - world moves: the original's ``External.update`` against our ``World.move``;
 - the thesis facade: the original's ``robot_arm.update_position`` (its prints sent to
@@ -45,11 +46,11 @@ _PROGRAMS = {
 import contextlib, os, random, sys, time
 sys.path.insert(0, SRC)
 from external import External
-world = External(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
-                 [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)])
 actions = [random.Random(12345).randrange(6) for _ in range(N)]
 with open(os.devnull, "w") as sink, contextlib.redirect_stdout(sink):  # it prints
     began = time.perf_counter()
+    world = External(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
+                     [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)])
     for a in actions:
         world.update(a)
     cold = time.perf_counter() - began
@@ -63,10 +64,11 @@ print(cold, warm)
 import random, sys, time
 from rsstp_sim.scenario import parse_scenario
 from rsstp_sim.world import World
-world = World(parse_scenario(TOML))
 actions = [random.Random(12345).randrange(6) for _ in range(N)]
-move = world.move
+scenario = parse_scenario(TOML)
 began = time.perf_counter()
+world = World(scenario)  # builds the world's table: part of the cold figure
+move = world.move
 for a in actions:
     move(a)
 cold = time.perf_counter() - began
@@ -81,11 +83,11 @@ sys.path.insert(0, SRC)
 import matplotlib
 matplotlib.use("Agg")
 from msrgym import robot_arm
-arm = robot_arm(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
-                [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)], list(range(6)))
 actions = [random.Random(12345).randrange(6) for _ in range(N)]
 with open(os.devnull, "w") as sink, contextlib.redirect_stdout(sink):
     began = time.perf_counter()
+    arm = robot_arm(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
+                    [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)], list(range(6)))
     for a in actions:
         arm.update_position(a)
     cold = time.perf_counter() - began
@@ -94,10 +96,10 @@ print(cold, cold)
     "ours-facade": """
 import random, sys, time
 from rsstp_sim.compat import robot_arm
-arm = robot_arm(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
-                [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)], list(range(6)))
 actions = [random.Random(12345).randrange(6) for _ in range(N)]
 began = time.perf_counter()
+arm = robot_arm(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
+                [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)], list(range(6)))
 for a in actions:
     arm.update_position(a)
 cold = time.perf_counter() - began

@@ -374,6 +374,12 @@ def move_blockers(
             & (to_mid - half[None, :, None] <= slack + sweep[:, :, None])
         )
         at_row, at_link, at_obstacle = np.nonzero(ring)
+        if len(at_row):  # the link's own distance to the disk, the tighter bound
+            static = point_segment_distance(
+                geo.centers[at_obstacle], a[at_row, at_link], b[at_row, at_link]
+            )
+            close = static <= slack[at_obstacle] + sweep[at_row, at_link]
+            at_row, at_link, at_obstacle = at_row[close], at_link[close], at_obstacle[close]
         obstacle = np.zeros((batch, n, geo.m), dtype=bool)
         if len(at_row):
             dist = arc_segment_distance(
@@ -398,6 +404,11 @@ def move_blockers(
         gap = np.hypot(*np.moveaxis(mid[rows, fixed] - mid[rows, moved], -1, 0))
         close = gap - half[fixed] - half[moved] <= sweep[rows, moved] + geo.eps
         rows, pairs, fixed, moved = rows[close], pairs[close], fixed[close], moved[close]
+        if len(rows):  # the links' own distance, the tighter bound
+            fixed_a, fixed_b = a[rows, fixed], b[rows, fixed]
+            static = segment_distance(fixed_a, fixed_b, a[rows, moved], b[rows, moved])
+            close = static <= sweep[rows, moved] + geo.eps
+            rows, pairs, fixed, moved = rows[close], pairs[close], fixed[close], moved[close]
         if len(rows):
             pv, d = pivot[rows], delta_rad[rows]
             fixed_a, fixed_b = a[rows, fixed], b[rows, fixed]

@@ -8,9 +8,10 @@ the smallest internal model that predicts every sensation correctly, the
 reference against which a learned model is judged (:func:`check_equivalence`).
 
 Poses are identified by their code ``sum_i angle_i * 360**i`` (as in
-:class:`~rsstp_sim.world.World`). The enumeration is breadth-first over whole
-frontiers, every frontier's moves computed in vectorised batches; nothing here
-loops over poses in Python.
+:class:`~rsstp_sim.world.World`). The reachable poses, their moves and their
+sensations come from the scenario's :class:`~rsstp_sim.world_table.WorldTable`
+completed (breadth first, whole frontiers per vectorised batch); nothing
+here loops over poses in Python.
 
 >>> from rsstp_sim.scenario import load_scenario
 >>> truth = compute_truth(load_scenario("thesis-roulette"))
@@ -25,7 +26,6 @@ loops over poses in Python.
 
 from __future__ import annotations
 
-import math
 import operator
 import time
 from collections import deque
@@ -35,11 +35,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rsstp_sim import geometry
 from rsstp_sim.errors import ModelError, RsstpError
-from rsstp_sim.geometry import ArmGeometry, IntArray
+from rsstp_sim.geometry import IntArray
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.world_table import WorldTable, pose_space_size
 
 __all__ = [
     "GroundTruth",
@@ -51,9 +51,6 @@ __all__ = [
 ]
 
 BoolArray = NDArray[np.bool_]
-
-CHUNK_ROWS = 50_000
-"""Moves (pose, action pairs) checked per call of :func:`geometry.move_blockers`."""
 
 
 class TruthError(RsstpError):
@@ -226,22 +223,6 @@ def format_truth(truth: GroundTruth) -> str:
 # --------------------------------------------------------------- enumeration
 
 
-def pose_space_size(scenario: Scenario) -> int:
-    """An upper bound on the reachable poses, known before enumerating.
-
-    Joint ``k`` only takes the angles ``initial_k + j * gcd(step, 360)`` (mod
-    360), that is ``360 / gcd(step, 360)`` values, and keeps its initial angle
-    when no action turns it.
-    """
-    return math.prod(_lattice_sizes(scenario))
-
-
-def _lattice_sizes(scenario: Scenario) -> list[int]:
-    values = 360 // math.gcd(scenario.step_deg, 360)
-    moving = {a // 2 for a in scenario.actions}
-    return [values if k in moving else 1 for k in range(scenario.n_joints)]
-
-
 def compute_truth(scenario: Scenario, *, max_poses: int = 2_000_000) -> GroundTruth:
     """Enumerate the reachable poses of ``scenario`` and minimise their Moore machine.
 
@@ -254,11 +235,18 @@ def compute_truth(scenario: Scenario, *, max_poses: int = 2_000_000) -> GroundTr
             f"{scenario.name}: the pose space has {bound:,} poses, more than the "
             f"limit of {max_poses:,} (pass a larger max_poses)"
         )
-    geo = ArmGeometry.from_scenario(scenario)
-    pose_codes, next_pose, start_index = _enumerate(scenario, geo)
-    radix = 360 ** np.arange(scenario.n_joints, dtype=np.int64)
-    angles = (pose_codes[:, None] // radix) % 360
-    sensation = _sensation(scenario, geo, angles)
+    table = WorldTable(scenario)
+    table.complete()
+    # The table's rows are in the order the poses were reached; the truth's are by code.
+    codes = np.frombuffer(table.codes, dtype=np.int64)
+    order = np.argsort(codes, kind="stable")
+    rank = np.empty(len(order), dtype=np.int64)
+    rank[order] = np.arange(len(order))
+    pose_codes = codes[order].copy()
+    next_pose = rank[table.next_array()[order]]
+    angles = table.angles()[order]
+    sensation = table.sensations()[order]
+    start_index = int(rank[0])
     blocked = next_pose == np.arange(len(pose_codes))[:, None]
 
     classes = _refine(next_pose, sensation)
@@ -277,74 +265,6 @@ def compute_truth(scenario: Scenario, *, max_poses: int = 2_000_000) -> GroundTr
         class_sensation=class_sensation,
         seconds=time.perf_counter() - started,
     )
-
-
-def _enumerate(scenario: Scenario, geo: ArmGeometry) -> tuple[IntArray, IntArray, int]:
-    """Breadth-first search over frontiers: sorted pose codes, next-pose indices, start index."""
-    n = scenario.n_joints
-    radix = 360 ** np.arange(n, dtype=np.int64)
-    actions = np.asarray(scenario.actions, dtype=np.int64)
-    n_actions = len(actions)
-    action_joint = actions // 2
-    action_delta = np.where(actions % 2 == 0, scenario.step_deg, -scenario.step_deg)
-    code_step = action_delta * radix[action_joint]
-
-    # Dense visited flags over the lattice of angles a joint can take (see pose_space_size).
-    sizes = np.asarray(_lattice_sizes(scenario), dtype=np.int64)
-    spacing = math.gcd(scenario.step_deg, 360)
-    lattice_radix = np.concatenate([[1], np.cumprod(sizes)[:-1]]).astype(np.int64)
-    initial = np.asarray(scenario.initial_deg, dtype=np.int64)
-    visited = np.zeros(int(sizes.prod()), dtype=bool)
-
-    def lattice(codes: IntArray) -> IntArray:
-        angles = (codes[:, None] // radix) % 360
-        return np.asarray((((angles - initial) % 360) // spacing) @ lattice_radix)
-
-    start = np.array([int(initial @ radix)], dtype=np.int64)
-    visited[lattice(start)] = True
-    found, moves = [start], []
-    frontier = start
-    rows_per_chunk = max(1, CHUNK_ROWS // n_actions)
-    while frontier.size:
-        targets = np.empty((len(frontier), n_actions), dtype=np.int64)
-        for lo in range(0, len(frontier), rows_per_chunk):
-            codes = frontier[lo : lo + rows_per_chunk]
-            starts = np.repeat((codes[:, None] // radix) % 360, n_actions, axis=0)
-            joints = np.tile(action_joint, len(codes))
-            deltas = np.tile(action_delta, len(codes))
-            free = geometry.move_blockers(geo, starts, joints, deltas) == 0
-            # A turn that wraps past 0 or 360 changes the code by -/+ 360 * radix.
-            turned = starts[np.arange(len(starts)), joints] + deltas
-            wrap = (turned // 360) * 360 * radix[joints]
-            moved = np.repeat(codes, n_actions) + np.tile(code_step, len(codes)) - wrap
-            targets[lo : lo + len(codes)] = np.where(
-                free, moved, np.repeat(codes, n_actions)
-            ).reshape(-1, n_actions)
-        moves.append(targets)
-        candidates = np.unique(targets)
-        cells = lattice(candidates)
-        fresh = ~visited[cells]
-        visited[cells[fresh]] = True
-        frontier = candidates[fresh]
-        found.append(frontier)
-
-    codes = np.concatenate(found)
-    order = np.argsort(codes)
-    pose_codes = codes[order]
-    next_pose = np.searchsorted(pose_codes, np.concatenate(moves)[order]).astype(np.int64)
-    return pose_codes, next_pose, int(np.searchsorted(pose_codes, start[0]))
-
-
-def _sensation(scenario: Scenario, geo: ArmGeometry, angles: IntArray) -> BoolArray:
-    points = np.asarray(scenario.feedback_points, dtype=np.float64)
-    tolerance_abs = scenario.tolerance * scenario.total_length
-    sensation = np.empty(len(angles), dtype=bool)
-    for lo in range(0, len(angles), CHUNK_ROWS):
-        tips = geometry.joint_positions(angles[lo : lo + CHUNK_ROWS], geo.lengths)[:, 1:]
-        sensation[lo : lo + CHUNK_ROWS] = geometry.feedback(
-            tips, points, geo.lengths, tolerance_abs
-        )[0]
-    return sensation
 
 
 # -------------------------------------------------------------- minimisation

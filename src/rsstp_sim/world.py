@@ -2,28 +2,26 @@
 
 The world knows nothing about the agent, its model or any recording. Its answer
 for a move depends only on the pose and the action, and the pose space is
-finite (integer angles), so every pose's moves are computed once, all actions
-in one vectorised call, and cached.
+finite (integer angles), so every answer comes from the scenario's
+:class:`~rsstp_sim.world_table.WorldTable`: computed once, in vectorised
+batches, and read back with a couple of array lookups per move.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
-from rsstp_sim import geometry
 from rsstp_sim.errors import ActionError
-from rsstp_sim.geometry import ArmGeometry, Blocker, FloatArray, IntArray
+from rsstp_sim.geometry import Blocker, FloatArray
 from rsstp_sim.scenario import Scenario
+from rsstp_sim.world_table import WorldTable
 
 __all__ = ["Pose", "World"]
 
-_FIRST_BOX = 350
-"""Lattice poses computed together at the first cache miss (a cube around the pose)."""
-_BOX_GROWTH = 1.5
-_LAST_BOX = 4096
-"""The cube grows by :data:`_BOX_GROWTH` at every miss, up to this many poses."""
+_FIRST_BLOCK = 256
+"""The poses a small pose space's table grows by at its first miss (doubling at each)."""
+_LAST_BLOCK = 4096
+"""The most poses a large pose space's table grows by at once (see :meth:`World._expand`)."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -60,98 +58,59 @@ class World:
 
     def __init__(self, scenario: Scenario) -> None:
         self.scenario = scenario
-        self.geometry = ArmGeometry.from_scenario(scenario)
-        n = scenario.n_joints
-        self._radix = np.array([360**i for i in range(n)], dtype=np.int64)
-        self._points = np.asarray(scenario.feedback_points, dtype=np.float64)
-        self._tolerance_abs = scenario.tolerance * scenario.total_length
-        actions = np.asarray(scenario.actions, dtype=np.int64)
-        self._action_joint = actions // 2
-        self._action_delta = np.where(actions % 2 == 0, scenario.step_deg, -scenario.step_deg)
-        self._box_poses = _FIRST_BOX
-        self._offsets = self._box_offsets()
+        self.table = WorldTable(scenario)
+        self.geometry = self.table.geometry
+        self._actions = {action: k for k, action in enumerate(self.table.actions)}
+        self._n_actions = len(self._actions)
+        self._next = self.table.next_row
+        self._blocker_codes = self.table.blocker
         self._blockers: dict[int, Blocker] = {}
         self._poses: dict[int, Pose] = {}
-        self._moves: dict[int, dict[int, tuple[int, Blocker | None]]] = {}
-        self._start = self._encode(scenario.initial_deg)
-        self._code = self._start
-        self._pose = self.pose(self._start)
+        self._moves_since_miss = 0
+        self._block = _FIRST_BLOCK
+        self._row = 0
+        self._pose = self._pose_at(0)
         self.last_blocker: Blocker | None = None
 
     # -- poses ---------------------------------------------------------------
 
-    def _encode(self, angles_deg: tuple[int, ...]) -> int:
-        return int(np.dot(np.asarray(angles_deg, dtype=np.int64) % 360, self._radix))
-
-    def _decode(self, code: int) -> tuple[int, ...]:
-        return tuple(int(v) for v in (code // self._radix) % 360)
-
-    def pose(self, code: int) -> Pose:
-        """The cached :class:`Pose` for a pose code (see :attr:`pose_code`)."""
-        pose = self._poses.get(code)
+    def _pose_at(self, row: int) -> Pose:
+        pose = self._poses.get(row)
         if pose is None:
-            self._prefetch(code)
-            pose = self._poses[code]
+            block, i = self.table.block_of(row)
+            pose = self._poses[row] = Pose(
+                self.table.codes[row],
+                tuple(block.angles[i].tolist()),
+                block.positions[i],
+                bool(block.sensation[i]),
+                float(block.feedback[i]),
+                block.distances[i],
+            )
         return pose
 
-    def _box_offsets(self) -> IntArray:
-        """Angle offsets of the poses computed together on a cache miss: a cube of about
-        ``self._box_poses`` lattice poses around the pose missed."""
-        n = self.scenario.n_joints
-        radius = max(1, int(round((self._box_poses ** (1.0 / n) - 1) / 2)))
-        span = np.arange(-radius, radius + 1, dtype=np.int64) * self.scenario.step_deg
-        grid = np.stack(np.meshgrid(*([span] * n), indexing="ij"), axis=-1)
-        return grid.reshape(-1, n)
+    def pose(self, code: int) -> Pose:
+        """The :class:`Pose` of a pose code the world has reached (see :attr:`pose_code`)."""
+        row = self.table.row_of(code)
+        if row < 0:
+            raise KeyError(f"pose code {code} has not been reached")
+        return self._pose_at(row)
 
-    def _prefetch(self, code: int) -> None:
-        """Compute, in one vectorised batch, the poses and moves around ``code``.
+    def _expand(self, row: int) -> None:
+        """Compute the moves of ``row`` and of a block of poses around it.
 
-        Numpy's per-call overhead dwarfs the arithmetic for one pose, so a miss
-        fills a box of neighbouring poses at once (invalid ones included: they
-        are never reached, so their entries are never read).
+        A small pose space (a dense table) doubles the block at every miss, from
+        :data:`_FIRST_BLOCK`: a short run pays for a few hundred poses, a long one for the
+        whole space in a dozen misses. In a large one the block is as many poses as the run
+        made moves since the last miss (1 to :data:`_LAST_BLOCK`): a walk that keeps to
+        known poses gets large blocks, one that keeps finding new poses (an arm of many
+        joints) pays just for the poses it stands on.
         """
-        angles = np.asarray(self._decode(code), dtype=np.int64)
-        box = (angles + self._offsets) % 360
-        codes = box @ self._radix
-        codes, first = np.unique(codes, return_index=True)
-        box = box[first]
-        fresh = np.array([c not in self._moves for c in codes.tolist()], dtype=bool)
-        # A pose that is itself invalid (a link in an obstacle, links crossing, a fold) is
-        # never reached (a move into it is blocked): its moves are not computed, which
-        # saves the most expensive part, the swept checks, for about half of a box near
-        # obstacles. The pose asked for is always computed.
-        fresh &= (geometry.pose_blockers(self.geometry, box) == 0) | (codes == code)
-        box, codes = box[fresh], codes[fresh]
-        # A run that keeps missing is a long one that will visit most poses: each miss makes
-        # the next box larger, so numpy's cost per call is spread over more poses.
-        if self._box_poses < _LAST_BOX:
-            self._box_poses = min(_LAST_BOX, int(self._box_poses * _BOX_GROWTH))
-            self._offsets = self._box_offsets()
-
-        n_actions = len(self._action_joint)
-        starts = np.repeat(box, n_actions, axis=0)
-        joints = np.tile(self._action_joint, len(box))
-        deltas = np.tile(self._action_delta, len(box))
-        blockers = geometry.move_blockers(self.geometry, starts, joints, deltas)
-        rows = np.arange(len(starts))
-        turned = (starts[rows, joints] + deltas) % 360
-        turn = (turned - starts[rows, joints]) * self._radix[joints]
-        targets = np.repeat(codes, n_actions) + turn
-        targets = np.where(blockers == 0, targets, np.repeat(codes, n_actions))
-        decode = self._blocker
-        actions = self.scenario.actions
-        target_list, blocker_list = targets.tolist(), blockers.tolist()
-        for i, pose_code in enumerate(codes.tolist()):
-            base = i * n_actions
-            self._moves[pose_code] = {
-                action: (target_list[base + k], decode(blocker_list[base + k]))
-                for k, action in enumerate(actions)
-            }
-
-        missing = np.array([c not in self._poses for c in codes.tolist()], dtype=bool)
-        self._make_poses(box[missing], codes[missing])
-        if code not in self._poses:  # only when the box held it already (cannot happen twice)
-            self._make_poses(angles[None, :], np.array([code]))
+        if self.table.dense:
+            budget, self._block = self._block, self._block * 2
+        else:
+            budget = min(_LAST_BLOCK, max(1, self._moves_since_miss))
+        self._moves_since_miss = 0
+        self.table.expand(row, budget)
 
     def _blocker(self, blocker_code: int) -> Blocker | None:
         if not blocker_code:
@@ -163,60 +122,44 @@ class World:
             blocker = self._blockers[blocker_code] = decoded
         return blocker
 
-    def _make_poses(self, angles: IntArray, codes: IntArray) -> None:
-        positions = geometry.joint_positions(angles, self.geometry.lengths)
-        positions.flags.writeable = False
-        tips = positions[:, 1:]
-        sensation, closeness = geometry.feedback(
-            tips, self._points, self.geometry.lengths, self._tolerance_abs
-        )
-        distances = geometry.obstacle_distances(tips, self.geometry.centers, self.geometry.radii)
-        distances.flags.writeable = False
-        for i, (pose_code, sensed, close) in enumerate(
-            zip(codes.tolist(), sensation.tolist(), closeness.tolist(), strict=True)
-        ):
-            self._poses[pose_code] = Pose(
-                pose_code, tuple(angles[i].tolist()), positions[i], sensed, close, distances[i]
-            )
-
     # -- the current pose ----------------------------------------------------
 
     def reset(self) -> Pose:
         """Put the arm back at the scenario's start pose."""
-        self._code = self._start
-        self._pose = self.pose(self._start)
+        self._row = 0
+        self._pose = self._pose_at(0)
         self.last_blocker = None
         return self._pose
 
-    def _outcome(self, action: int) -> tuple[int, Blocker | None]:
-        """(pose code reached, blocker) for ``action`` from the current pose; cached."""
-        moves = self._moves.get(self._code)
-        if moves is None:
-            self._prefetch(self._code)
-            moves = self._moves[self._code]
-        try:
-            if action.__class__ is bool:  # True would pass for action 1
-                raise KeyError(action)
-            return moves[action]
-        except KeyError:
+    def _outcome(self, action: int) -> tuple[int, int]:
+        """(row reached, blocker code) for ``action`` from the current pose."""
+        k = self._actions.get(action) if action.__class__ is not bool else None
+        if k is None:  # True would pass for action 1
             raise ActionError(
-                f"action {action!r} is not one of the scenario's actions {list(moves)}"
-            ) from None
+                f"action {action!r} is not one of the scenario's actions {list(self._actions)}"
+            )
+        at = self._row * self._n_actions + k
+        row = self._next[at]
+        if row < 0:
+            self._expand(self._row)
+            row = self._next[at]
+        return row, self._blocker_codes[at]
 
     def move(self, action: int) -> Blocker | None:
         """Execute an action; return None when the arm moved, else why it was blocked."""
-        code, blocker = self._outcome(action)
-        if code != self._code:
-            self._code = code
-            pose = self._poses.get(code)
-            self._pose = pose if pose is not None else self.pose(code)
-        self.last_blocker = blocker
+        row, blocker_code = self._outcome(action)
+        self._moves_since_miss += 1
+        if row != self._row:
+            self._row = row
+            pose = self._poses.get(row)
+            self._pose = pose if pose is not None else self._pose_at(row)
+        blocker = self.last_blocker = self._blocker(blocker_code) if blocker_code else None
         return blocker
 
     def peek(self, action: int) -> tuple[Pose, Blocker | None]:
         """Where an action would lead from the current pose, without moving."""
-        code, blocker = self._outcome(action)
-        return self.pose(code), blocker
+        row, blocker_code = self._outcome(action)
+        return self._pose_at(row), self._blocker(blocker_code)
 
     @property
     def current(self) -> Pose:
@@ -224,7 +167,7 @@ class World:
 
     @property
     def pose_code(self) -> int:
-        return self._code
+        return self._pose.code
 
     @property
     def angles_deg(self) -> tuple[int, ...]:
@@ -247,5 +190,5 @@ class World:
         return self._pose.distances
 
     def cache_info(self) -> tuple[int, int]:
-        """(poses cached, poses whose moves are cached)."""
-        return len(self._poses), len(self._moves)
+        """(poses in the world's table, poses whose moves are computed)."""
+        return len(self.table), self.table.moves_computed()

@@ -302,7 +302,12 @@ def test_cached_answers_equal_a_fresh_computation(data: st.DataObject) -> None:
             joint, delta = action // 2, scenario.step_deg * (1 if action % 2 == 0 else -1)
             code_alone = int(geometry.move_blockers(geo, [angles], [joint], [delta])[0])
             expected = angles if code_alone else end_pose(scenario, angles, action)
-            target, blocker = world._moves[code][action]
+            table, row = world.table, world.table.row_of(code)
+            if not table.has_moves(row):  # the walk's last pose: its moves not asked yet
+                table.expand(row, 1)
+            at = row * len(scenario.actions) + scenario.actions.index(action)
+            target = table.codes[table.next_row[at]]
+            blocker = geo.decode(table.blocker[at])
             assert blocker == geo.decode(code_alone)
             assert world.pose(target).angles_deg == expected
             fresh_pose, fresh_blocker = fresh.peek(action)
@@ -323,13 +328,35 @@ def test_seven_links_keep_exact_poses(scenario_text) -> None:
     assert world.angles_deg == tuple(angles)
 
 
-def test_cache_fills_on_first_use_and_is_reused() -> None:
+def test_a_small_pose_space_grows_in_doubling_blocks() -> None:
     world = World(load_scenario("three-joint"))
-    poses, moves = world.cache_info()
-    assert poses == moves > 1  # the start pose came with a box of neighbours
+    assert world.cache_info() == (1, 0)  # the start pose, no moves computed yet
     world.move(0)
+    poses, moves = world.cache_info()
+    assert moves == 256  # the first block, breadth first around the start
     world.move(1)
-    assert world.cache_info() == (poses, moves)
+    assert world.cache_info() == (poses, moves)  # back at the start: nothing new
+    rng = np.random.default_rng(0)
+    for action in rng.integers(0, 6, size=200_000).tolist():
+        world.move(action)
+    poses, moves = world.cache_info()
+    assert 39_000 < moves <= poses <= 39_232  # reachable poses only, nearly all of them
+    world.table.complete()
+    assert world.cache_info() == (39_232, 39_232)
+
+
+def test_a_large_pose_space_grows_with_the_walk(scenario_text) -> None:
+    """Seven links at 5 degrees (72**7 lattice poses): the table holds the poses the walk
+    reached and their targets, never a box of the lattice."""
+    arm = {"lengths": [1.0] * 7, "initial_deg": [0, 30, 30, 30, 30, 30, 30], "step_deg": 5}
+    world = World(parse_scenario(scenario_text({"arm": arm})))
+    assert world.cache_info() == (1, 0)
+    rng = np.random.default_rng(3)
+    for action in rng.integers(0, 14, size=200).tolist():
+        world.move(action)
+    poses, moves = world.cache_info()
+    assert moves <= 201  # one pose's moves per miss: the walk keeps finding new poses
+    assert poses <= 1 + 14 * moves
 
 
 # -- reset, peek, actions -----------------------------------------------------------------------

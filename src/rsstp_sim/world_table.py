@@ -1,0 +1,250 @@
+"""The world table: the poses an arm can reach, their sensations and their moves, in arrays.
+
+This is the one home of the geometry's answers. The world (one move at a time), the
+ground truth (every reachable pose at once) and the Gymnasium env (through the world)
+all read the same table, and the table asks :mod:`rsstp_sim.geometry` for whole batches
+of poses and moves at once.
+
+- A *pose code* is ``sum(angle_k * 360**k)`` (integer degrees), a *row* the pose's place
+  in the table, in the order the poses were reached: the start pose is row 0.
+- ``next_row[row * A + k]`` is the row reached by the scenario's ``k``-th action (the row
+  itself when the move is blocked), or -1 while that pose's moves are not computed;
+  ``blocker[row * A + k]`` is the move's blocker code (0 = free, see
+  :class:`~rsstp_sim.geometry.ArmGeometry`). Both are ``array.array`` of C ints: compact,
+  growable, and read by Python without numpy's per-call cost.
+- Only poses the arm can reach are ever stored: a pose enters the table as the target of
+  a free move, never as a neighbour on a lattice, so invalid and unreachable poses cost
+  nothing.
+
+The table grows on demand: :meth:`WorldTable.expand` computes the moves of a block of
+poses around the one the arm stands on, breadth first, one vectorised batch per frontier,
+as many poses as the caller's budget allows; :meth:`WorldTable.complete` computes every
+reachable pose the same way (the ground truth's enumeration). A pose space of at most
+:data:`DENSE_LIMIT` lattice poses finds rows by pose code in a dense array, a larger one
+in a dict of the poses reached.
+"""
+
+from __future__ import annotations
+
+import array
+import bisect
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from rsstp_sim import geometry
+from rsstp_sim.geometry import ArmGeometry, FloatArray, IntArray
+from rsstp_sim.scenario import Scenario
+
+__all__ = ["DENSE_LIMIT", "PoseBlock", "WorldTable", "lattice_sizes", "pose_space_size"]
+
+BoolArray = NDArray[np.bool_]
+Int32Array = NDArray[np.int32]
+
+DENSE_LIMIT = 4_000_000
+"""Pose spaces of at most this many lattice poses index their rows in a dense array."""
+_CHUNK_MOVES = 65_536
+"""Moves per call to :func:`geometry.move_blockers` (bounds the temporaries' memory)."""
+
+
+def lattice_sizes(scenario: Scenario) -> list[int]:
+    """How many angles each joint can take: ``360 / gcd(step, 360)``, or 1 when no
+    action turns it (it keeps its initial angle)."""
+    values = 360 // math.gcd(scenario.step_deg, 360)
+    moving = {a // 2 for a in scenario.actions}
+    return [values if k in moving else 1 for k in range(scenario.n_joints)]
+
+
+def pose_space_size(scenario: Scenario) -> int:
+    """An upper bound on the reachable poses, known before any geometry is computed."""
+    return math.prod(lattice_sizes(scenario))
+
+
+@dataclass(frozen=True, slots=True)
+class PoseBlock:
+    """The per-pose geometry of rows ``first .. first + len(angles) - 1``, computed together.
+
+    - ``angles``: ``(k, n)`` relative joint angles in integer degrees;
+    - ``positions``: ``(k, n + 1, 2)`` the base then every link tip;
+    - ``sensation``, ``feedback``: the feedback point's boolean and float readings;
+    - ``distances``: ``(k, n, m)`` from every tip to every obstacle's surface.
+
+    The arrays are read-only.
+    """
+
+    first: int
+    angles: IntArray
+    positions: FloatArray
+    sensation: BoolArray
+    feedback: FloatArray
+    distances: FloatArray
+
+
+class WorldTable:
+    """The reachable poses of ``scenario`` found so far, and the moves computed so far."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.scenario = scenario
+        self.geometry = ArmGeometry.from_scenario(scenario)
+        n = scenario.n_joints
+        self.actions: tuple[int, ...] = tuple(scenario.actions)
+        self.radix = np.array([360**k for k in range(n)], dtype=np.int64)
+        actions = np.asarray(self.actions, dtype=np.int64)
+        self._joint = actions // 2
+        self._delta = np.where(actions % 2 == 0, scenario.step_deg, -scenario.step_deg)
+        self._points = np.asarray(scenario.feedback_points, dtype=np.float64)
+        self._tolerance_abs = scenario.tolerance * scenario.total_length
+
+        self.codes = array.array("q")
+        self.next_row = array.array("i")
+        self.blocker = array.array("i")
+        self.sensation = array.array("b")
+        self.feedback = array.array("d")
+        self.blocks: list[PoseBlock] = []
+        self._block_firsts: list[int] = []
+        self.dense = pose_space_size(scenario) <= DENSE_LIMIT
+        # Rows by pose code: a dense array over a small lattice, else a dict of the poses
+        # reached.
+        sizes = np.asarray(lattice_sizes(scenario), dtype=np.int64)
+        self._spacing = math.gcd(scenario.step_deg, 360)
+        self._lattice_radix = np.concatenate([[1], np.cumprod(sizes)[:-1]]).astype(np.int64)
+        self._initial = np.asarray(scenario.initial_deg, dtype=np.int64)
+        self._dense = np.full(int(sizes.prod()), -1, dtype=np.int32) if self.dense else None
+        self._row_of: dict[int, int] = {}
+        start = int(self._initial @ self.radix)
+        self._add_poses(np.array([start], dtype=np.int64))
+
+    # -- size ----------------------------------------------------------------
+
+    def __len__(self) -> int:
+        return len(self.codes)
+
+    @property
+    def n_actions(self) -> int:
+        return len(self.actions)
+
+    def has_moves(self, row: int) -> bool:
+        return self.next_row[row * len(self.actions)] >= 0
+
+    def moves_computed(self) -> int:
+        """How many rows have their moves computed."""
+        return int(np.count_nonzero(self.next_array()[:, 0] >= 0))
+
+    # -- growing ---------------------------------------------------------------
+
+    def complete(self) -> None:
+        """Compute every reachable pose and all its moves (breadth first from the start)."""
+        frontier = np.flatnonzero(self.next_array()[:, 0] < 0)
+        while frontier.size:
+            first_new = len(self.codes)
+            self._compute_moves(frontier)
+            frontier = np.arange(first_new, len(self.codes), dtype=np.int64)
+
+    def expand(self, row: int, budget: int) -> None:
+        """Compute the moves of ``row`` and, breadth first through the poses it reaches, of
+        up to ``budget`` poses in all (at least ``row``'s)."""
+        frontier = np.array([row], dtype=np.int64)
+        done = 0
+        n_actions = len(self.actions)
+        while frontier.size and done < budget:
+            frontier = frontier[: budget - done]
+            self._compute_moves(frontier)
+            done += len(frontier)
+            nxt = self.next_array()
+            reached = np.unique(nxt[frontier].ravel())
+            frontier = reached[nxt[reached, 0] < 0]
+            del nxt
+        assert self.next_row[row * n_actions] >= 0
+
+    def _compute_moves(self, rows: IntArray) -> None:
+        """Blockers and targets of every action from ``rows`` (poses without moves yet)."""
+        n_actions = len(self.actions)
+        per_chunk = max(1, _CHUNK_MOVES // n_actions)
+        all_codes = np.frombuffer(self.codes, dtype=np.int64)
+        codes_of = all_codes[rows]
+        del all_codes  # the table grows below: no view of it may stay
+        for lo in range(0, len(rows), per_chunk):
+            chunk, codes = rows[lo : lo + per_chunk], codes_of[lo : lo + per_chunk]
+            angles = (codes[:, None] // self.radix) % 360
+            starts = np.repeat(angles, n_actions, axis=0)
+            joints = np.tile(self._joint, len(chunk))
+            deltas = np.tile(self._delta, len(chunk))
+            blockers = geometry.move_blockers(self.geometry, starts, joints, deltas)
+            index = np.arange(len(starts))
+            turned = (starts[index, joints] + deltas) % 360
+            moved = (
+                np.repeat(codes, n_actions)
+                + (turned - starts[index, joints]) * (self.radix[joints])
+            )
+            targets = np.where(blockers == 0, moved, np.repeat(codes, n_actions))
+            target_rows = self.rows_of(targets)
+            if (target_rows < 0).any():
+                self._add_poses(np.unique(targets[target_rows < 0]))
+                target_rows = self.rows_of(targets)
+            self.next_array()[chunk] = target_rows.reshape(-1, n_actions)
+            self.blocker_array()[chunk] = blockers.reshape(-1, n_actions)
+
+    def rows_of(self, codes: IntArray) -> Int32Array:
+        """The row of every pose code, -1 for a pose not in the table."""
+        if self._dense is not None:
+            angles = (codes[:, None] // self.radix) % 360
+            cells = (((angles - self._initial) % 360) // self._spacing) @ self._lattice_radix
+            return np.asarray(self._dense[cells], dtype=np.int32)
+        get = self._row_of.get
+        return np.fromiter((get(c, -1) for c in codes.tolist()), np.int32, len(codes))
+
+    def row_of(self, code: int) -> int:
+        """The row of one pose code, -1 when the pose is not in the table."""
+        return int(self.rows_of(np.array([code], dtype=np.int64))[0])
+
+    def _add_poses(self, codes: IntArray) -> None:
+        """Append poses (new codes) as rows, with their geometry computed in one batch."""
+        first = len(self.codes)
+        rows = np.arange(first, first + len(codes), dtype=np.int32)
+        angles = (codes[:, None] // self.radix) % 360
+        positions = geometry.joint_positions(angles, self.geometry.lengths)
+        tips = positions[:, 1:]
+        sensation, closeness = geometry.feedback(
+            tips, self._points, self.geometry.lengths, self._tolerance_abs
+        )
+        distances = geometry.obstacle_distances(tips, self.geometry.centers, self.geometry.radii)
+        for a in (angles, positions, sensation, closeness, distances):
+            a.flags.writeable = False
+        self.blocks.append(PoseBlock(first, angles, positions, sensation, closeness, distances))
+        self._block_firsts.append(first)
+        if self._dense is not None:
+            cells = (((angles - self._initial) % 360) // self._spacing) @ self._lattice_radix
+            self._dense[cells] = rows
+        else:
+            self._row_of.update(zip(codes.tolist(), rows.tolist(), strict=True))
+        self.codes.frombytes(codes.astype(np.int64).tobytes())
+        self.sensation.frombytes(sensation.astype(np.int8).tobytes())
+        self.feedback.frombytes(closeness.astype(np.float64).tobytes())
+        blank = len(codes) * len(self.actions)
+        self.next_row.frombytes(np.full(blank, -1, dtype=np.int32).tobytes())
+        self.blocker.frombytes(np.zeros(blank, dtype=np.int32).tobytes())
+
+    # -- reading ---------------------------------------------------------------
+
+    def block_of(self, row: int) -> tuple[PoseBlock, int]:
+        """The block holding ``row`` and the row's offset in it."""
+        block = self.blocks[bisect.bisect_right(self._block_firsts, row) - 1]
+        return block, row - block.first
+
+    def next_array(self) -> Int32Array:
+        """``next_row`` as a ``(rows, actions)`` numpy view (valid until the table grows)."""
+        return np.frombuffer(self.next_row, dtype=np.int32).reshape(-1, len(self.actions))
+
+    def blocker_array(self) -> Int32Array:
+        """``blocker`` as a ``(rows, actions)`` numpy view (valid until the table grows)."""
+        return np.frombuffer(self.blocker, dtype=np.int32).reshape(-1, len(self.actions))
+
+    def angles(self) -> IntArray:
+        """``(rows, n)`` joint angles of every row."""
+        return np.concatenate([block.angles for block in self.blocks])
+
+    def sensations(self) -> BoolArray:
+        """The boolean sensation of every row."""
+        return np.concatenate([block.sensation for block in self.blocks])
