@@ -42,7 +42,9 @@ COMMANDS = [
     ("rsstp_sim", "run", "thesis-roulette", "--steps", "140000"),
     ("rsstp_sim", "record", "one-joint-10", "--steps", "9000", "-o", "{tmp}/run.mcap", "--force"),
     ("rsstp_replay", "audit", str(REFERENCE), "--truth"),
-]
+    ("rsstp_sim", "sweep", str(ROOT / "tests/sweep/tiny-sweep.toml"), "-o", "{tmp}/sweep",
+     "--workers", "1"),
+]  # fmt: skip
 
 
 @pytest.mark.parametrize("command", COMMANDS, ids=lambda c: c[1])

@@ -459,6 +459,10 @@ def _build_parser() -> Parser:
     p.add_argument("m", type=_integer, metavar="M", help="second start step")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_cmd_compare)
+
+    from rsstp_sweep.commands import add_report_parser  # the sweep's report (no Dask needed)
+
+    add_report_parser(sub)
     return parser
 
 

@@ -253,6 +253,12 @@ def _build_parser() -> Parser:
         help="refuse larger pose spaces (default 2,000,000)",
     )
     p.set_defaults(func=_cmd_truth)
+
+    # The sweep records and audits: it sits above the simulator and the replay side, and is
+    # imported only when the command runs.
+    from rsstp_sweep.commands import add_sweep_parser  # noqa: TID251
+
+    add_sweep_parser(sub)
     return parser
 
 

@@ -1,0 +1,167 @@
+"""Run a checked sweep on Dask and gather one table.
+
+Without a scheduler address, :func:`run_sweep` starts a ``distributed.LocalCluster`` of
+worker processes (one thread each, listening on 127.0.0.1) and closes it at the end; with
+one, it submits to that cluster and leaves it running. Each run is one task
+(:func:`~rsstp_sweep.execute.execute_run`); its row arrives as it finishes. The output
+directory gets, besides the recordings and ``findings/``:
+
+- ``sweep.toml``: the sweep file as given;
+- ``sweep.json``: the package and library versions, the runs' names and the sweep's origin;
+- ``runs.parquet``: one row per run, in the sweep file's order, written at the end and also
+  when the sweep is interrupted (runs that did not finish are rows with status ``not run``).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import logging
+import signal
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import pandas as pd
+
+from rsstp_sweep.execute import ROW_FIELDS, execute_run, failed_row
+from rsstp_sweep.plan import Run, Sweep
+
+__all__ = ["RUNS_TABLE", "SweepResult", "run_sweep", "runs_frame"]
+
+RUNS_TABLE = "runs.parquet"
+
+
+@dataclass(frozen=True, slots=True)
+class SweepResult:
+    """What a sweep did: its table (one row per run) and whether it was interrupted."""
+
+    runs: pd.DataFrame
+    interrupted: bool
+
+    @property
+    def failed(self) -> pd.DataFrame:
+        return self.runs[self.runs["status"] == "failed"]
+
+    @property
+    def done(self) -> int:
+        return int((self.runs["status"] == "done").sum())
+
+
+def run_sweep(
+    sweep: Sweep,
+    output: str,
+    *,
+    workers: int | None = None,
+    scheduler: str | None = None,
+    on_row: Callable[[Mapping[str, Any]], None] | None = None,
+) -> SweepResult:
+    """Run every run of ``sweep`` into ``output`` (a folder or fsspec URL); see the module
+    docstring. ``on_row`` is called with each row as its run ends. Ctrl-C cancels the runs
+    not finished and returns with ``interrupted`` set; the finished runs are kept."""
+    import fsspec
+    from distributed import Client, LocalCluster, as_completed
+
+    fs, root = fsspec.core.url_to_fs(output)
+    fs.makedirs(root, exist_ok=True)
+    _write_metadata(fs, root, sweep)
+    rows: dict[str, dict[str, Any]] = {}
+    interrupted = False
+    cluster = None
+    if scheduler is None:
+        # The workers are started ignoring SIGINT (a disposition a new process inherits): a
+        # Ctrl-C at the terminal reaches the whole process group, and it is this process
+        # that stops the sweep and then the cluster, the runs in flight with it.
+        previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+        try:
+            cluster = LocalCluster(
+                n_workers=workers,
+                threads_per_worker=1,
+                processes=True,
+                host="127.0.0.1",
+                dashboard_address=None,
+                silence_logs=logging.ERROR,
+            )
+        finally:
+            signal.signal(signal.SIGINT, previous)
+    try:
+        with Client(cluster if cluster is not None else scheduler, timeout="20s") as client:
+            by_key = {}
+            for run in sweep.runs:
+                future = client.submit(
+                    execute_run, run, output, key=f"rsstp-{run.name}", pure=False
+                )
+                by_key[future.key] = (run, future)
+            try:
+                for future in as_completed([f for _, f in by_key.values()]):
+                    run, _ = by_key[future.key]
+                    try:
+                        row = future.result()
+                    except Exception as exc:  # the worker itself died (e.g. killed)
+                        row = failed_row(run, f"the worker running it was lost: {exc}")
+                    rows[run.name] = row
+                    if on_row is not None:
+                        on_row(row)
+            except KeyboardInterrupt:
+                interrupted = True
+                client.cancel([f for _, f in by_key.values()])
+    finally:
+        if cluster is not None:
+            cluster.close()
+    table = runs_frame([rows.get(run.name) or _not_run(run) for run in sweep.runs])
+    buffer = io.BytesIO()
+    table.to_parquet(buffer, index=False)
+    with fs.open(f"{root.rstrip('/')}/{RUNS_TABLE}", "wb") as out:
+        out.write(buffer.getvalue())
+    return SweepResult(table, interrupted)
+
+
+def runs_frame(rows: list[dict[str, Any]]) -> pd.DataFrame:
+    """The runs table with its column types fixed (nullable where a failed run has none)."""
+    frame = pd.DataFrame(rows, columns=list(ROW_FIELDS))
+    types = {
+        "seed": "int64",
+        "steps": "int64",
+        "reused": "bool",
+        "seconds": "Float64",
+        "seconds_record": "Float64",
+        "seconds_audit": "Float64",
+        "recorded_steps": "Int64",
+        "model_versions": "Int64",
+        "final_states": "Int64",
+        "final_transitions": "Int64",
+        "final_deterministic": "boolean",
+        "minimal_states": "Int64",
+        "equivalent": "boolean",
+        "learned_at_step": "Int64",
+        "contradictory_states": "Int64",
+        "contradictions_within_versions": "Int64",
+        "blocked": "Int64",
+        "no_transition": "Int64",
+    }
+    for column in ("run", "scenario", "scenario_sha256", "strategy", "params", "status"):
+        types[column] = "string"
+    types["error"] = "string"
+    types["recording"] = "string"
+    return frame.astype(types)
+
+
+def _not_run(run: Run) -> dict[str, Any]:
+    row = failed_row(run, "not run: the sweep was interrupted")
+    row["status"] = "not run"
+    return row
+
+
+def _write_metadata(fs: Any, root: str, sweep: Sweep) -> None:
+    from rsstp_sim.recording.recorder import environment_versions
+
+    base = root.rstrip("/")
+    with fs.open(f"{base}/sweep.toml", "w") as out:
+        out.write(sweep.source)
+    document = {
+        "origin": sweep.origin,
+        **environment_versions(),
+        "runs": [run.name for run in sweep.runs],
+    }
+    with fs.open(f"{base}/sweep.json", "w") as out:
+        json.dump(document, out, indent=1)

@@ -1,0 +1,97 @@
+"""Sweep files: expanded into runs in file order, and every mistake caught before any work."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from rsstp_sweep import SweepError, load_sweep, parse_sweep
+
+BASE = """
+steps = 100
+seeds = 3
+scenarios = ["thesis-roulette", "one-joint-10"]
+[[strategy]]
+name = "learner"
+[[strategy]]
+name = "script"
+params = { actions = [0] }
+"""
+
+
+def test_runs_are_scenario_by_strategy_by_seed_in_file_order() -> None:
+    sweep = parse_sweep(BASE)
+    assert sweep.seeds == (0, 1, 2)
+    assert len(sweep.runs) == 2 * 2 * 3
+    first = sweep.runs[0]
+    assert (first.scenario, first.strategy, first.seed, first.steps) == (
+        "thesis-roulette",
+        "learner",
+        0,
+        100,
+    )
+    assert [run.seed for run in sweep.runs[:3]] == [0, 1, 2]
+    script = sweep.runs[3]
+    assert script.strategy == "script" and dict(script.params) == {"actions": [0]}
+    assert script.name.startswith("thesis-roulette__script-") and script.name.endswith("__seed0")
+    assert len({run.name for run in sweep.runs}) == len(sweep.runs)
+
+
+def test_a_grid_sweeps_every_combination_and_params_stay_fixed() -> None:
+    sweep = parse_sweep(
+        """
+steps = 10
+seeds = [5]
+scenarios = ["one-joint-10"]
+[[strategy]]
+name = "script"
+grid = { actions = [[0], [1], [0, 1]] }
+"""
+    )
+    assert [dict(run.params) for run in sweep.runs] == [
+        {"actions": [0]},
+        {"actions": [1]},
+        {"actions": [0, 1]},
+    ]
+    assert len({run.name for run in sweep.runs}) == 3
+
+
+def test_a_scenario_file_is_read_relative_to_the_sweep_file(tmp_path: Path) -> None:
+    arms = tmp_path / "arms"
+    arms.mkdir()
+    scenario = Path("src/rsstp_sim/scenarios/thesis-roulette.toml").read_text()
+    (arms / "mine.toml").write_text(scenario.replace('name = "thesis-roulette"', 'name = "mine"'))
+    (tmp_path / "sweep.toml").write_text(BASE.replace('"one-joint-10"', '"arms/mine.toml"'))
+    sweep = load_sweep(tmp_path / "sweep.toml")
+    run = sweep.runs[-1]
+    assert run.scenario == "arms/mine.toml" and run.name.startswith("mine__")
+    assert 'name = "mine"' in run.scenario_source
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (("steps = 100", "steps = -1"), r"steps: expected an integer >= 0, got -1"),
+        (("seeds = 3", "seeds = 0"), r"seeds: expected a count >= 1"),
+        (("seeds = 3", "seeds = [1, 1]"), r"seeds: a seed is listed twice"),
+        (('"one-joint-10"', '"no-such"'), r"no-such: no such scenario file"),
+        (('"one-joint-10"', '"missing.toml"'), r"missing.toml: no such scenario file"),
+        (('name = "learner"', 'name = "nope"'), r"strategy\[0\]: .*nope"),
+        (("actions = [0]", "actions = [7]"), r"strategy 'script'.*actions \[7\]"),
+        (("params = {", "parms = {"), r"strategy\[1\]: unknown key 'parms'"),
+        (("steps = 100", "steps = 100\nstep = 3"), r"unknown key 'step'"),
+        (('"thesis-roulette", ', '"one-joint-10", '), r"two scenarios are named 'one-joint-10'"),
+        (("steps = 100", "steps = [100"), r"TOML syntax error"),
+    ],
+)
+def test_a_bad_sweep_is_one_error_naming_the_key(change: tuple[str, str], message: str) -> None:
+    old, new = change
+    assert old in BASE
+    with pytest.raises(SweepError, match=message):
+        parse_sweep(BASE.replace(old, new), origin="sweep.toml")
+
+
+def test_a_missing_sweep_file_is_named(tmp_path: Path) -> None:
+    with pytest.raises(SweepError, match=r"nothere.toml: no such sweep file"):
+        load_sweep(tmp_path / "nothere.toml")
