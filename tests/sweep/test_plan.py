@@ -95,3 +95,20 @@ def test_a_bad_sweep_is_one_error_naming_the_key(change: tuple[str, str], messag
 def test_a_missing_sweep_file_is_named(tmp_path: Path) -> None:
     with pytest.raises(SweepError, match=r"nothere.toml: no such sweep file"):
         load_sweep(tmp_path / "nothere.toml")
+
+
+def test_the_readme_sweep_file_is_valid(tmp_path: Path) -> None:
+    """The README's example sweep checks (with a scenario file of its own beside it)."""
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    text = next(block for block in readme.split("```toml\n")[1:] if "seeds" in block)
+    text = text.split("```")[0]
+    scenario = Path("src/rsstp_sim/scenarios/two-joint-30.toml").read_text()
+    (tmp_path / "my-arm.toml").write_text(scenario.replace("two-joint-30", "my-arm"))
+    (tmp_path / "sweep.toml").write_text(text)
+    sweep = load_sweep(tmp_path / "sweep.toml")
+    assert len(sweep.runs) == 3 * (1 + 1 + 3) * 3
+    assert {run.params.get("horizon") for run in sweep.runs if run.strategy == "splitter"} == {
+        4,
+        8,
+        16,
+    }
