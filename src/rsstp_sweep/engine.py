@@ -31,6 +31,11 @@ __all__ = ["RUNS_TABLE", "SweepResult", "run_sweep", "runs_frame"]
 
 RUNS_TABLE = "runs.parquet"
 
+_KILLED = (
+    "its worker process died while running it, on every retry (killed: out of memory, a "
+    "signal, or a crash in native code)"
+)
+
 
 @dataclass(frozen=True, slots=True)
 class SweepResult:
@@ -60,7 +65,7 @@ def run_sweep(
     docstring. ``on_row`` is called with each row as its run ends. Ctrl-C cancels the runs
     not finished and returns with ``interrupted`` set; the finished runs are kept."""
     import fsspec
-    from distributed import Client, LocalCluster, as_completed
+    from distributed import Client, KilledWorker, LocalCluster, as_completed
 
     fs, root = fsspec.core.url_to_fs(output)
     fs.makedirs(root, exist_ok=True)
@@ -80,7 +85,7 @@ def run_sweep(
                 processes=True,
                 host="127.0.0.1",
                 dashboard_address=None,
-                silence_logs=logging.ERROR,
+                silence_logs=logging.CRITICAL,  # a run's failure is its row and one line
             )
         finally:
             signal.signal(signal.SIGINT, previous)
@@ -97,8 +102,10 @@ def run_sweep(
                     run, _ = by_key[future.key]
                     try:
                         row = future.result()
-                    except Exception as exc:  # the worker itself died (e.g. killed)
-                        row = failed_row(run, f"the worker running it was lost: {exc}")
+                    except KilledWorker:  # the run kills its worker, on every retry
+                        row = failed_row(run, _KILLED)
+                    except Exception as exc:  # the cluster lost it another way
+                        row = failed_row(run, f"the cluster lost the run: {exc}")
                     rows[run.name] = row
                     if on_row is not None:
                         on_row(row)

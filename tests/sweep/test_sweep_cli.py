@@ -24,6 +24,9 @@ from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import make_strategy
 
 FAULTY = """
+import os
+import signal
+
 from rsstp_sim import AgentView, StrategyBase
 
 
@@ -33,6 +36,15 @@ class Breaks(StrategyBase):
     def choose_action(self, agent: AgentView) -> int:
         if agent.step == 40:
             raise RuntimeError("boom at 40")
+        return agent.actions[0]
+
+
+class Dies(StrategyBase):
+    name = "dies"
+
+    def choose_action(self, agent: AgentView) -> int:
+        if agent.step == 40:
+            os.kill(os.getpid(), signal.SIGKILL)  # as the kernel's OOM killer would
         return agent.actions[0]
 """
 
@@ -165,6 +177,21 @@ def test_a_rerun_keeps_whole_runs_and_redoes_broken_ones(
     assert truncated.read_bytes() == whole
 
 
+def test_a_run_that_kills_its_worker_is_a_failed_row(folder: Path, tmp_path: Path) -> None:
+    sweep = tmp_path / "kills.toml"
+    sweep.write_text(
+        'steps = 300\nseeds = 2\nscenarios = ["thesis-roulette"]\n'
+        '[[strategy]]\nname = "learner"\n[[strategy]]\nname = "sweep_faulty:Dies"\n'
+    )
+    out = tmp_path / "out"
+    done = sweep_cli(str(sweep), "-o", str(out), "--workers", "2", path=folder)
+    assert done.returncode == 1
+    assert "Traceback" not in done.stderr and "distributed" not in done.stderr
+    assert done.stderr.count("its worker process died while running it") == 2
+    runs = pd.read_parquet(out / "runs.parquet")
+    assert list(runs["status"]) == ["done", "done", "failed", "failed"]
+
+
 def test_a_sweep_runs_on_a_scheduler_started_apart(folder: Path, tmp_path: Path) -> None:
     """`dask scheduler` and `dask worker` as their own processes, on 127.0.0.1."""
     dask = shutil.which("dask", path=str(Path(sys.executable).parent))
@@ -194,11 +221,13 @@ def test_a_sweep_runs_on_a_scheduler_started_apart(folder: Path, tmp_path: Path)
             '[[strategy]]\nname = "learner"\n'
         )
         out = tmp_path / "out"
-        done = sweep_cli(str(sweep), "-o", str(out), "--scheduler", address, path=folder)
+        url = f"file://{out}"  # an fsspec URL, as s3://... would be
+        done = sweep_cli(str(sweep), "-o", url, "--scheduler", address, path=folder)
         assert done.returncode == 0, done.stderr
         assert "2 of 2 runs done, 0 failed" in done.stdout
         runs = pd.read_parquet(out / "runs.parquet")
         assert list(runs["seed"]) == [4, 9] and runs["equivalent"].all()
+        assert report_cli(url, "--fail-if", "learned_fraction < 1").returncode == 0
         assert scheduler.poll() is None  # a cluster given is left running
     finally:
         for process in (worker, scheduler):
