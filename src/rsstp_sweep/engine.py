@@ -24,7 +24,7 @@ from typing import Any
 
 import pandas as pd
 
-from rsstp_sweep.execute import ROW_FIELDS, execute_run, failed_row
+from rsstp_sweep.execute import ROW_FIELDS, execute_run, failed_row, finished_row
 from rsstp_sweep.plan import Run, Sweep
 
 __all__ = ["RUNS_TABLE", "SweepResult", "run_sweep", "runs_frame"]
@@ -115,6 +115,14 @@ def run_sweep(
     finally:
         if cluster is not None:
             cluster.close()
+    if interrupted:  # a run may have finished while its result was on the way
+        for run in sweep.runs:
+            if run.name not in rows:
+                row = finished_row(run, output)
+                if row is not None:
+                    rows[run.name] = row
+                    if on_row is not None:
+                        on_row(row)
     table = runs_frame([rows.get(run.name) or _not_run(run) for run in sweep.runs])
     buffer = io.BytesIO()
     table.to_parquet(buffer, index=False)

@@ -27,7 +27,7 @@ from typing import Any
 
 from rsstp_sweep.plan import Run
 
-__all__ = ["FINDINGS", "ROW_FIELDS", "execute_run", "failed_row"]
+__all__ = ["FINDINGS", "ROW_FIELDS", "execute_run", "failed_row", "finished_row"]
 
 FINDINGS = "findings"
 """The folder of the output directory that holds each run's findings as JSON."""
@@ -106,6 +106,19 @@ def execute_run(run: Run, output: str) -> dict[str, Any]:
         return row
     except Exception as exc:  # a run's own failure is its row; the sweep goes on
         return failed_row(run, _one_line(exc), seconds=time.perf_counter() - began)
+
+
+def finished_row(run: Run, output: str) -> dict[str, Any] | None:
+    """The row a run wrote when it finished (its findings, its recording whole), or None: for
+    a run whose result never reached the sweep (it was interrupted just then)."""
+    import fsspec
+
+    try:
+        fs, root = fsspec.core.url_to_fs(output)
+        target = f"{root.rstrip('/')}/{run.recording}"
+        return _kept_findings(fs, target, f"{root.rstrip('/')}/{FINDINGS}/{run.name}.json", run)
+    except OSError:
+        return None
 
 
 def failed_row(run: Run, error: str, *, seconds: float | None = None) -> dict[str, Any]:
