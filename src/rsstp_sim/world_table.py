@@ -94,6 +94,12 @@ class WorldTable:
         actions = np.asarray(self.actions, dtype=np.int64)
         self._joint = actions // 2
         self._delta = np.where(actions % 2 == 0, scenario.step_deg, -scenario.step_deg)
+        # The index of each action's reverse (the same joint turned back), -1 when the
+        # scenario lacks it: a move and its reverse sweep the same poses.
+        self._reverse = np.array(
+            [self.actions.index(a ^ 1) if a ^ 1 in self.actions else -1 for a in self.actions],
+            dtype=np.int64,
+        )
         self._points = np.asarray(scenario.feedback_points, dtype=np.float64)
         self._tolerance_abs = scenario.tolerance * scenario.total_length
 
@@ -159,7 +165,13 @@ class WorldTable:
         assert self.next_row[row * n_actions] >= 0
 
     def _compute_moves(self, rows: IntArray) -> None:
-        """Blockers and targets of every action from ``rows`` (poses without moves yet)."""
+        """Blockers and targets of every action from ``rows`` (poses without moves yet).
+
+        A move and its reverse sweep the same poses, so they meet the same obstacles and
+        links and have the same blocker (in endpoint mode both ends are valid poses, so both
+        are free): a move whose reverse is already computed, from the pose it leads to, is
+        copied from it; only the others are computed, in vectorised chunks.
+        """
         n_actions = len(self.actions)
         per_chunk = max(1, _CHUNK_MOVES // n_actions)
         all_codes = np.frombuffer(self.codes, dtype=np.int64)
@@ -171,18 +183,30 @@ class WorldTable:
             starts = np.repeat(angles, n_actions, axis=0)
             joints = np.tile(self._joint, len(chunk))
             deltas = np.tile(self._delta, len(chunk))
-            blockers = geometry.move_blockers(self.geometry, starts, joints, deltas)
             index = np.arange(len(starts))
             turned = (starts[index, joints] + deltas) % 360
-            moved = (
-                np.repeat(codes, n_actions)
-                + (turned - starts[index, joints]) * (self.radix[joints])
-            )
-            targets = np.where(blockers == 0, moved, np.repeat(codes, n_actions))
-            target_rows = self.rows_of(targets)
-            if (target_rows < 0).any():
-                self._add_poses(np.unique(targets[target_rows < 0]))
-                target_rows = self.rows_of(targets)
+            here = np.repeat(codes, n_actions)
+            moved = here + (turned - starts[index, joints]) * self.radix[joints]
+            reverse = np.tile(self._reverse, len(chunk))
+            there = self.rows_of(moved)
+            known = (there >= 0) & (reverse >= 0)
+            blockers = np.zeros(len(starts), dtype=np.int64)
+            if known.any():
+                at, back = there[known], reverse[known]
+                copied = self.next_array()[at, back] >= 0
+                known[np.flatnonzero(known)[~copied]] = False
+                blockers[known] = self.blocker_array()[there[known], reverse[known]]
+            todo = ~known
+            if todo.any():
+                blockers[todo] = geometry.move_blockers(
+                    self.geometry, starts[todo], joints[todo], deltas[todo]
+                )
+            free = blockers == 0
+            target_rows = np.where(free, there, np.repeat(chunk, n_actions)).astype(np.int32)
+            new = target_rows < 0  # free moves to poses not in the table yet
+            if new.any():
+                self._add_poses(np.unique(moved[new]))
+                target_rows[new] = self.rows_of(moved[new])
             self.next_array()[chunk] = target_rows.reshape(-1, n_actions)
             self.blocker_array()[chunk] = blockers.reshape(-1, n_actions)
 
