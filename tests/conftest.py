@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import copy
 import json
-from collections.abc import Callable, Mapping
+import os
+from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 
 import pytest
@@ -87,3 +88,44 @@ def write_scenario(tmp_path: Path) -> WriteScenario:
         return path
 
     return write
+
+
+@pytest.fixture
+def unwritable_directory(tmp_path: Path) -> Iterator[Path]:
+    """A directory this user cannot create files in: a 0o500 one for an ordinary user; for
+    root, who may write anywhere permissions say no, procfs's ``/proc/1`` (the kernel refuses
+    new files there to everyone)."""
+    directory = tmp_path / "read-only"
+    directory.mkdir()
+    directory.chmod(0o500)
+    try:
+        if os.access(directory, os.W_OK):
+            proc = Path("/proc/1")
+            if not proc.is_dir() or os.access(proc, os.W_OK):
+                pytest.fail("no directory here refuses new files to this user (root without /proc)")
+            yield proc
+        else:
+            yield directory
+    finally:
+        directory.chmod(0o700)
+
+
+ALLOWED_SKIPS: tuple[str, ...] = ()
+"""Skip reasons (substrings) that CI accepts; .ci/run prints them. Every other skip in CI
+(``RSSTP_FAIL_ON_SKIP=1``) fails the run: a test that never runs does not exist."""
+
+
+def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
+    if os.environ.get("RSSTP_FAIL_ON_SKIP") != "1":
+        return
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    skipped = reporter.stats.get("skipped", []) if reporter is not None else []
+    unexpected = [
+        report
+        for report in skipped
+        if not any(allowed in str(report.longrepr) for allowed in ALLOWED_SKIPS)
+    ]
+    for report in unexpected:
+        reporter.write_line(f"skipped in CI (not allowed): {report.nodeid}: {report.longrepr}")
+    if unexpected:
+        session.exitstatus = pytest.ExitCode.TESTS_FAILED

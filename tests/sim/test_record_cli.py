@@ -91,17 +91,10 @@ def test_existing_output_with_force(tmp_path: Path) -> None:
     assert step_counts(out)["/rsstp/step"] == 11
 
 
-def test_unwritable_output_directory(tmp_path: Path) -> None:
-    directory = tmp_path / "read-only"
-    directory.mkdir()
-    directory.chmod(0o500)
-    try:
-        if os.access(directory, os.W_OK):
-            pytest.skip("running as a user (root) who can write to a 0o500 directory")
-        done = rsstp_record("three-joint", "--steps", "10", "-o", directory / "out.mcap")
-        assert_one_line_error(done, r"read-only is not writable")
-    finally:
-        directory.chmod(0o700)
+def test_unwritable_output_directory(unwritable_directory: Path) -> None:
+    done = rsstp_record("three-joint", "--steps", "10", "-o", unwritable_directory / "out.mcap")
+    assert_one_line_error(done, rf"{re.escape(str(unwritable_directory))} is not writable")
+    assert not (unwritable_directory / "out.mcap").exists()
 
 
 BAD_ARGUMENTS: dict[str, tuple[list[str], str, str]] = {
