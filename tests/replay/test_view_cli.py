@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -61,6 +62,10 @@ def test_view_bad_arguments_are_one_line(args: list[str], message: str, tmp_path
     assert len(done.stderr.strip().splitlines()) == 1 and "Traceback" not in done.stderr
 
 
+@pytest.mark.skipif(
+    shutil.which("dot") is None or shutil.which("neato") is None,
+    reason="Graphviz is not installed (Debian: apt-get install graphviz)",
+)
 def test_graph_draws_the_model_at_a_step(tmp_path: Path) -> None:
     out = tmp_path / "model.svg"
     done = run_cli("graph", str(REFERENCE), "--step", "10", "-o", str(out))
