@@ -28,6 +28,7 @@ from mcap.records import Attachment, Channel, Metadata, Schema
 
 from rsstp_replay._chunks import MESSAGE_TIME, RECORD, chunk_records, message_channels
 from rsstp_replay.errors import CorruptRecording, NotARecording
+from rsstp_sim.files import irregular
 
 __all__ = ["ChunkRef", "Container", "open_container"]
 
@@ -329,6 +330,9 @@ def _stream(body: bytes) -> ReadDataStream:
 
 
 def _open(path: Path) -> BinaryIO:
+    kind = irregular(path)
+    if kind is not None:  # a named pipe would block the reader forever
+        raise NotARecording(f"{path}: {kind}, not a recording (only regular files are read)")
     try:
         return open(path, "rb")  # the caller closes it
     except FileNotFoundError:

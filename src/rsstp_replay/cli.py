@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_sim.commandline import Parser, UsageError, progress, run_command
+from rsstp_sim.files import irregular
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -273,6 +274,9 @@ def _check_output(out: Path, *, force: bool) -> None:
     """One line for an output path we must not or cannot write."""
     if out.is_dir():
         raise UsageError(f"{out}: is a directory, not an output file")
+    kind = irregular(out)
+    if kind is not None:
+        raise UsageError(f"{out}: {kind}: only a regular file is ever written or replaced")
     if out.exists() and not force:
         raise UsageError(f"{out}: already exists (use --force to overwrite)")
     parent = out.parent if str(out.parent) else Path(".")

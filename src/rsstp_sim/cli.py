@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import signal
 import sys
 import time
@@ -18,6 +19,7 @@ from typing import Any
 from rsstp_sim import graph
 from rsstp_sim.commandline import Parser, UsageError, progress, run_command
 from rsstp_sim.coupling import Runner
+from rsstp_sim.errors import RecordingWriteError
 from rsstp_sim.scenario import builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
@@ -25,6 +27,10 @@ from rsstp_sim.transition_system import TransitionSystem
 __all__ = ["main"]
 
 PROG = "rsstp-sim"
+
+
+_JSON_STARTS = frozenset('[{"-0123456789')
+"""A value starting with one of these is JSON or an error; any other text is a string."""
 
 
 def _parse_params(items: Sequence[str]) -> dict[str, Any]:
@@ -36,8 +42,12 @@ def _parse_params(items: Sequence[str]) -> dict[str, Any]:
             raise UsageError(f"--param expects key=value, got {item!r}")
         try:
             params[key] = json.loads(raw)
-        except json.JSONDecodeError:
+        except json.JSONDecodeError as exc:
+            if raw.lstrip()[:1] in _JSON_STARTS:  # meant as JSON: say where it breaks
+                raise UsageError(f"--param {key}: not valid JSON ({exc}): {raw!r}") from None
             params[key] = raw
+        except RecursionError:
+            raise UsageError(f"--param {key}: JSON nested too deeply") from None
     return params
 
 
@@ -85,6 +95,44 @@ def _chunk_size(text: str) -> int:
     return value
 
 
+_MEMORY_BYTES_PER_STEP = 32
+"""What a run's memory holds per step (action, state, sensation, feedback: 21 bytes) with
+the slack of its doubling arrays."""
+_DISK_BYTES_PER_STEP = 16
+"""Fewer bytes than any recording takes per step (the smallest scenarios take about 20)."""
+
+
+def _check_steps_fit(steps: int, output: Path | None = None) -> None:
+    """Refuse at once a run this machine cannot hold: its memory in RAM, its recording on
+    the output's disk."""
+    import shutil
+
+    ram = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    need = steps * _MEMORY_BYTES_PER_STEP
+    if need > ram:
+        raise UsageError(
+            f"--steps {steps:,}: the run's memory needs about {_size(need)}, more than this "
+            f"machine's {_size(ram)} of RAM"
+        )
+    if output is not None:
+        parent = output.parent if str(output.parent) else Path(".")
+        if parent.is_dir() and os.access(parent, os.W_OK):  # else the recorder says why
+            free = shutil.disk_usage(parent).free
+            if steps * _DISK_BYTES_PER_STEP > free:
+                raise UsageError(
+                    f"--steps {steps:,}: the recording needs at least "
+                    f"{_size(steps * _DISK_BYTES_PER_STEP)}; {parent} has {_size(free)} free"
+                )
+
+
+def _size(n_bytes: int) -> str:
+    for unit in ("bytes", "KiB", "MiB", "GiB", "TiB"):
+        if n_bytes < 1024 or unit == "TiB":
+            return f"{n_bytes:,.0f} {unit}" if unit == "bytes" else f"{n_bytes:,.1f} {unit}"
+        n_bytes /= 1024  # type: ignore[assignment]
+    raise AssertionError("unreachable")
+
+
 def _runner(args: argparse.Namespace) -> Runner:
     scenario = load_scenario(args.scenario)
     strategy = make_strategy(args.strategy, _parse_params(args.param))
@@ -114,6 +162,7 @@ def _cmd_strategies(args: argparse.Namespace) -> int:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
+    _check_steps_fit(args.steps)
     runner = _runner(args)
     started = time.perf_counter()
     with progress(args.steps, "running", quiet=args.quiet) as bar:
@@ -155,6 +204,7 @@ def _cmd_graph(args: argparse.Namespace) -> int:
 def _cmd_record(args: argparse.Namespace) -> int:
     from rsstp_sim.recording.recorder import Recorder
 
+    _check_steps_fit(args.steps, Path(args.output))
     scenario = load_scenario(args.scenario)
     strategy = make_strategy(args.strategy, _parse_params(args.param))
     recorder = Recorder(
@@ -175,6 +225,9 @@ def _cmd_record(args: argparse.Namespace) -> int:
     try:
         with progress(args.steps, "recording", quiet=args.quiet) as bar:
             result = recorder.run(args.steps, progress=bar.to)
+    except RecordingWriteError as exc:  # the disk failed, not the input: exit 1
+        print(f"{PROG}: error: {exc}", file=sys.stderr)
+        return 1
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)

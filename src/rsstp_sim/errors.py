@@ -11,6 +11,7 @@ __all__ = [
     "GraphvizFailed",
     "GraphvizMissing",
     "RecordingError",
+    "RecordingWriteError",
     "ActionError",
 ]
 
@@ -45,6 +46,16 @@ class GraphvizFailed(RsstpError):
 
 class RecordingError(RsstpError):
     """A recording cannot be written (existing output, unwritable directory, ...)."""
+
+
+class RecordingWriteError(RecordingError):
+    """Writing a recording failed part way (a full disk, a file-size limit, an I/O error);
+    ``safe_steps`` are in complete chunks of the side file, which a reader recovers."""
+
+    def __init__(self, message: str, *, safe_steps: int, side_file: str) -> None:
+        super().__init__(message)
+        self.safe_steps = safe_steps
+        self.side_file = side_file
 
 
 class ActionError(RsstpError):

@@ -35,6 +35,7 @@ from typing import Literal
 
 from rsstp_sim import geometry
 from rsstp_sim.errors import ScenarioError
+from rsstp_sim.files import irregular
 
 __all__ = [
     "Obstacle",
@@ -127,6 +128,9 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
         raise ScenarioError(
             f"{text_name}: no such scenario file, and not a built-in scenario ({known})"
         )
+    kind = irregular(path)
+    if kind is not None:
+        raise ScenarioError(f"{path}: {kind}, not a scenario file (only regular files are read)")
     try:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:

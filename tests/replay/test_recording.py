@@ -367,20 +367,22 @@ def test_a_truncated_recording_is_read_up_to_its_last_complete_chunk(
 
 def test_a_killed_writer_leaves_a_readable_recording(tmp_path: Path) -> None:
     path = tmp_path / "killed.mcap"
+    side = tmp_path / "killed.mcap.partial"  # where it is written until it is finished
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     command = [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--steps", "10000000"]
     command += ["--seed", "3", "--chunk-size", "4096", "-o", str(path)]
     process = subprocess.Popen(command, env=env, stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 30
-        while (not path.exists() or path.stat().st_size < 60_000) and time.monotonic() < deadline:
+        while (not side.exists() or side.stat().st_size < 60_000) and time.monotonic() < deadline:
             time.sleep(0.02)
     finally:
         process.send_signal(signal.SIGKILL)
         process.wait()
     assert process.returncode == -signal.SIGKILL
-    with pytest.warns(UnfinishedRecordingWarning, match="killed.mcap: the file was not finished"):
-        recording = open_recording(path)
+    assert not path.exists()
+    with pytest.warns(UnfinishedRecordingWarning, match="killed.mcap.partial: the file was not"):
+        recording = open_recording(side)
     n = recording.n_steps
     assert n > 0
     runner = Runner(load_scenario("three-joint"), make_strategy("random"), seed=3)

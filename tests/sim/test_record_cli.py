@@ -217,13 +217,19 @@ def start_long_recording(out: Path) -> subprocess.Popen[str]:
     )
 
 
+def side(out: Path) -> Path:
+    """Where a recording of ``out`` is written until it is finished."""
+    return out.with_name(f"{out.name}.partial")
+
+
 def wait_for_chunks(proc: subprocess.Popen[str], out: Path, *, min_bytes: int) -> None:
-    """Poll until ``out`` is bigger than ``min_bytes`` (several complete chunks)."""
+    """Poll until the side file of ``out`` is bigger than ``min_bytes`` (several complete
+    chunks)."""
     deadline = time.monotonic() + TIMEOUT_S
     while time.monotonic() < deadline:
         if proc.poll() is not None:
             pytest.fail(f"the recording ended early: {proc.returncode} {proc.communicate()}")
-        if out.exists() and out.stat().st_size > min_bytes:
+        if side(out).exists() and side(out).stat().st_size > min_bytes:
             return
         time.sleep(0.02)
     pytest.fail(f"{out} did not grow past {min_bytes} bytes in {TIMEOUT_S} s")
@@ -325,11 +331,12 @@ def test_sigkill_keeps_every_complete_chunk(tmp_path: Path) -> None:
             proc.kill()
             proc.communicate()
     assert proc.returncode == -signal.SIGKILL
-    data = out.read_bytes()
+    assert not out.exists()  # nothing unfinished ever has the output's name
+    data = side(out).read_bytes()
 
     # Not finished: no footer, no summary for a seeking reader.
     assert not data.endswith(MCAP_MAGIC)
-    with out.open("rb") as stream, pytest.raises((McapError, struct.error)):
+    with side(out).open("rb") as stream, pytest.raises((McapError, struct.error)):
         make_reader(stream).get_summary()
 
     messages, steps_per_chunk, end, footer = read_sequentially(data)
@@ -344,3 +351,129 @@ def test_sigkill_keeps_every_complete_chunk(tmp_path: Path) -> None:
     # on a record boundary. (That no completed chunk waits in a user-space buffer is checked
     # in-process by test_recorder.py::test_completed_chunks_are_on_disk_during_the_run.)
     assert end == len(data), f"{len(data) - end} bytes of a partial record at the end"
+
+
+# -- nothing lost, nothing corrupt ----------------------------------------------------------
+
+
+def test_force_keeps_the_old_recording_until_the_new_one_is_whole(tmp_path: Path) -> None:
+    out = tmp_path / "run.mcap"
+    assert rsstp_record("thesis-roulette", "--steps", "20", "-o", out).returncode == 0
+    old = out.read_bytes()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--steps", "2000000",
+         "-o", str(out), "--chunk-size", str(CHUNK_SIZE), "--force"],
+        env=cli_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    try:
+        wait_for_chunks(proc, out, min_bytes=2 * CHUNK_SIZE)
+        proc.kill()  # right in the middle of replacing it
+        proc.communicate(timeout=TIMEOUT_S)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.communicate()
+    assert out.read_bytes() == old  # the old recording is untouched
+    assert side(out).stat().st_size > 2 * CHUNK_SIZE  # the killed run's chunks are kept
+    out.rename(tmp_path / "old.mcap")
+    again = rsstp_record("thesis-roulette", "--steps", "20", "-o", out)
+    assert_one_line_error(again, r"run.mcap.partial: left by an interrupted recording")
+    forced = rsstp_record("thesis-roulette", "--steps", "20", "-o", out, "--force")
+    assert forced.returncode == 0, forced.stderr
+    assert out.read_bytes() == old and not side(out).exists()  # same run, same bytes
+
+
+def test_a_second_writer_on_the_same_output_is_refused(tmp_path: Path) -> None:
+    out = tmp_path / "run.mcap"
+    first = start_long_recording(out)
+    try:
+        wait_for_chunks(first, out, min_bytes=CHUNK_SIZE)
+        second = rsstp_record("thesis-roulette", "--steps", "20", "-o", out, "--force")
+        assert_one_line_error(second, r"another recording is being written there")
+        first.send_signal(signal.SIGINT)
+        first.communicate(timeout=TIMEOUT_S)
+    finally:
+        if first.poll() is None:
+            first.kill()
+            first.communicate()
+    assert first.returncode == 128 + signal.SIGINT
+    assert out.read_bytes().endswith(MCAP_MAGIC) and not side(out).exists()
+
+
+def test_a_file_size_limit_is_one_line_saying_what_is_safe(tmp_path: Path) -> None:
+    """EFBIG (RLIMIT_FSIZE in the child): exit 1, one line; the side file holds the steps it
+    names, and a reader recovers exactly those."""
+    import resource
+
+    out = tmp_path / "run.mcap"
+    limit = 200_000
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--steps", "50000",
+         "-o", str(out)],
+        env=cli_env(), capture_output=True, text=True, timeout=TIMEOUT_S, preexec_fn=small_files,
+    )  # fmt: skip
+    assert done.returncode == 1, done.stderr
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1 and "File too large" in lines[0], done.stderr
+    safe = int(re.search(r"steps 1 to ([\d,]+) are safe", lines[0])[1].replace(",", ""))
+    assert not out.exists()
+    from rsstp_replay import open_recording
+
+    with pytest.warns(UserWarning, match="not finished"), open_recording(side(out)) as rec:
+        assert rec.n_steps == safe > 0
+
+
+def test_a_full_disk_is_one_line_saying_what_is_safe(tmp_path: Path) -> None:
+    """ENOSPC on a real 512 KiB tmpfs (mounting needs root: CI runs as root)."""
+    if os.geteuid() != 0:
+        pytest.skip("needs root to mount a small tmpfs (CI runs as root)")
+    disk = tmp_path / "disk"
+    disk.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=512k", "tmpfs", str(disk)])
+    if mounted.returncode != 0:
+        pytest.skip("this machine refuses to mount a tmpfs")
+    try:
+        out = disk / "run.mcap"
+        done = rsstp_record("three-joint", "--steps", "30000", "-o", out)
+        assert done.returncode == 1, done.stderr
+        assert "No space left on device; steps 1 to " in done.stderr
+        assert len(done.stderr.splitlines()) == 1 and not out.exists()
+        assert side(out).exists()
+    finally:
+        subprocess.run(["umount", str(disk)], check=True)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--steps", "10", "-o", "/dev/null", "--force"], r"/dev/null: a character device"),
+        (["--steps", str(10**13), "-o", "{tmp}/x.mcap"], r"--steps .*more than this machine"),
+        (["--param", "actions=[0,", "--strategy", "script", "--steps", "5", "-o", "{tmp}/x.mcap"],
+         r"--param actions: not valid JSON"),
+    ],
+)  # fmt: skip
+def test_extreme_or_malformed_input_is_refused_up_front(
+    args: list[str], message: str, tmp_path: Path
+) -> None:
+    done = rsstp_record("thesis-roulette", *(a.format(tmp=tmp_path) for a in args))
+    assert_one_line_error(done, message)
+    assert not (tmp_path / "x.mcap").exists() and not list(tmp_path.glob("*.partial"))
+
+
+def test_a_named_pipe_is_refused_not_waited_on(tmp_path: Path) -> None:
+    pipe = tmp_path / "scenario.toml"
+    os.mkfifo(pipe)
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_sim", "run", str(pipe), "--steps", "3"],
+        env=cli_env(), capture_output=True, text=True, timeout=30,
+    )  # fmt: skip
+    assert_one_line_error(done, r"scenario.toml: a named pipe, not a scenario file")
+    replay = subprocess.run(
+        [sys.executable, "-m", "rsstp_replay", "info", str(pipe)],
+        env=cli_env(), capture_output=True, text=True, timeout=30,
+    )  # fmt: skip
+    assert replay.returncode == 2 and "a named pipe, not a recording" in replay.stderr

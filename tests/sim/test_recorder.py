@@ -603,8 +603,8 @@ def test_completed_chunks_are_on_disk_during_the_run(tmp_path: Path) -> None:
     recorder = make_recorder(path, "two-joint-30", chunk_size=4096)
     seen: list[tuple[int, list[int], int]] = []
 
-    def progress(done: int) -> None:
-        seen.append((done, *recovered_steps(path.read_bytes())))
+    def progress(done: int) -> None:  # the side file, where it is written until finished
+        seen.append((done, *recovered_steps(recorder.side_file.read_bytes())))
 
     recorder.run(4 * 4096, progress=progress)
     assert [done for done, _, _ in seen] == [4096, 8192, 12288, 16384]

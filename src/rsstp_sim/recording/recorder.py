@@ -14,15 +14,21 @@ runner's callbacks and writes:
 ``log_time`` of step ``t`` is ``t * 1_000_000`` ns; no wall-clock time is
 written, so the same scenario, strategy and seed give the same bytes.
 
-Crash safety: the file is written without a user-space buffer, so every chunk
-the writer completes is on disk at once; after a SIGKILL all complete chunks
-can be recovered by a sequential reader. :meth:`Recorder.request_stop` (what
-the CLI's SIGINT/SIGTERM handlers call) ends the run after the current step and
-the file is finished properly.
+Crash safety: the recording is written to a side file, ``<name>.partial`` beside the
+output, and renamed onto the output only when finished: an existing recording (``force``)
+survives until the new one is whole, and nothing half written ever has the output's name.
+The side file holds an exclusive lock while it is written, so a second recorder on the same
+output is refused. It is written without a user-space buffer, so every chunk the writer
+completes is on disk at once; after a SIGKILL, a full disk or a file-size limit, the side
+file stays and a sequential reader recovers all its complete chunks (a later recorder
+refuses to replace it without ``force``). :meth:`Recorder.request_stop` (what the CLI's
+SIGINT/SIGTERM handlers call) ends the run after the current step and the file is finished
+properly.
 """
 
 from __future__ import annotations
 
+import fcntl
 import io
 import json
 import os
@@ -36,7 +42,8 @@ import msgspec
 from mcap.writer import CompressionType, Writer
 
 from rsstp_sim.coupling import Event, Runner, StepOutcome
-from rsstp_sim.errors import RecordingError
+from rsstp_sim.errors import RecordingError, RecordingWriteError
+from rsstp_sim.files import irregular
 from rsstp_sim.recording import records
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_MEDIA_TYPE,
@@ -98,19 +105,30 @@ class _UnbufferedFile:
     """A write-through file for the MCAP writer: each completed chunk reaches the OS at once.
 
     (The writer would wrap a raw file in a ``BufferedWriter``, which could keep
-    the tail of a chunk in memory when the process is killed.)
+    the tail of a chunk in memory when the process is killed.) ``safe_steps`` is the last
+    step whose messages are all in complete chunks, as of the last write (the writer writes
+    only when a chunk is complete): what a reader recovers from the file as it stands.
     """
 
-    def __init__(self, raw: io.FileIO) -> None:
+    def __init__(self, raw: io.FileIO, steps_done: Callable[[], int]) -> None:
         self._raw = raw
+        self._steps_done = steps_done
+        self.safe_steps = 0
+        self.error: OSError | None = None  # the write error, told apart from other OSErrors
 
     def write(self, data: bytes | bytearray | memoryview) -> int:
         view = memoryview(data)
         while view:
-            written = self._raw.write(view)
+            try:
+                written = self._raw.write(view)
+            except OSError as exc:
+                self.error = exc
+                raise
             if written is None:  # pragma: no cover - only for non-blocking files
                 continue
             view = view[written:]
+        if data:  # the step being written may have messages after this chunk: not counted
+            self.safe_steps = max(0, self._steps_done() - 1)
         return len(data)
 
     def tell(self) -> int:
@@ -123,11 +141,23 @@ class _UnbufferedFile:
         self._raw.close()
 
 
+def side_file(path: Path) -> Path:
+    """Where a recording of ``path`` is written until it is finished."""
+    return path.with_name(f"{path.name}.partial")
+
+
 def _open_output(path: Path, *, force: bool) -> io.FileIO:
-    """Open ``path`` for writing, refusing to overwrite without ``force``."""
+    """Open the side file of ``path`` for writing, locked; refuse what must not be replaced."""
     parent = path.parent if str(path.parent) else Path(".")
     if path.is_dir():
         raise RecordingError(f"{path}: is a directory, not an output file")
+    partial = side_file(path)
+    for checked in (path, partial):
+        kind = irregular(checked)
+        if kind is not None:
+            raise RecordingError(
+                f"{checked}: {kind}: only a regular file is ever written or replaced"
+            )
     if not parent.is_dir():
         found = "is not a directory" if parent.exists() else "does not exist"
         raise RecordingError(f"{path}: the output directory {parent} {found}")
@@ -136,11 +166,27 @@ def _open_output(path: Path, *, force: bool) -> io.FileIO:
     if path.exists() and not force:
         raise RecordingError(f"{path}: already exists (use --force to overwrite)")
     try:
-        return io.FileIO(path, "wb" if force else "xb")
-    except FileExistsError:
-        raise RecordingError(f"{path}: already exists (use --force to overwrite)") from None
+        fd = os.open(partial, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
     except OSError as exc:
         raise RecordingError(f"{path}: cannot open for writing: {exc.strerror or exc}") from None
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            raise RecordingError(
+                f"{path}: another recording is being written there (its side file "
+                f"{partial.name} is locked)"
+            ) from None
+        if os.fstat(fd).st_size and not force:
+            raise RecordingError(
+                f"{partial}: left by an interrupted recording; read it with rsstp-replay, "
+                "move it away, or use --force to replace it"
+            )
+        os.ftruncate(fd, 0)
+        return io.FileIO(fd, "w", closefd=True)
+    except BaseException:
+        os.close(fd)
+        raise
 
 
 class Recorder:
@@ -182,8 +228,9 @@ class Recorder:
         self._stop = False
         self._pose_parts: dict[int, tuple[bytes, bytes]] = {}
         self._counts = dict.fromkeys(TOPICS, 0)
+        self.side_file = side_file(self.path)
         self._raw = _open_output(self.path, force=force)
-        self._file = _UnbufferedFile(self._raw)
+        self._file = _UnbufferedFile(self._raw, lambda: self.runner.step_index)
         self._writer = Writer(
             self._file,  # type: ignore[arg-type]
             chunk_size=chunk_size,
@@ -192,6 +239,11 @@ class Recorder:
         self._closed = False
         try:
             self._write_header(scenario, strategy, seed)
+        except OSError as exc:
+            self._abort()
+            raise RecordingError(
+                f"{self.side_file}: cannot write: {exc.strerror or exc}; nothing recorded"
+            ) from None
         except BaseException:
             self._abort()
             raise
@@ -370,6 +422,12 @@ class Recorder:
                 done += 1
                 if progress is not None and not done & 4095:
                     progress(done)
+        except OSError as exc:
+            self._counts["/rsstp/step"] += done
+            if exc is self._file.error:  # the disk, not the run: the side file keeps its chunks
+                raise self._write_failed(exc) from None
+            self.close()
+            raise
         except BaseException:
             self._counts["/rsstp/step"] += done
             self.close()
@@ -379,19 +437,48 @@ class Recorder:
         return RecordResult(self.path, runner.step_index, dict(self._counts), self._stop)
 
     def close(self) -> None:
-        """Finish the file (summary and indexes) and close it; idempotent."""
+        """Finish the file (summary and indexes) and rename it onto the output; idempotent.
+        A write error leaves the side file (its complete chunks readable) and raises
+        :class:`~rsstp_sim.errors.RecordingWriteError`."""
         if self._closed:
             return
-        self._closed = True
         try:
             self._writer.finish()  # type: ignore[no-untyped-call]
+        except OSError as exc:
+            if exc is not self._file.error:
+                self._closed = True
+                self._file.close()
+                raise
+            raise self._write_failed(exc) from None
+        except BaseException:
+            self._closed = True
+            self._file.close()
+            raise
+        self._closed = True
+        try:
+            os.replace(self.side_file, self.path)  # still locked: nobody can take the file
         finally:
             self._file.close()
+
+    def _write_failed(self, exc: OSError) -> RecordingWriteError:
+        """Close the side file as it is (no summary can be written) and say what is safe."""
+        self._closed = True
+        try:
+            self._file.close()
+        except OSError:
+            pass
+        safe = self._file.safe_steps
+        return RecordingWriteError(
+            f"{self.side_file}: cannot write: {exc.strerror or exc}; steps 1 to {safe:,} "
+            f"are safe in it (rsstp-replay reads them); {self.path} was not touched",
+            safe_steps=safe,
+            side_file=str(self.side_file),
+        )
 
     def _abort(self) -> None:
         self._closed = True
         self._file.close()
-        self.path.unlink(missing_ok=True)
+        self.side_file.unlink(missing_ok=True)  # ours: the lock was held from its creation
 
     @property
     def counts(self) -> Mapping[str, int]:
