@@ -472,6 +472,9 @@ def _build_parser() -> Parser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point; returns the exit code (0 ok, 1 an audit failed, 2 bad input)."""
+    # Rerun's native logs (gRPC retries, its file writer's errors) would add lines of their
+    # own to ours; they stay off unless the user sets RUST_LOG.
+    os.environ.setdefault("RUST_LOG", "off")
     return run_command(PROG, _build_parser(), argv)
 
 

@@ -19,6 +19,7 @@ spawned) is reported as a :class:`ViewerWarning` and the rest is still shown. Ba
 from __future__ import annotations
 
 import bisect
+import os
 import tempfile
 import time
 import uuid
@@ -210,11 +211,15 @@ def view(
         if save is None:
             folder = tempfile.TemporaryDirectory(prefix="rsstp-view-")
     target = save if folder is None else Path(folder.name) / "view.rrd"
+    # The .rrd is written to a side file and renamed onto ``target`` only when whole: a full
+    # disk or a file-size limit never leaves a truncated file under the name, nor destroys
+    # the file that was there.
+    writing = None if target is None else target.with_name(f"{target.name}.partial")
     loaded = _load(recording)
     stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     sinks: list[rr.FileSink | rr.GrpcSink] = []
-    if target is not None:
-        sinks.append(rr.FileSink(target))
+    if writing is not None:
+        sinks.append(rr.FileSink(writing))
     spawned = False
     if spawn:
         try:
@@ -230,10 +235,19 @@ def view(
     began = time.perf_counter()
     try:
         stream.flush()
-    except RuntimeError as exc:  # a spawned viewer that never listened: the file is still whole
+    except RuntimeError as exc:
+        if writing is not None and not spawned:  # only the file sink can have failed
+            stream.disconnect()
+            writing.unlink(missing_ok=True)
+            if folder is not None:
+                folder.cleanup()
+            raise ReplayError(f"{target}: cannot write the .rrd: {exc}") from None
+        # A spawned viewer that never listened (the file, if any, is checked below).
         warnings.warn(ViewerWarning(f"the Rerun viewer could not be reached: {exc}"), stacklevel=2)
         spawned = False
     stream.disconnect()  # finishes the file (its footer) and the connection
+    if writing is not None and target is not None:
+        _finish_rrd(writing, target, folder)
     seconds = summary.seconds_rerun + time.perf_counter() - began
     server = None
     if serve_web:
@@ -253,6 +267,36 @@ def view(
         _server=server,
         _folder=folder,
     )
+
+
+def _finish_rrd(
+    writing: Path, target: Path, folder: tempfile.TemporaryDirectory[str] | None
+) -> None:
+    """Rename the finished side file onto ``target``, once Rerun's file writer has closed it
+    whole (its end-of-stream footer written); else remove it and say why."""
+    try:
+        whole = writing.stat().st_size > 0 and _has_rrd_end(writing)
+    except OSError:
+        whole = False
+    if not whole:
+        writing.unlink(missing_ok=True)
+        if folder is not None:
+            folder.cleanup()
+        raise ReplayError(
+            f"{target}: cannot write the .rrd: Rerun's file writer did not finish it "
+            "(a full disk or a file-size limit?)"
+        )
+    os.replace(writing, target)
+
+
+_RRD_FOOTER = b"RRF2FOOT"
+"""How a whole .rrd of rerun-sdk 0.41 ends: its stream footer's magic, then 4 bytes."""
+
+
+def _has_rrd_end(path: Path) -> bool:
+    with path.open("rb") as file:
+        file.seek(max(0, path.stat().st_size - 64))
+        return _RRD_FOOTER in file.read()
 
 
 def log_recording(

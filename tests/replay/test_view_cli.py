@@ -211,3 +211,29 @@ def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(tmp_path: Path) -> No
     assert "Traceback" not in err
     assert not list(tmp_path.glob("rsstp-view-*"))
     assert not _listening(web)
+
+
+def test_a_file_size_limit_never_leaves_a_truncated_rrd(tmp_path: Path) -> None:
+    """EFBIG while saving (RLIMIT_FSIZE in the child): one line, exit 2, and the .rrd that
+    was there is untouched; no side file stays."""
+    import resource
+
+    out = tmp_path / "run.rrd"
+    first = run_cli("view", str(REFERENCE), "--save", str(out))
+    assert first.returncode == 0, first.stderr
+    before = out.read_bytes()
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))
+
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_replay", "view", str(LEARNER), "--save", str(out),
+         "--force", "--quiet"],
+        capture_output=True, text=True, timeout=120, preexec_fn=small_files,
+        env={"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "HOME": "/tmp"},
+    )  # fmt: skip
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and "cannot write the .rrd" in lines[0], done.stderr
+    assert out.read_bytes() == before
+    assert [p.name for p in tmp_path.iterdir()] == ["run.rrd"]
