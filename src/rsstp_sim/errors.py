@@ -10,6 +10,7 @@ __all__ = [
     "StrategyError",
     "GraphvizFailed",
     "GraphvizMissing",
+    "OutputError",
     "RecordingError",
     "RecordingWriteError",
     "ActionError",
@@ -34,6 +35,10 @@ class MemoryRangeError(RsstpError):
 
 class StrategyError(RsstpError):
     """A strategy name is unknown, its parameters are invalid, or it returned an invalid action."""
+
+
+class OutputError(RsstpError):
+    """An output file could not be written whole (a full disk, a file-size limit, ...)."""
 
 
 class GraphvizMissing(RsstpError):

@@ -1,4 +1,4 @@
-"""Only regular files: what this project reads, and what it ever replaces.
+"""Only regular files, written whole: what this project reads, and how it replaces a file.
 
 A named pipe given as a scenario or a recording would block a reader forever, and a device
 given as an output would be truncated or deleted on failure. Every path a command opens is
@@ -11,7 +11,9 @@ import os
 import stat
 from pathlib import Path
 
-__all__ = ["irregular"]
+from rsstp_sim.errors import OutputError
+
+__all__ = ["irregular", "write_whole"]
 
 
 def irregular(path: str | os.PathLike[str]) -> str | None:
@@ -33,3 +35,21 @@ def irregular(path: str | os.PathLike[str]) -> str | None:
     if stat.S_ISSOCK(mode):
         return "a socket"
     return "not a regular file"
+
+
+def write_whole(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` to ``path`` through a side file renamed into place: a reader never sees
+    a part, and a failed write (a full disk) leaves what was at ``path`` as it was.
+    :class:`~rsstp_sim.errors.OutputError` says what failed, in one line."""
+    out = Path(path)
+    kind = irregular(out)
+    if kind is not None:
+        raise OutputError(f"{out}: {kind}: only a regular file is ever written or replaced")
+    side = out.with_name(f"{out.name}.partial")
+    try:
+        side.write_bytes(data)
+        os.replace(side, out)
+    except OSError as exc:
+        side.unlink(missing_ok=True)
+        raise OutputError(f"{out}: cannot write: {exc.strerror or exc}") from None
+    return out

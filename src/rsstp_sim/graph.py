@@ -30,6 +30,7 @@ from pathlib import Path
 import graphviz
 
 from rsstp_sim.errors import GraphvizFailed, GraphvizMissing, ModelError, RsstpError
+from rsstp_sim.files import write_whole
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["graphviz_failed", "layout", "plain_positions", "render", "run_graphviz", "to_dot"]
@@ -167,14 +168,12 @@ def render(
         )
     source = to_dot(model, current=current, positions=positions)
     if fmt in _SOURCE_FORMATS:
-        out.write_text(source, encoding="utf-8")
-        return out
+        return write_whole(out, source.encode("utf-8"))
     if positions is None:
         data = run_graphviz("dot", source, [f"-T{fmt}"], what=_describe(model))
     else:
         data = run_graphviz("neato", source, ["-n2", f"-T{fmt}"], what=_describe(model))
-    out.write_bytes(data)
-    return out
+    return write_whole(out, data)
 
 
 def graphviz_failed(

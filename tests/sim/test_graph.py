@@ -173,3 +173,27 @@ def test_a_program_that_dies_before_reading_is_one_error(
     with pytest.raises(GraphvizFailed, match=r"crashed \(SIGSEGV\) drawing a model of 3000 states"):
         render(big, out, positions=places)
     assert not out.exists()
+
+
+def test_a_picture_that_cannot_be_written_whole_leaves_the_old_one(tmp_path: Path) -> None:
+    """EFBIG (RLIMIT_FSIZE in the child) while writing: one line, exit 2, the old file as it
+    was and no side file."""
+    import resource
+    import subprocess
+    import sys
+
+    out = tmp_path / "model.dot"
+    out.write_text("the old picture")
+
+    def tiny_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20, 20))
+
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_sim", "graph", "--matrix", "[[[0],[1]],[[1],[0]]]",
+         "-o", str(out), "--force"],
+        capture_output=True, text=True, timeout=60, preexec_fn=tiny_files,
+    )  # fmt: skip
+    assert done.returncode == 2
+    assert done.stderr.strip() == f"rsstp-sim: error: {out}: cannot write: File too large"
+    assert out.read_text() == "the old picture"
+    assert [p.name for p in tmp_path.iterdir()] == ["model.dot"]
