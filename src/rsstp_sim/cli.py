@@ -20,7 +20,7 @@ from rsstp_sim import graph
 from rsstp_sim.commandline import Parser, UsageError, progress, run_command
 from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import RecordingWriteError
-from rsstp_sim.scenario import builtin_scenarios, load_scenario
+from rsstp_sim.scenario import Scenario, builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -133,8 +133,21 @@ def _size(n_bytes: int) -> str:
     raise AssertionError("unreachable")
 
 
+def _warn_if_unsensable(scenario: Scenario) -> None:
+    from rsstp_sim.world_table import unsensable
+
+    problem = unsensable(scenario)
+    if problem is not None:
+        print(
+            f"{PROG}: warning: no pose can sense the feedback point, every sensation will be "
+            f"false: {problem}",
+            file=sys.stderr,
+        )
+
+
 def _runner(args: argparse.Namespace) -> Runner:
     scenario = load_scenario(args.scenario)
+    _warn_if_unsensable(scenario)
     strategy = make_strategy(args.strategy, _parse_params(args.param))
     return Runner(scenario, strategy, seed=args.seed)
 
@@ -206,6 +219,7 @@ def _cmd_record(args: argparse.Namespace) -> int:
 
     _check_steps_fit(args.steps, Path(args.output))
     scenario = load_scenario(args.scenario)
+    _warn_if_unsensable(scenario)
     strategy = make_strategy(args.strategy, _parse_params(args.param))
     recorder = Recorder(
         args.output,
@@ -247,7 +261,9 @@ def _cmd_record(args: argparse.Namespace) -> int:
 def _cmd_truth(args: argparse.Namespace) -> int:
     from rsstp_sim.truth import compute_truth, format_truth
 
-    truth = compute_truth(load_scenario(args.scenario), max_poses=args.max_poses)
+    scenario = load_scenario(args.scenario)
+    _warn_if_unsensable(scenario)
+    truth = compute_truth(scenario, max_poses=args.max_poses)
     if args.json:
         print(json.dumps(truth.to_json(), indent=2))
     else:

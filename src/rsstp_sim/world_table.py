@@ -38,7 +38,14 @@ from rsstp_sim import geometry
 from rsstp_sim.geometry import ArmGeometry, FloatArray, IntArray
 from rsstp_sim.scenario import Scenario
 
-__all__ = ["DENSE_LIMIT", "PoseBlock", "WorldTable", "lattice_sizes", "pose_space_size"]
+__all__ = [
+    "DENSE_LIMIT",
+    "PoseBlock",
+    "WorldTable",
+    "lattice_sizes",
+    "pose_space_size",
+    "unsensable",
+]
 
 BoolArray = NDArray[np.bool_]
 Int32Array = NDArray[np.int32]
@@ -55,6 +62,54 @@ def lattice_sizes(scenario: Scenario) -> list[int]:
     values = 360 // math.gcd(scenario.step_deg, 360)
     moving = {a // 2 for a in scenario.actions}
     return [values if k in moving else 1 for k in range(scenario.n_joints)]
+
+
+def unsensable(scenario: Scenario) -> str | None:
+    """Why no pose of the arm can sense its feedback point, when a look at the one pose that
+    could tells (the ground truth then counts the reachable poses that sense it): the points
+    out of the links' reach, the pose off the arm's lattice, or the pose itself blocked.
+    None when that pose exists and is valid (it may still be unreachable behind obstacles)."""
+    lengths = np.asarray(scenario.lengths, dtype=np.float64)
+    points = np.asarray(scenario.feedback_points, dtype=np.float64)
+    tolerance = scenario.tolerance * scenario.total_length
+    initial = np.asarray(scenario.initial_deg, dtype=np.int64)
+    spacing = math.gcd(scenario.step_deg, 360)
+    fixed = np.asarray(lattice_sizes(scenario)) == 1
+    if scenario.feedback_target_deg is not None:
+        pose = np.asarray(scenario.feedback_target_deg, dtype=np.int64)
+        off = (fixed & (pose != initial)) | ((pose - initial) % spacing != 0)
+        if off.any():
+            return (
+                f"the target pose {pose.tolist()} is not on the arm's lattice (from "
+                f"{initial.tolist()} in {scenario.step_deg}-degree steps, joints "
+                f"{np.flatnonzero(fixed).tolist()} never turning)"
+            )
+    else:
+        links = np.diff(np.vstack([[0.0, 0.0], points]), axis=0)
+        gaps = np.abs(np.hypot(links[:, 0], links[:, 1]) - lengths)
+        if (gaps > 2 * tolerance).any():
+            k = int(np.argmax(gaps))
+            return (
+                f"feedback point {k} is {gaps[k]:.3g} from every place link {k}'s tip can be "
+                f"(tolerance {tolerance:.3g})"
+            )
+        absolute = np.degrees(np.arctan2(links[:, 1], links[:, 0]))
+        relative = np.diff(np.concatenate([[0.0], absolute]))
+        steps = np.where(fixed, 0, np.round((relative - initial) / spacing))
+        pose = (initial + steps.astype(np.int64) * spacing) % 360
+        tips = geometry.joint_positions(pose, lengths)[1:]
+        miss = float(np.hypot(*(tips - points).T).max())
+        if miss > tolerance:
+            return (
+                f"no pose on the arm's {scenario.step_deg}-degree lattice puts the tips on the "
+                f"feedback points (the nearest, {pose.tolist()}, misses by {miss:.3g}; "
+                f"tolerance {tolerance:.3g})"
+            )
+    code = int(geometry.pose_blockers(ArmGeometry.from_scenario(scenario), [pose])[0])
+    blocker = ArmGeometry.from_scenario(scenario).decode(code)
+    if blocker is not None:
+        return f"the pose at the feedback point, {pose.tolist()}, is blocked: {blocker.describe()}"
+    return None
 
 
 def pose_space_size(scenario: Scenario) -> int:
