@@ -29,7 +29,8 @@ def test_both_commands_print_the_installed_version(program: str) -> None:
 
 
 def test_the_licence_file_is_the_declared_one() -> None:
-    assert PYPROJECT["project"]["license"] == {"text": "MIT"}
+    assert PYPROJECT["project"]["license"] == "MIT"
+    assert PYPROJECT["project"]["license-files"] == ["LICENSE"]
     assert (ROOT / "LICENSE").read_text().startswith("MIT License")
 
 
