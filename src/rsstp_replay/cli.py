@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_sim.commandline import Parser, UsageError, progress, run_command
-from rsstp_sim.files import irregular
+from rsstp_sim.files import irregular, written_whole
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -119,21 +119,16 @@ def _check_table_output(out: Path, *, force: bool) -> None:
 
 
 def _write_table(table: pd.DataFrame, out: Path) -> None:
-    """Write ``table`` (Parquet or CSV by the suffix) to a side file, then rename it into
-    place: a failed write leaves no partial table and the old one untouched."""
-    partial = out.with_name(f".{out.name}.partial")
-    try:
+    """Write ``table`` (Parquet or CSV by the suffix) whole: a failed write leaves no partial
+    table and the old one untouched."""
+    with written_whole(out) as side:
         if out.suffix.lower() == ".parquet":
             import pyarrow as pa
             import pyarrow.parquet as pq
 
-            pq.write_table(pa.Table.from_pandas(table, preserve_index=False), partial)
+            pq.write_table(pa.Table.from_pandas(table, preserve_index=False), side)
         else:
-            table.to_csv(partial, index=False)
-        os.replace(partial, out)
-    except OSError as exc:
-        partial.unlink(missing_ok=True)
-        raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
+            table.to_csv(side, index=False)
     print(f"wrote {len(table):,} rows and {len(table.columns)} columns to {out}")
 
 

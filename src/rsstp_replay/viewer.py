@@ -45,6 +45,7 @@ from rsstp_replay.audits.determinism import DeterminismFindings, audit_determini
 from rsstp_replay.errors import ReplayError, StepOutOfRange
 from rsstp_sim import graph
 from rsstp_sim.errors import RsstpError
+from rsstp_sim.files import side_file
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
@@ -214,7 +215,7 @@ def view(
     # The .rrd is written to a side file and renamed onto ``target`` only when whole: a full
     # disk or a file-size limit never leaves a truncated file under the name, nor destroys
     # the file that was there.
-    writing = None if target is None else target.with_name(f"{target.name}.partial")
+    writing = None if target is None else side_file(target)
     loaded = _load(recording)
     stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
     sinks: list[rr.FileSink | rr.GrpcSink] = []

@@ -126,11 +126,10 @@ def _check_steps_fit(steps: int, output: Path | None = None) -> None:
 
 
 def _size(n_bytes: int) -> str:
-    for unit in ("bytes", "KiB", "MiB", "GiB", "TiB"):
-        if n_bytes < 1024 or unit == "TiB":
-            return f"{n_bytes:,.0f} {unit}" if unit == "bytes" else f"{n_bytes:,.1f} {unit}"
-        n_bytes /= 1024  # type: ignore[assignment]
-    raise AssertionError("unreachable")
+    if n_bytes < 1024:
+        return f"{n_bytes:,} bytes"
+    power = min(4, (n_bytes.bit_length() - 1) // 10)
+    return f"{n_bytes / 1024**power:,.1f} {('KiB', 'MiB', 'GiB', 'TiB')[power - 1]}"
 
 
 def _warn_if_unsensable(scenario: Scenario) -> None:

@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import os
 import stat
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from rsstp_sim.errors import OutputError
 
-__all__ = ["irregular", "write_whole"]
+__all__ = ["irregular", "side_file", "write_whole", "written_whole"]
 
 
 def irregular(path: str | os.PathLike[str]) -> str | None:
@@ -37,19 +39,33 @@ def irregular(path: str | os.PathLike[str]) -> str | None:
     return "not a regular file"
 
 
-def write_whole(path: str | os.PathLike[str], data: bytes) -> Path:
-    """Write ``data`` to ``path`` through a side file renamed into place: a reader never sees
-    a part, and a failed write (a full disk) leaves what was at ``path`` as it was.
-    :class:`~rsstp_sim.errors.OutputError` says what failed, in one line."""
+def side_file(path: str | os.PathLike[str]) -> Path:
+    """Where a file of ``path`` is written until it is whole: ``<name>.partial`` beside it."""
+    out = Path(path)
+    return out.with_name(f"{out.name}.partial")
+
+
+@contextmanager
+def written_whole(path: str | os.PathLike[str]) -> Iterator[Path]:
+    """Give the side file to write ``path`` through; once the block ends, rename it into
+    place. A reader never sees a part, and a failed write (a full disk) removes the side file
+    and leaves what was at ``path`` as it was: :class:`~rsstp_sim.errors.OutputError` says
+    what failed, in one line."""
     out = Path(path)
     kind = irregular(out)
     if kind is not None:
         raise OutputError(f"{out}: {kind}: only a regular file is ever written or replaced")
-    side = out.with_name(f"{out.name}.partial")
+    side = side_file(out)
     try:
-        side.write_bytes(data)
+        yield side
         os.replace(side, out)
     except OSError as exc:
         side.unlink(missing_ok=True)
         raise OutputError(f"{out}: cannot write: {exc.strerror or exc}") from None
-    return out
+
+
+def write_whole(path: str | os.PathLike[str], data: bytes) -> Path:
+    """Write ``data`` to ``path`` whole (see :func:`written_whole`)."""
+    with written_whole(path) as side:
+        side.write_bytes(data)
+    return Path(path)

@@ -43,7 +43,7 @@ from mcap.writer import CompressionType, Writer
 
 from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.errors import RecordingError, RecordingWriteError
-from rsstp_sim.files import irregular
+from rsstp_sim.files import irregular, side_file
 from rsstp_sim.recording import records
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_MEDIA_TYPE,
@@ -139,11 +139,6 @@ class _UnbufferedFile:
 
     def close(self) -> None:
         self._raw.close()
-
-
-def side_file(path: Path) -> Path:
-    """Where a recording of ``path`` is written until it is finished."""
-    return path.with_name(f"{path.name}.partial")
 
 
 def _open_output(path: Path, *, force: bool) -> io.FileIO:
