@@ -17,13 +17,25 @@ import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import urllib.parse
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
 from pathlib import Path
 
 from rsstp_replay.errors import ReplayError
 
-__all__ = ["DEFAULT_BIND", "WebServer", "check_port", "has_display", "rerun_program"]
+__all__ = [
+    "DEFAULT_BIND",
+    "CtrlC",
+    "WebServer",
+    "check_port",
+    "ctrl_c_remembered",
+    "has_display",
+    "rerun_program",
+]
 
 DEFAULT_BIND = "127.0.0.1"
 
@@ -51,6 +63,43 @@ def check_port(address: str, port: int, *, option: str) -> None:
             raise ReplayError(
                 f"cannot listen on {address} port {port}: {exc.strerror or exc}"
             ) from None
+
+
+@dataclass(slots=True)
+class CtrlC:
+    """Whether Ctrl-C was pressed within :func:`ctrl_c_remembered` (a plain flag: a signal
+    handler must not take a lock its own thread may hold)."""
+
+    pressed: bool = False
+
+
+@contextmanager
+def ctrl_c_remembered(*, interrupt: bool = True) -> Iterator[CtrlC]:
+    """Within: Ctrl-C (SIGINT) sets the flag yielded and, with ``interrupt``, also raises
+    :class:`KeyboardInterrupt`; a wait that polls the flag stops even when the exception
+    was lost.
+
+    Python ignores an exception raised inside a finaliser (``__del__``), and a
+    ``KeyboardInterrupt`` lands in one whenever the signal arrives while the garbage collector
+    runs one (rerun's ``RecordingStream.__del__`` is a likely one here); a server waiting on
+    the exception alone would then serve on after Ctrl-C. Outside the main thread (where
+    signal handlers cannot be set) the flag is only set by whoever holds it.
+    """
+    pressed = CtrlC()
+
+    def handler(signum: int, frame: object) -> None:
+        pressed.pressed = True
+        if interrupt:
+            raise KeyboardInterrupt
+
+    if threading.current_thread() is not threading.main_thread():
+        yield pressed
+        return
+    previous = signal.signal(signal.SIGINT, handler)
+    try:
+        yield pressed
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 def rerun_program() -> str:
@@ -82,9 +131,13 @@ class WebServer:
             stdin=subprocess.DEVNULL,
             stdout=subprocess.DEVNULL,
             stderr=self._errors,
-            start_new_session=True,
+            start_new_session=True,  # Ctrl-C reaches this process alone, which stops the server
         )
-        self._wait_until_listening()
+        try:
+            self._wait_until_listening()
+        except BaseException:  # Ctrl-C while it starts too: no server left behind
+            self.close()
+            raise
 
     @property
     def url(self) -> str:
@@ -109,15 +162,17 @@ class WebServer:
                 if probe.connect_ex((host, self.web_port)) == 0:
                     return
             time.sleep(0.1)
-        self.close()
         raise ReplayError(f"the rerun web server did not listen on port {self.web_port} in time")
 
-    def wait(self) -> None:
-        """Until the server ends, or Ctrl-C."""
+    def wait(self, stop: CtrlC | None = None) -> None:
+        """Until the server ends, or Ctrl-C, or ``stop`` is pressed (polled every 0.2 s);
+        then close."""
         try:
-            self._process.wait()
-        except KeyboardInterrupt:
-            pass
+            with ctrl_c_remembered(interrupt=False) as pressed:
+                while self._process.poll() is None and not pressed.pressed:
+                    if stop is not None and stop.pressed:
+                        break
+                    time.sleep(0.2)
         finally:
             self.close()
 

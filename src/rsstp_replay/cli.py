@@ -280,7 +280,7 @@ def _check_output(out: Path, *, force: bool) -> None:
 
 
 def _cmd_view(args: argparse.Namespace) -> int:
-    from rsstp_replay._viewer_serve import check_port, has_display
+    from rsstp_replay._viewer_serve import check_port, ctrl_c_remembered, has_display
     from rsstp_replay.viewer import ViewerWarning, view
 
     save = Path(args.save) if args.save is not None else None
@@ -295,38 +295,41 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if args.serve_web:  # before anything is read: a port in use is one line
         check_port(args.bind, args.web_port, option="--web-port")
         check_port(args.bind, args.grpc_port, option="--grpc-port")
-    with (
-        _open(args.file) as recording,
-        warnings.catch_warnings(record=True) as caught,
-        progress(1, "reading, auditing, logging to Rerun", unit="view", quiet=args.quiet) as bar,
-    ):
-        warnings.simplefilter("always", ViewerWarning)
-        result = view(
-            recording,
-            save=save,
-            spawn=spawn,
-            serve_web=args.serve_web,
-            start=args.start,
-            end=args.end,
-            bind=args.bind,
-            web_port=args.web_port,
-            grpc_port=args.grpc_port,
-        )
-        bar.to(1)
-    try:  # the server runs from here: Ctrl-C at any moment stops it and removes its file
-        for warning in caught:
-            print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
-        print(result.to_text())
-        if save is not None:
-            print(f"open it with: rerun {save}")
-        if args.serve_web:
-            print(f"serving on {args.bind} until Ctrl-C", flush=True)
-            result.serve_forever()
-    except KeyboardInterrupt:
-        if not args.serve_web:
-            raise
-    finally:
-        result.close()
+    with ctrl_c_remembered() as pressed:  # a Ctrl-C lost in a finaliser still stops serving
+        with (
+            _open(args.file) as recording,
+            warnings.catch_warnings(record=True) as caught,
+            progress(
+                1, "reading, auditing, logging to Rerun", unit="view", quiet=args.quiet
+            ) as bar,
+        ):
+            warnings.simplefilter("always", ViewerWarning)
+            result = view(
+                recording,
+                save=save,
+                spawn=spawn,
+                serve_web=args.serve_web,
+                start=args.start,
+                end=args.end,
+                bind=args.bind,
+                web_port=args.web_port,
+                grpc_port=args.grpc_port,
+            )
+            bar.to(1)
+        try:  # the server runs from here: Ctrl-C at any moment stops it and removes its file
+            for warning in caught:
+                print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
+            print(result.to_text())
+            if save is not None:
+                print(f"open it with: rerun {save}")
+            if args.serve_web:
+                print(f"serving on {args.bind} until Ctrl-C", flush=True)
+                result.serve_forever(pressed)
+        except KeyboardInterrupt:
+            if not args.serve_web:
+                raise
+        finally:
+            result.close()
     if args.serve_web:
         print("stopped serving")
     return 0

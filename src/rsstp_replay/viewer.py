@@ -39,7 +39,7 @@ from rsstp_replay import _viewer_world as world_part
 from rsstp_replay._viewer_blueprint import default_blueprint
 from rsstp_replay._viewer_chunks import TIMELINE
 from rsstp_replay._viewer_layout import ViewerWarning, graph_positions
-from rsstp_replay._viewer_serve import DEFAULT_BIND, WebServer, check_port
+from rsstp_replay._viewer_serve import DEFAULT_BIND, CtrlC, WebServer, check_port
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.errors import ReplayError, StepOutOfRange
@@ -158,11 +158,11 @@ class ViewResult:
             f"{self.seconds_rerun:.2f} s" + ("; " + ", ".join(where) if where else "")
         )
 
-    def serve_forever(self) -> None:
-        """Keep serving the web viewer until interrupted (Ctrl-C), then stop."""
+    def serve_forever(self, stop: CtrlC | None = None) -> None:
+        """Keep serving the web viewer until Ctrl-C (or until ``stop`` is pressed), then stop."""
         try:
             if self._server is not None:
-                self._server.wait()
+                self._server.wait(stop)
         finally:
             self.close()
 
@@ -255,7 +255,7 @@ def view(
         assert target is not None
         try:
             server = WebServer(target, bind=bind, web_port=web_port, grpc_port=grpc_port)
-        except ReplayError:
+        except BaseException:  # Ctrl-C as well: the temporary file goes with the server
             if folder is not None:
                 folder.cleanup()
             raise

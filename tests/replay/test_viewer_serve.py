@@ -1,0 +1,67 @@
+"""Serving the web viewer: Ctrl-C stops it, even a Ctrl-C that Python loses in a finaliser."""
+
+from __future__ import annotations
+
+import gc
+import os
+import signal
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from rsstp_replay._viewer_serve import WebServer, ctrl_c_remembered
+from rsstp_replay.recording import open_recording
+from rsstp_replay.viewer import view
+
+ROOT = Path(__file__).resolve().parents[2]
+REFERENCE = ROOT / "recordings" / "thesis-roulette-script.mcap"
+
+
+class _InterruptedFinaliser:
+    """Its finaliser receives the Ctrl-C: Python prints the KeyboardInterrupt and drops it."""
+
+    def __del__(self) -> None:
+        os.kill(os.getpid(), signal.SIGINT)
+        deadline = time.monotonic() + 5
+        while time.monotonic() < deadline:  # the handler runs between these bytecodes
+            pass
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+def test_a_ctrl_c_lost_in_a_finaliser_is_still_remembered() -> None:
+    with ctrl_c_remembered() as ctrl_c:
+        _InterruptedFinaliser()  # collected at once: the KeyboardInterrupt is lost in __del__
+        gc.collect()
+        assert ctrl_c.pressed
+
+
+def test_ctrl_c_without_interrupt_only_sets_the_flag() -> None:
+    with ctrl_c_remembered(interrupt=False) as ctrl_c:
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.05)  # the handler runs here; no KeyboardInterrupt
+    assert ctrl_c.pressed
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
+
+
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
+
+
+def test_a_real_server_stops_on_ctrl_c_during_its_wait(tmp_path: Path) -> None:
+    rrd = tmp_path / "run.rrd"
+    with open_recording(REFERENCE) as recording:
+        view(recording, save=rrd, spawn=False, serve_web=False, start=None, end=None)
+    server = WebServer(rrd, bind="127.0.0.1", web_port=_free_port(), grpc_port=_free_port())
+    process = server._process
+    threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT)).start()
+    began = time.monotonic()
+    server.wait()
+    assert time.monotonic() - began < 10
+    assert process.poll() is not None  # the rerun server is gone
