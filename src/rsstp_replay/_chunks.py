@@ -26,6 +26,7 @@ __all__ = [
     "chunk_records",
     "message_channels",
     "message_times",
+    "log_times_at",
     "messages_at",
     "split_messages",
 ]
@@ -36,6 +37,7 @@ MESSAGE_TIME = struct.Struct("<BQHIQ")
 """A message record's opcode, length, channel id, sequence and log time."""
 _MESSAGE = struct.Struct("<BQH")  # opcode, record length, channel id
 _MESSAGE_HEAD = 31  # opcode 1, length 8, channel 2, sequence 4, log_time 8, publish_time 8
+_LOG_TIME = 15  # where a message record's log_time starts
 _CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
 _MESSAGE_OP = int(Opcode.MESSAGE)
 
@@ -129,6 +131,15 @@ def message_channels(data: bytes) -> list[int]:
             channels.append(channel)
         position += 9 + length
     return channels
+
+
+def log_times_at(data: bytes, offsets: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
+    """The log times of the message records that start at ``offsets`` in ``data`` (offsets
+    that :func:`messages_at` checked)."""
+    raw = np.frombuffer(data, np.uint8)
+    at = offsets[:, None] + np.arange(_LOG_TIME, _LOG_TIME + 8)
+    times: npt.NDArray[np.int64] = raw[at].copy().view("<u8").ravel().astype(np.int64)
+    return times
 
 
 def message_times(data: bytes, channel: int) -> list[int]:

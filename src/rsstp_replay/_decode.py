@@ -140,6 +140,7 @@ class StepColumns:
         self.truth = truth
         self.rows = 0
         self.step = np.empty(n_rows, np.int64)
+        self.log_time = np.empty(n_rows, np.int64)
         self.action = np.empty(n_rows, np.int64)
         self.state_before = np.empty(n_rows, np.int64)
         self.internal_state = np.empty(n_rows, np.int64)
@@ -158,8 +159,9 @@ class StepColumns:
 
     # -- filling ----------------------------------------------------------------------------
 
-    def add(self, parts: list[memoryview]) -> None:
-        """Decode a batch of step messages (their JSON bytes) into the next rows."""
+    def add(self, parts: list[memoryview], log_times: npt.ArrayLike) -> None:
+        """Decode a batch of step messages (their JSON bytes, and their log times) into the
+        next rows."""
         if not parts:
             return
         batch, one = _DECODERS[self.truth]
@@ -180,6 +182,7 @@ class StepColumns:
             raise BadStep(f"more step messages than the {self.n_rows} counted", index=0)
         s = slice(r, r + k)
         self.step[s] = [x.step for x in rows]
+        self.log_time[s] = log_times
         agents = [x.agent for x in rows]
         self.action[s] = _nullable([a.action for a in agents], r, self.action_nulls)
         self.state_before[s] = _nullable(

@@ -29,9 +29,10 @@ from typing import Any, NamedTuple
 
 import msgspec
 import numpy as np
+import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
-from rsstp_replay._chunks import message_times, messages_at
+from rsstp_replay._chunks import log_times_at, message_times, messages_at
 from rsstp_replay._chunks import split_messages as _split
 from rsstp_replay._container import ChunkRef, Container, open_container
 from rsstp_replay._contract import (
@@ -81,6 +82,9 @@ EVENT_KINDS = (
 """The categories of :meth:`Recording.events`' ``kind`` column (``rsstp.Event`` 1.x)."""
 
 _CACHED_CHUNKS = 4
+
+
+_Ints = npt.NDArray[np.int64]
 
 
 def open_recording(path: str | os.PathLike[str]) -> Recording:
@@ -231,6 +235,11 @@ class Recording:
             frame["true_class"] = step_true_classes(frame, self.ground_truth())
         return frame
 
+    def step_log_times(self) -> _Ints:
+        """The log time of each step message, in step order (the contract wants step x
+        1,000,000 ns: :func:`~rsstp_replay.audits.contract.check_contract`)."""
+        return self._agent_columns().log_time
+
     def ground_truth(self) -> GroundTruth:
         """The scenario's ground truth (computed once per recording; may take seconds)."""
         if self._ground_truth is None:
@@ -333,9 +342,9 @@ class Recording:
 
     def _chunks(
         self, topic: str, *, step: int | None = None
-    ) -> Generator[tuple[ChunkRef, bytes, list[memoryview], list[int]], None, None]:
+    ) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
         """The chunks with messages of ``topic`` (or only those around ``step``'s log time),
-        each with its records, those messages' bytes and (except for steps) log times."""
+        each with its records, those messages' bytes and their log times."""
         self._check_open()
         channel = self._channels[topic]
         limit = self._limit_ns
@@ -352,19 +361,13 @@ class Recording:
                 if topic == "/rsstp/step" and cut is None:
                     offsets = self._container.message_offsets(stream, ref, channel)
                     if offsets is not None:  # a finished file: its index says where they are
-                        yield (
-                            ref,
-                            data,
-                            messages_at(self.path, data, offsets, channel, where=ref.offset),
-                            [],
-                        )
+                        found = messages_at(self.path, data, offsets, channel, where=ref.offset)
+                        yield ref, data, found, log_times_at(data, offsets)
                         continue
                 parts: dict[int, list[memoryview]] = {channel: []}
-                times: dict[int, list[int]] | None = None
-                if topic != "/rsstp/step":
-                    times = {channel: []}
+                times: dict[int, list[int]] = {channel: []}
                 _split(self.path, data, parts, where=ref.offset, limit_ns=cut, times=times)
-                yield ref, data, parts[channel], [] if times is None else times[channel]
+                yield ref, data, parts[channel], np.array(times[channel], np.int64)
 
     def _read_scenario(self) -> ScenarioRecord:
         count = self.topic_counts.get("/rsstp/scenario", 0)
@@ -413,10 +416,15 @@ class Recording:
             ) from None
 
     def _decode_steps(
-        self, columns: StepColumns, ref: ChunkRef, data: bytes, parts: list[memoryview]
+        self,
+        columns: StepColumns,
+        ref: ChunkRef,
+        data: bytes,
+        parts: list[memoryview],
+        log_times: _Ints,
     ) -> None:
         try:
-            columns.add(parts)
+            columns.add(parts, log_times)
         except BadStep as exc:
             times = message_times(data, self._channels["/rsstp/step"])
             at = f"at step {times[exc.index] // STEP_NS} " if exc.index is not None else ""
@@ -436,8 +444,8 @@ class Recording:
             geometry=ArmGeometry.from_scenario(self.scenario) if truth else None,
         )
         with _gc_paused():
-            for ref, data, parts, _ in self._chunks("/rsstp/step"):
-                self._decode_steps(columns, ref, data, parts)
+            for ref, data, parts, times in self._chunks("/rsstp/step"):
+                self._decode_steps(columns, ref, data, parts, times)
         try:
             columns.check(actions=record.actions)
         except BadStep as exc:
@@ -464,9 +472,9 @@ class Recording:
                 return row
         n_joints = self.scenario_record.n_joints
         with closing(self._chunks("/rsstp/step", step=step)) as chunks:
-            for ref, data, parts, _ in chunks:
+            for ref, data, parts, times in chunks:
                 columns = StepColumns(len(parts), n_joints=n_joints, n_obstacles=0, truth=False)
-                self._decode_steps(columns, ref, data, parts)
+                self._decode_steps(columns, ref, data, parts, times)
                 if len(self._agent_cache) >= _CACHED_CHUNKS:
                     self._agent_cache.pop(next(iter(self._agent_cache)))
                 self._agent_cache[ref.offset] = columns

@@ -10,6 +10,12 @@ directory gets, besides the recordings and ``findings/``:
 - ``sweep.json``: the package and library versions, the runs' names and the sweep's origin;
 - ``runs.parquet``: one row per run, in the sweep file's order, written at the end and also
   when the sweep is interrupted (runs that did not finish are rows with status ``not run``).
+
+A worker process that dies (out of memory, a signal, a crash in native code) takes with it
+every run the scheduler had given it, and Dask gives up on a run that was on dying workers
+too often (``KilledWorker``), whether it was the culprit or a bystander. So such a run is run
+once more at the end, alone on the cluster: only a run that kills its worker then too is a
+failed row.
 """
 
 from __future__ import annotations
@@ -32,8 +38,8 @@ __all__ = ["RUNS_TABLE", "SweepResult", "run_sweep", "runs_frame"]
 RUNS_TABLE = "runs.parquet"
 
 _KILLED = (
-    "its worker process died while running it, on every retry (killed: out of memory, a "
-    "signal, or a crash in native code)"
+    "its worker process died while running it, also when it ran alone (killed: out of "
+    "memory, a signal, or a crash in native code)"
 )
 
 
@@ -97,18 +103,25 @@ def run_sweep(
                     execute_run, run, output, key=f"rsstp-{run.name}", pure=False
                 )
                 by_key[future.key] = (run, future)
+            suspects: list[Run] = []
             try:
                 for future in as_completed([f for _, f in by_key.values()]):
                     run, _ = by_key[future.key]
-                    try:
-                        row = future.result()
-                    except KilledWorker:  # the run kills its worker, on every retry
-                        row = failed_row(run, _KILLED)
-                    except Exception as exc:  # the cluster lost it another way
-                        row = failed_row(run, f"the cluster lost the run: {exc}")
+                    row = _result(run, future, KilledWorker)
+                    if row is None:  # it, or a run beside it, killed its workers
+                        suspects.append(run)
+                        continue
                     rows[run.name] = row
                     if on_row is not None:
                         on_row(row)
+                for run in suspects:  # once more, alone: only the culprit dies again
+                    future = client.submit(
+                        execute_run, run, output, key=f"rsstp-{run.name}-alone", pure=False
+                    )
+                    by_key[future.key] = (run, future)
+                    rows[run.name] = _result(run, future, KilledWorker) or failed_row(run, _KILLED)
+                    if on_row is not None:
+                        on_row(rows[run.name])
             except KeyboardInterrupt:
                 interrupted = True
                 client.cancel([f for _, f in by_key.values()])
@@ -129,6 +142,18 @@ def run_sweep(
     with fs.open(f"{root.rstrip('/')}/{RUNS_TABLE}", "wb") as out:
         out.write(buffer.getvalue())
     return SweepResult(table, interrupted)
+
+
+def _result(run: Run, future: Any, killed: type[Exception]) -> dict[str, Any] | None:
+    """The run's row from its future; None when Dask gave up because its workers died
+    (``killed``: distributed's ``KilledWorker``, imported with Dask)."""
+    try:
+        row: dict[str, Any] = future.result()
+    except killed:
+        return None
+    except Exception as exc:  # the cluster lost it another way
+        return failed_row(run, f"the cluster lost the run: {exc}")
+    return row
 
 
 def runs_frame(rows: list[dict[str, Any]]) -> pd.DataFrame:

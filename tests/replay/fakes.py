@@ -14,12 +14,14 @@ from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 
 from rsstp_sim import Runner, Scenario, Strategy
 from rsstp_sim.coupling import Event
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording import records
+from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.strategies import AgentView, StrategyBase
 from rsstp_sim.transition_system import Operation, TransitionSystem
 
@@ -146,6 +148,9 @@ class FakeRecording:
     def model_versions(self) -> list[records.ModelRecord]:
         return list(self._models)
 
+    def step_log_times(self) -> npt.NDArray[np.int64]:
+        return self._steps["step"].to_numpy(np.int64) * STEP_NS
+
     def model_at(self, step: int) -> TransitionSystem:
         record = [model for model in self._models if model.step <= step][-1]
         return TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
@@ -240,3 +245,9 @@ class StaticRecording:
 
     def steps(self, *, geometry: bool = True) -> pd.DataFrame:
         return self._steps.copy()
+
+    def step_log_times(self) -> npt.NDArray[np.int64]:
+        return np.arange(self._memory.steps + 1, dtype=np.int64) * STEP_NS
+
+    def events(self) -> pd.DataFrame:
+        return pd.DataFrame({"step": np.array([], np.int64), "kind": [], "text": [], "data": []})

@@ -110,6 +110,7 @@ def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
     record(path, load_scenario("thesis-roulette"), make_strategy("roulette"), steps=40, seed=0)
     with open_recording(path) as recording:
         table, versions = recording.steps(), list(recording.model_versions())
+        times, events = recording.step_log_times(), recording.events()
 
     class Edited:
         def __init__(self, table: object) -> None:
@@ -120,6 +121,12 @@ def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
 
         def model_versions(self) -> list[ModelRecord]:
             return versions
+
+        def step_log_times(self) -> object:
+            return times
+
+        def events(self) -> object:
+            return events
 
     edited = table.copy()
     edited.loc[20, "state_before"] = 999
@@ -171,3 +178,45 @@ def test_check_and_audit_gate_on_the_contract(tmp_path: Path) -> None:
     assert gated.returncode == 1
     assert "the steps break the recording contract" in gated.stderr
     assert cli("audit", str(good), "--fail-on", "contract").returncode == 0
+
+
+def test_log_times_and_event_steps_are_checked(tmp_path: Path) -> None:
+    """A step logged off its step x 1,000,000 ns, and an event naming a step the recording
+    does not have (its log time agreeing, so the reader takes it), are contract findings."""
+    import json
+
+    from test_corrupt import rewrite
+
+    good = tmp_path / "good.mcap"
+    record(good, load_scenario("thesis-roulette"), make_strategy("roulette"), steps=40, seed=0)
+
+    def late(topic: str, log_time: int) -> int:
+        return log_time + 500_000 if topic == "/rsstp/step" and log_time >= 30_000_000 else log_time
+
+    retimed = rewrite(good, tmp_path / "retimed.mcap", retime=late)
+    with open_recording(retimed) as recording:
+        found = check_contract(recording)
+    assert [(v.rule, v.step, v.count) for v in found.violations] == [("log-time", 30, 11)]
+    assert "step 30 is logged at 30,500,000 ns, not 30,000,000" in found.to_text()
+
+    def far(topic: str, log_time: int, data: bytes) -> bytes:
+        if topic != "/rsstp/event" or log_time != 40_000_000:
+            return data
+        event = json.loads(data)
+        event["step"] = 1_000_000
+        return json.dumps(event).encode()
+
+    def far_time(topic: str, log_time: int) -> int:
+        return (
+            1_000_000 * 1_000_000
+            if topic == "/rsstp/event" and log_time == 40_000_000
+            else log_time
+        )
+
+    with open_recording(good) as recording:
+        assert (recording.events()["step"] == 40).any()  # roulette notes its last step
+    moved = rewrite(good, tmp_path / "moved.mcap", message=far, retime=far_time)
+    with open_recording(moved) as recording:
+        found = check_contract(recording)
+    assert [v.rule for v in found.violations] == ["event-in-range"]
+    assert "names step 1,000,000, outside the recording's steps 0 to 40" in found.to_text()

@@ -68,9 +68,11 @@ def rewrite(
     schema: Callable[[str, bytes], bytes] = lambda name, data: data,
     message: Callable[[str, int, bytes], bytes | None] = lambda topic, log_time, data: data,
     attachment: Callable[[bytes], bytes] = lambda data: data,
+    retime: Callable[[str, int], int] = lambda topic, log_time: log_time,
 ) -> Path:
     """Copy a recording record by record into a new finished file, changing what is asked
-    (``message`` returning None drops the message)."""
+    (``message`` returning None drops the message; ``retime`` gives a message's new log
+    time)."""
     with open(source, "rb") as stream, open(target, "wb") as out:
         reader = make_reader(stream)
         summary = reader.get_summary()
@@ -98,7 +100,8 @@ def rewrite(
         for _, channel, msg in reader.iter_messages(log_time_order=False):
             data = message(channel.topic, msg.log_time, msg.data)
             if data is not None:
-                writer.add_message(channel_ids[channel.id], msg.log_time, data, msg.publish_time)
+                at = retime(channel.topic, msg.log_time)
+                writer.add_message(channel_ids[channel.id], at, data, at)
         writer.finish()
     return target
 

@@ -8,7 +8,13 @@ the current state of the model. The contract ties them together, step by step:
 - ``state-in-model``: its internal state is a state of that version;
 - ``state-chain``: a step starts where the step before it ended (``state_before`` of step
   ``t`` is the internal state of step ``t - 1``);
-- ``versions-in-order``: model versions grow from one message to the next.
+- ``versions-in-order``: model versions grow from one message to the next;
+- ``log-time``: a step message is logged at step x 1,000,000 ns (what tools that plot by
+  log time, Foxglove and Rerun's importer, rely on);
+- ``event-in-range``: an event names a step of the recording.
+
+(A model or event message whose log time disagrees with its step, and a channel whose message
+count differs from the summary's, are refused by the reader itself.)
 
 So ``Recording.model_at(t).current`` is the internal state of step ``t`` at every step, and an
 audit can read a state id as what its version says. :func:`check_contract` checks every step
@@ -26,6 +32,7 @@ import numpy.typing as npt
 import pandas as pd
 
 from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.recording.schemas import STEP_NS
 
 __all__ = ["ContractFindings", "ContractSource", "Violation", "check_contract", "version_index"]
 
@@ -36,17 +43,21 @@ class ContractSource(Protocol):
     """What the contract check reads of a recording."""
 
     def steps(self, *, geometry: bool = True) -> pd.DataFrame: ...
+    def step_log_times(self) -> _Ints: ...
     def model_versions(self) -> Sequence[ModelRecord]: ...
+    def events(self) -> pd.DataFrame: ...
 
 
 @dataclass(frozen=True, slots=True)
 class Violation:
-    """A broken rule: its name, the first step that breaks it, how many steps do, and why."""
+    """A broken rule: its name, the first step that breaks it, how many steps (or ``counted``
+    things) do, and why."""
 
     rule: str
     step: int
     count: int
     text: str
+    counted: str = "step"
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,7 +76,7 @@ class ContractFindings:
             return f"contract: holds at every one of the {self.steps + 1:,} steps"
         lines = [f"contract: {len(self.violations)} rule(s) broken"]
         lines += [
-            f"  {v.rule}: from step {v.step} ({v.count:,} step(s)): {v.text}"
+            f"  {v.rule}: from step {v.step:,} ({v.count:,} {v.counted}(s)): {v.text}"
             for v in self.violations
         ]
         return "\n".join(lines)
@@ -74,7 +85,13 @@ class ContractFindings:
         return {
             "holds": self.holds,
             "violations": [
-                {"rule": v.rule, "step": v.step, "count": v.count, "text": v.text}
+                {
+                    "rule": v.rule,
+                    "step": v.step,
+                    "count": v.count,
+                    "counted": v.counted,
+                    "text": v.text,
+                }
                 for v in self.violations
             ],
         }
@@ -158,5 +175,40 @@ def check_contract(source: ContractSource) -> ContractFindings:
                 f"state {state[t - 1]}",
             )
         )
+    found += _log_times(step, source.step_log_times())
+    found += _event_steps(source.events(), int(step[-1]) if len(step) else 0)
     found.sort(key=lambda v: v.step)
     return ContractFindings(int(step[-1]) if len(step) else 0, tuple(found))
+
+
+def _log_times(step: _Ints, log_time: _Ints) -> list[Violation]:
+    off = np.flatnonzero(log_time != step * STEP_NS)
+    if not len(off):
+        return []
+    t = int(off[0])
+    return [
+        Violation(
+            "log-time",
+            int(step[t]),
+            len(off),
+            f"step {step[t]} is logged at {log_time[t]:,} ns, not {step[t] * STEP_NS:,}",
+        )
+    ]
+
+
+def _event_steps(events: pd.DataFrame, last_step: int) -> list[Violation]:
+    steps = events["step"].to_numpy(np.int64)
+    outside = np.flatnonzero((steps < 0) | (steps > last_step))
+    if not len(outside):
+        return []
+    at = int(steps[outside[0]])
+    kind = events["kind"].iloc[int(outside[0])]
+    return [
+        Violation(
+            "event-in-range",
+            at,
+            len(outside),
+            f"a {kind} event names step {at:,}, outside the recording's steps 0 to {last_step:,}",
+            counted="event",
+        )
+    ]

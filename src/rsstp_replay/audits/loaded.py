@@ -14,6 +14,7 @@ from collections.abc import Sequence
 from typing import Protocol
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 
 from rsstp_sim.memory import Memory
@@ -25,7 +26,9 @@ __all__ = ["LoadedRecording", "load"]
 
 class _Source(Protocol):
     def steps(self, *, geometry: bool = True) -> pd.DataFrame: ...
+    def step_log_times(self) -> npt.NDArray[np.int64]: ...
     def model_versions(self) -> Sequence[ModelRecord]: ...
+    def events(self) -> pd.DataFrame: ...
 
 
 class LoadedRecording:
@@ -62,6 +65,12 @@ class LoadedRecording:
 
     def model_versions(self) -> Sequence[ModelRecord]:
         return self._models
+
+    def step_log_times(self) -> npt.NDArray[np.int64]:
+        return self.source.step_log_times()
+
+    def events(self) -> pd.DataFrame:
+        return self.source.events()
 
 
 def load(source: _Source) -> LoadedRecording:

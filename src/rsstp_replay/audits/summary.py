@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 
 from rsstp_replay.audits.compare import HasMemory
@@ -41,10 +42,14 @@ class AuditSource(HasMemory, HasModelVersions, Protocol):
     - ``model_versions()``: the ``/rsstp/model`` messages, in order;
     - ``steps(geometry=False)``: one row per step (0 is the reset) with at least the boolean
       columns ``blocked`` and ``no_transition`` (``geometry=False``: the joint positions and
-      obstacle distances may be left out, the audits do not read them).
+      obstacle distances may be left out, the audits do not read them);
+    - ``step_log_times()`` and ``events()``: for the contract's ``log-time`` and
+      ``event-in-range`` rules.
     """
 
     def steps(self, *, geometry: bool = True) -> pd.DataFrame: ...
+    def step_log_times(self) -> npt.NDArray[np.int64]: ...
+    def events(self) -> pd.DataFrame: ...
 
 
 @dataclass(frozen=True, slots=True)
