@@ -9,14 +9,24 @@ line and exit 130.
 from __future__ import annotations
 
 import importlib
+import signal
 import sys
 
 __all__ = ["rsstp_replay", "rsstp_sim"]
 
 
 def _start(prog: str, module: str) -> int:
+    # While the packages load, Ctrl-C is only noted: a KeyboardInterrupt raised inside an
+    # extension's import comes out as that import's ImportError (numpy's does), a traceback.
+    pressed: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: pressed.append(signum))
     try:
         main = importlib.import_module(module).main
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    try:
+        if pressed:
+            raise KeyboardInterrupt
         code: int = main()
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)

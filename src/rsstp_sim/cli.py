@@ -20,7 +20,7 @@ from rsstp_sim import graph
 from rsstp_sim.commandline import Parser, UsageError, progress, run_command
 from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import RecordingWriteError
-from rsstp_sim.scenario import Scenario, builtin_scenarios, load_scenario
+from rsstp_sim.scenario import MANY_OBSTACLES, Scenario, builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -132,7 +132,9 @@ def _size(n_bytes: int) -> str:
     return f"{n_bytes / 1024**power:,.1f} {('KiB', 'MiB', 'GiB', 'TiB')[power - 1]}"
 
 
-def _warn_if_unsensable(scenario: Scenario) -> None:
+def _warn_about(scenario: Scenario) -> None:
+    """Warnings a scenario earns before it runs: a feedback point no pose can sense, and so
+    many obstacles that steps slow down."""
     from rsstp_sim.world_table import unsensable
 
     problem = unsensable(scenario)
@@ -142,11 +144,18 @@ def _warn_if_unsensable(scenario: Scenario) -> None:
             f"false: {problem}",
             file=sys.stderr,
         )
+    n = len(scenario.obstacles)
+    if n > MANY_OBSTACLES:
+        print(
+            f"{PROG}: warning: {n:,} obstacles: every step measures each joint's distance to "
+            f"each of them, so steps run about {1 + n / 60:.0f} times slower than with a few",
+            file=sys.stderr,
+        )
 
 
 def _runner(args: argparse.Namespace) -> Runner:
     scenario = load_scenario(args.scenario)
-    _warn_if_unsensable(scenario)
+    _warn_about(scenario)
     strategy = make_strategy(args.strategy, _parse_params(args.param))
     return Runner(scenario, strategy, seed=args.seed)
 
@@ -218,7 +227,7 @@ def _cmd_record(args: argparse.Namespace) -> int:
 
     _check_steps_fit(args.steps, Path(args.output))
     scenario = load_scenario(args.scenario)
-    _warn_if_unsensable(scenario)
+    _warn_about(scenario)
     strategy = make_strategy(args.strategy, _parse_params(args.param))
     recorder = Recorder(
         args.output,
@@ -261,7 +270,7 @@ def _cmd_truth(args: argparse.Namespace) -> int:
     from rsstp_sim.truth import compute_truth, format_truth
 
     scenario = load_scenario(args.scenario)
-    _warn_if_unsensable(scenario)
+    _warn_about(scenario)
     truth = compute_truth(scenario, max_poses=args.max_poses)
     if args.json:
         print(json.dumps(truth.to_json(), indent=2))

@@ -57,6 +57,14 @@ _TOP_LEVEL = frozenset({"name", "description", "arm", "obstacles", "feedback", "
 _OBSTACLE_KEYS = frozenset({"center", "radius"})
 MAX_JOINTS = 7
 """Most links an arm may have: the world numbers poses as int64 ``sum(angle_i * 360**i)``."""
+MAX_OBSTACLES = 1_000
+"""Most obstacles a scenario may have: every step measures each joint's distance to every
+obstacle and records them, so a step's time and its record grow with their number (about
+1,000 three-joint steps a second at this bound, against 25,000 with two obstacles)."""
+MANY_OBSTACLES = 100
+"""Above this many obstacles the command lines warn that steps slow down."""
+MAX_SCENARIO_BYTES = 1 << 20
+"""Largest scenario file read (a thousand obstacles take about 50 KB)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -132,6 +140,12 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
     if kind is not None:
         raise ScenarioError(f"{path}: {kind}, not a scenario file (only regular files are read)")
     try:
+        size = path.stat().st_size
+        if size > MAX_SCENARIO_BYTES:
+            raise ScenarioError(
+                f"{path}: {size:,} bytes is too large for a scenario file (at most "
+                f"{MAX_SCENARIO_BYTES:,}; {MAX_OBSTACLES:,} obstacles take about 50 KB)"
+            )
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"{path}: cannot read scenario file: {exc}") from None
@@ -238,6 +252,11 @@ class _Validator:
         obstacles_raw = data.get("obstacles", [])
         if not isinstance(obstacles_raw, list):
             raise self.fail("obstacles", "an array of tables [[obstacles]]", obstacles_raw)
+        if len(obstacles_raw) > MAX_OBSTACLES:
+            raise ScenarioError(
+                f"{self.origin}: obstacles: expected at most {MAX_OBSTACLES:,} (each step "
+                f"measures every joint's distance to each), found {len(obstacles_raw):,}"
+            )
         obstacles = []
         for j, entry in enumerate(obstacles_raw):
             where = f"obstacles[{j}]"

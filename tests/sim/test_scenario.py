@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import hashlib
 import re
+import subprocess
+import sys
+import time
 from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
@@ -476,6 +479,12 @@ INVALID: list[tuple[str, Mutation, str]] = [
         _set("arm.actions", [1, 2, 1]),
         r"arm\.actions: expected distinct actions, found \[1, 2, 1\]$",
     ),
+    (
+        "too-many-obstacles",
+        _set("obstacles", [{"center": [9.0, float(k)], "radius": 0.1} for k in range(1_001)]),
+        r"obstacles: expected at most 1,000 \(each step measures every joint's distance to "
+        r"each\), found 1,001$",
+    ),
 ]
 
 
@@ -509,3 +518,32 @@ def test_parse_error_names_the_given_origin(scenario_text, scenario_data) -> Non
         parse_scenario(scenario_text(scenario_data), origin="mine.toml")
     with pytest.raises(ScenarioError, match=r"^<string>: arm\.step_deg"):
         parse_scenario(scenario_text(scenario_data))
+
+
+def test_a_huge_scenario_file_is_refused_before_it_is_parsed(
+    write_scenario, scenario_text, scenario_data
+) -> None:
+    """A 10 MB scenario (150,000 obstacles) is refused by its size at once, not parsed."""
+    obstacle = "\n[[obstacles]]\ncenter = [50.0, 50.0]\nradius = 0.5\n"
+    path = write_scenario(scenario_text(scenario_data) + obstacle * 250_000)
+    began = time.perf_counter()
+    with pytest.raises(
+        ScenarioError, match=r"bytes is too large for a scenario file \(at most 1,048,576"
+    ):
+        load_scenario(path)
+    assert time.perf_counter() - began < 0.5
+
+
+def test_many_obstacles_run_with_a_one_line_warning(tmp_path: Path) -> None:
+    obstacles = "".join(f"[[obstacles]]\ncenter = [9.0, {k}.0]\nradius = 0.1\n" for k in range(150))
+    scenario = tmp_path / "crowded.toml"
+    scenario.write_text(
+        "[arm]\nlengths = [1.0, 1.0]\ninitial_deg = [0, 0]\nstep_deg = 10\n" + obstacles
+    )
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_sim", "run", str(scenario), "--steps", "10"],
+        capture_output=True, text=True, timeout=60,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stderr.startswith("rsstp-sim: warning: 150 obstacles: every step measures")
+    assert len(done.stderr.splitlines()) == 1
