@@ -1,0 +1,135 @@
+"""Fuzz scenario files and recordings with a long budget; report cases tried and failures.
+
+    PYTHONPATH=src:tests python bench/fuzz.py [--scenarios 5000] [--recordings 5000]
+
+The strategies and the properties are the test suite's (``tests/fuzzing.py``); the default
+test run tries 80 fixed cases of each, this tries many more, random ones, and does not stop
+at the first failure: every case that breaks a property is counted and the first few of each
+kind are printed. Exit 1 when any case failed.
+
+The recordings mutated are real ones of several chunks, model versions and events: a
+three-joint splitter run of 300 steps (chunks of 8 KiB) and a two-joint-30 learner run of
+400 steps.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+import tempfile
+import time
+from collections import Counter
+from collections.abc import Callable
+from pathlib import Path
+
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from fuzzing import (  # noqa: E402 (the test suite's folder goes on the path first)
+    Written,
+    check_recording,
+    check_scenario,
+    recording_mutations,
+    scenario_texts,
+)
+from rsstp_sim import load_scenario, make_strategy  # noqa: E402
+from rsstp_sim.recording import record  # noqa: E402
+
+SHOWN = 3
+"""Examples printed for each kind of failure."""
+
+
+class Tally:
+    """Cases tried and failures found by kind (a failure's text up to its first digit)."""
+
+    def __init__(self, name: str, budget: int) -> None:
+        self.name = name
+        self.budget = budget
+        self.cases = 0
+        self.failures: Counter[str] = Counter()
+        self.examples: dict[str, list[tuple[str, object]]] = {}
+        self.began = time.perf_counter()
+
+    def note(self, case: object, failure: str | None) -> None:
+        self.cases += 1
+        if failure is None:
+            return
+        kind = failure.split(":")[0][:80]
+        self.failures[kind] += 1
+        shown = self.examples.setdefault(kind, [])
+        if len(shown) < SHOWN:
+            shown.append((failure, case))
+
+    def report(self) -> None:
+        seconds = time.perf_counter() - self.began
+        failed = sum(self.failures.values())
+        print(
+            f"{self.name}: {self.cases:,} cases in {seconds:.0f} s, "
+            f"{failed:,} failed ({len(self.failures)} kinds)"
+        )
+        for kind, count in self.failures.most_common():
+            print(f"  {count:,} x {kind}")
+            for failure, case in self.examples[kind]:
+                print(f"      {failure[:300]}\n      case: {str(case)[:300]}")
+
+
+def explore(
+    tally: Tally, strategy: st.SearchStrategy[object], check: Callable[[object], str | None]
+) -> None:
+    """Run ``check`` on ``tally``'s budget of random cases, noting each outcome."""
+
+    @settings(
+        max_examples=tally.budget,
+        deadline=None,
+        database=None,
+        suppress_health_check=list(HealthCheck),
+    )
+    @given(case=strategy)
+    def run(case: object) -> None:
+        tally.note(case, check(case))
+
+    run()
+
+
+def reference_recordings(folder: Path) -> list[Written]:
+    three = folder / "three-joint-splitter.mcap"
+    record(
+        three,
+        load_scenario("three-joint"),
+        make_strategy("splitter"),
+        steps=300,
+        seed=3,
+        chunk_size=8_192,
+    )
+    two = folder / "two-joint-learner.mcap"
+    record(two, load_scenario("two-joint-30"), make_strategy("learner"), steps=400, seed=5)
+    return [Written.read(three), Written.read(two)]
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--scenarios", type=int, default=5_000, help="scenario cases")
+    parser.add_argument("--recordings", type=int, default=5_000, help="recording cases")
+    args = parser.parse_args()
+    with tempfile.TemporaryDirectory() as name:
+        folder = Path(name)
+        scenarios = Tally("scenario files", args.scenarios)
+        explore(scenarios, scenario_texts(), lambda text: check_scenario(text, folder))
+        scenarios.report()
+
+        recordings = Tally("damaged recordings", args.recordings)
+        references = reference_recordings(folder)
+        cases = st.tuples(st.sampled_from(range(len(references))), recording_mutations())
+        explore(
+            recordings,
+            cases,
+            lambda case: check_recording(case[1], references[case[0]], folder),
+        )
+        recordings.report()
+    return 1 if scenarios.failures or recordings.failures else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

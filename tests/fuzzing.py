@@ -1,0 +1,397 @@
+"""Fuzzing: hypothesis strategies for scenario files and recording bytes, and what every case
+must keep to.
+
+- :func:`scenario_texts`: a valid scenario with one to four keys set to anything TOML can
+  hold (or to plausible values, so that many cases get past validation and run), keys
+  deleted, unknown keys added, and now and then a character of the text changed.
+- :func:`recording_mutations`: edits of a real recording's bytes: bit flips, truncation,
+  ranges overwritten, deleted, duplicated or inserted.
+
+:func:`check_scenario` and :func:`check_recording` return what went wrong with one case
+(``None`` when nothing did): an exception that is not the package's documented error, a
+command line that ends in anything but its exit code and one line, a case over its time
+bound, or (for recordings) a message returned that was never written. The default test run
+(``tests/test_fuzz.py``) runs a short budget; ``bench/fuzz.py`` runs a long one and counts.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import copy
+import io
+import signal
+import time
+import warnings
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+from hypothesis import strategies as st
+
+from conftest import VALID_SCENARIO, toml_text
+from rsstp_replay import ReplayError, UnfinishedRecordingWarning, open_recording
+from rsstp_replay import cli as replay_cli
+from rsstp_sim import RsstpError, parse_scenario
+from rsstp_sim import cli as sim_cli
+
+SCENARIO_SECONDS = 10.0
+"""Time bound of one scenario case: validate, then run and record a few steps."""
+RECORDING_SECONDS = 10.0
+"""Time bound of one recording case: read everything, then ``rsstp-replay check``."""
+
+# ------------------------------------------------------------------------ scenario files
+
+_KEYS = [
+    "name",
+    "description",
+    "arm",
+    "arm.lengths",
+    "arm.initial_deg",
+    "arm.step_deg",
+    "arm.actions",
+    "obstacles",
+    "obstacles.0",
+    "obstacles.0.center",
+    "obstacles.0.radius",
+    "feedback",
+    "feedback.target_deg",
+    "feedback.points",
+    "feedback.mode",
+    "feedback.tolerance",
+    "motion",
+    "motion.collision",
+    "unknown",
+    "arm.unknown",
+    "obstacles.0.unknown",
+]
+"""Every key of a scenario file (``obstacles.0`` is the first obstacle's table), and a few
+unknown ones."""
+
+_BARE_KEY = st.text("abcdefghijklmnopqrstuvwxyz_", min_size=1, max_size=8)
+_SCALARS = st.one_of(
+    st.booleans(),
+    st.integers(-(2**63), 2**63 - 1),
+    st.floats(allow_nan=True, allow_infinity=True),
+    st.sampled_from([0, -1, 1, 359, 360, 361, 1e308, -1e308, 5e-324, 1e-6]),
+    st.text(max_size=12),
+)
+_TOML = st.recursive(
+    _SCALARS,
+    lambda inner: st.lists(inner, max_size=8) | st.dictionaries(_BARE_KEY, inner, max_size=3),
+    max_leaves=24,
+)
+"""Any value a TOML file can hold (datetimes aside)."""
+
+_LENGTH = st.floats(min_value=0.01, max_value=10.0)
+_ANGLE = st.integers(-720, 720)
+_PLAUSIBLE: dict[str, st.SearchStrategy[Any]] = {
+    "arm.lengths": st.lists(_LENGTH, min_size=1, max_size=4),
+    "arm.initial_deg": st.lists(_ANGLE, min_size=1, max_size=4),
+    "arm.step_deg": st.integers(1, 359),
+    "arm.actions": st.lists(st.integers(0, 3), min_size=1, max_size=4, unique=True),
+    "obstacles": st.lists(
+        st.fixed_dictionaries(
+            {
+                "center": st.tuples(st.floats(-5, 5), st.floats(-5, 5)).map(list),
+                "radius": st.floats(0.01, 3.0),
+            }
+        ),
+        max_size=6,
+    ),
+    "obstacles.0.center": st.tuples(st.floats(-5, 5), st.floats(-5, 5)).map(list),
+    "obstacles.0.radius": st.floats(0.0, 5.0),
+    "feedback.target_deg": st.lists(_ANGLE, min_size=1, max_size=4),
+    "feedback.points": st.lists(
+        st.tuples(st.floats(-5, 5), st.floats(-5, 5)).map(list), min_size=1, max_size=3
+    ),
+    "feedback.mode": st.sampled_from(["bool", "float"]),
+    "feedback.tolerance": st.floats(0.0, 1.0),
+    "motion.collision": st.sampled_from(["swept", "endpoint"]),
+}
+"""Values of the right shape, so that many cases pass validation and run."""
+_SHAPE_KEEPING = [
+    key for key in sorted(_PLAUSIBLE) if not key.endswith(("_deg", "lengths", "points"))
+]
+"""The plausible keys that keep the joint count (``arm.actions`` aside) and the kind of
+feedback."""
+
+
+@st.composite
+def _arms(draw: st.DrawFn) -> tuple[dict[str, Any], dict[str, Any]]:
+    """An ``[arm]`` of one to four joints and a ``[feedback]`` that agree on the count."""
+    n = draw(st.integers(1, 4))
+    joints = st.lists(_ANGLE, min_size=n, max_size=n)
+    arm = {
+        "lengths": draw(st.lists(_LENGTH, min_size=n, max_size=n)),
+        "initial_deg": draw(joints),
+        "step_deg": draw(st.integers(1, 180)),
+    }
+    if draw(st.booleans()):
+        arm["actions"] = draw(st.lists(st.integers(0, 2 * n - 1), min_size=1, unique=True))
+    return arm, {"target_deg": draw(joints), "mode": draw(st.sampled_from(["bool", "float"]))}
+
+
+def _put(data: dict[str, Any], path: str, value: Any, *, delete: bool) -> None:
+    """Set (or delete) ``path`` in ``data``, making the tables on the way when needed."""
+    *parents, last = path.split(".")
+    here: Any = data
+    for part in parents:
+        if part == "0":
+            if not isinstance(here, list) or not here or not isinstance(here[0], dict):
+                return
+            here = here[0]
+        else:
+            if not isinstance(here.get(part), dict | list):
+                if delete:
+                    return
+                here[part] = {}
+            here = here[part]
+    if last == "0":
+        if isinstance(here, list) and here:
+            if delete:
+                here.pop(0)
+            else:
+                here[0] = value
+        return
+    if not isinstance(here, dict):
+        return
+    if delete:
+        here.pop(last, None)
+    else:
+        here[last] = value
+
+
+@st.composite
+def scenario_texts(draw: st.DrawFn) -> str:
+    """A scenario file's text: the valid one with a few keys changed (see the module)."""
+    data = copy.deepcopy(VALID_SCENARIO)
+    plausible_only = draw(st.booleans())  # half the cases: values of the right shape only
+    if plausible_only and draw(st.booleans()):
+        data["arm"], data["feedback"] = draw(_arms())
+    for _ in range(draw(st.integers(1, 4))):
+        if plausible_only:
+            path = draw(st.sampled_from(_SHAPE_KEEPING))
+            _put(data, path, draw(_PLAUSIBLE[path]), delete=False)
+            continue
+        path = draw(st.sampled_from(_KEYS))
+        if draw(st.integers(0, 5)) == 0:
+            _put(data, path, None, delete=True)
+            continue
+        plausible = _PLAUSIBLE.get(path)
+        value = draw(plausible if plausible is not None and draw(st.booleans()) else _TOML)
+        _put(data, path, value, delete=False)
+    text = toml_text(data)
+    if draw(st.integers(0, 7)) == 0 and text:  # a character changed, dropped or added
+        at = draw(st.integers(0, len(text) - 1))
+        text = text[:at] + draw(st.text(max_size=2)) + text[at + draw(st.integers(0, 1)) :]
+    return text
+
+
+# ------------------------------------------------------------------------- recording bytes
+
+
+@dataclass(frozen=True, slots=True)
+class Mutation:
+    """One edit of a file's bytes, at a fraction ``where`` of its length."""
+
+    kind: str
+    where: float
+    size: int
+    data: bytes
+
+    def apply(self, raw: bytes) -> bytes:
+        at = min(int(self.where * len(raw)), max(len(raw) - 1, 0))
+        end = min(at + self.size, len(raw))
+        if self.kind == "flip":
+            if not raw:
+                return raw
+            return raw[:at] + bytes([raw[at] ^ (1 << (self.size % 8))]) + raw[at + 1 :]
+        if self.kind == "truncate":
+            return raw[:at]
+        if self.kind == "overwrite":
+            return raw[:at] + self.data[: end - at] + raw[at + len(self.data[: end - at]) :]
+        if self.kind == "delete":
+            return raw[:at] + raw[end:]
+        if self.kind == "duplicate":
+            return raw[:end] + raw[at:end] + raw[end:]
+        assert self.kind == "insert"
+        return raw[:at] + self.data + raw[at:]
+
+
+_MUTATION = st.builds(
+    Mutation,
+    kind=st.sampled_from(
+        ["flip", "flip", "truncate", "overwrite", "delete", "duplicate", "insert"]
+    ),
+    where=st.floats(0.0, 1.0),
+    size=st.integers(1, 4096),
+    data=st.binary(min_size=1, max_size=64),
+)
+
+
+def recording_mutations() -> st.SearchStrategy[list[Mutation]]:
+    """One to three edits of a recording's bytes."""
+    return st.lists(_MUTATION, min_size=1, max_size=3)
+
+
+# ---------------------------------------------------------------------------------- checks
+
+
+class _OverTime(Exception):
+    pass
+
+
+@contextlib.contextmanager
+def _time_bound(seconds: float) -> Iterator[None]:
+    """Raise :class:`_OverTime` in the block after ``seconds`` (a stall is a finding, not a
+    hang of the suite); main thread only."""
+
+    def expire(signum: int, frame: object) -> None:
+        raise _OverTime
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def _command(main: Callable[[list[str]], int], argv: list[str], prog: str) -> str | None:
+    """Run a command line in this process; what is wrong with how it ended, if anything:
+    exit 0, 1 or 2, and on 2 exactly one error line (warnings aside)."""
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+        code = main(argv)
+    lines = err.getvalue().splitlines()
+    errors = [line for line in lines if not line.startswith(f"{prog}: warning: ")]
+    if code not in (0, 1, 2):
+        return f"{prog} {' '.join(argv[:1])} exited {code}: {lines[-3:]}"
+    if code == 2 and (len(errors) != 1 or not errors[0].startswith(f"{prog}: error: ")):
+        return f"{prog} {argv[0]} exited 2 with {len(errors)} error line(s): {errors[:3]}"
+    if code != 2 and errors:
+        return f"{prog} {argv[0]} exited {code} but wrote {errors[:3]}"
+    return None
+
+
+def check_scenario(text: str, folder: Path) -> str | None:
+    """Parse the text (only :class:`ScenarioError` may come out); if it is a scenario, record
+    five steps of it with ``rsstp-sim record`` (exit 0, or 2 and one line)."""
+    began = time.perf_counter()
+    try:
+        with _time_bound(SCENARIO_SECONDS):
+            try:
+                parse_scenario(text, origin="fuzz.toml")
+            except RsstpError:
+                return None
+            path = folder / "fuzz.toml"
+            path.write_text(text, encoding="utf-8")
+            out = folder / "fuzz.mcap"
+            argv = ["record", str(path), "--steps", "5", "-o", str(out), "--force", "--quiet"]
+            return _command(sim_cli.main, argv, "rsstp-sim")
+    except _OverTime:
+        return f"over {SCENARIO_SECONDS} s ({time.perf_counter() - began:.1f} s)"
+    except Exception as exc:  # the finding: anything but the documented errors
+        return f"{type(exc).__name__}: {str(exc)[:300]}"
+
+
+class Written:
+    """A recording's bytes and what it holds, read from the intact file: the reference for a
+    damaged copy (a plain class, so that hypothesis prints it by its short repr)."""
+
+    def __init__(
+        self,
+        raw: bytes,
+        steps: pd.DataFrame,
+        models: dict[int, Any],
+        events: set[tuple[int, str, str, str]],
+    ) -> None:
+        self.raw = raw
+        self.steps = steps
+        self.models = models
+        self.events = events
+
+    @classmethod
+    def read(cls, path: Path) -> Written:
+        with open_recording(path) as recording:
+            return cls(
+                path.read_bytes(),
+                recording.steps(),
+                {record.version: record for record in recording.model_versions()},
+                _event_set(recording.events()),
+            )
+
+    def __repr__(self) -> str:
+        return f"Written({len(self.raw):,} bytes, {len(self.steps):,} steps)"
+
+
+def _event_set(events: pd.DataFrame) -> set[tuple[int, str, str, str]]:
+    return set(
+        zip(
+            events["step"].tolist(),
+            events["kind"].astype(str).tolist(),
+            events["text"].tolist(),
+            events["data"].tolist(),
+            strict=True,
+        )
+    )
+
+
+def _plain(table: pd.DataFrame) -> pd.DataFrame:
+    """The table with categorical columns as text: a file read in part holds fewer
+    categories, in the same order of first appearance."""
+    return table.astype({c: object for c in table.columns if table[c].dtype == "category"})
+
+
+def _not_written(path: Path, written: Written) -> str | None:
+    """Read the damaged file through the API: only :class:`ReplayError` may come out, and
+    every step, model version and event it returns must be one that was written."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnfinishedRecordingWarning)
+        try:
+            with open_recording(path) as recording:
+                steps = recording.steps()
+                models = recording.model_versions()
+                events = recording.events()
+                recording.memory()
+        except ReplayError:
+            return None
+    steps = _plain(steps)
+    original = _plain(written.steps).set_index("step", drop=False)
+    if len(steps) and not steps.step.isin(original.index).all():
+        return f"steps {sorted(set(steps.step) - set(original.index))[:5]} were never written"
+    expected = original.loc[steps["step"].to_numpy()].reset_index(drop=True)
+    if not steps.reset_index(drop=True).equals(expected):
+        changed = steps.reset_index(drop=True).compare(expected)
+        return f"steps read back differ from those written: {changed.head(3).to_dict()}"
+    for record in models:
+        if written.models.get(record.version) != record:
+            return f"model version {record.version} differs from the one written"
+    extra = _event_set(events) - written.events
+    if extra:
+        return f"events never written: {sorted(extra)[:2]}"
+    return None
+
+
+def check_recording(mutations: list[Mutation], written: Written, folder: Path) -> str | None:
+    """Damage a real recording's bytes, read it through the API and with ``rsstp-replay
+    check``; what went wrong, if anything."""
+    data = written.raw
+    for mutation in mutations:
+        data = mutation.apply(data)
+    path = folder / "fuzz.mcap"
+    path.write_bytes(data)
+    began = time.perf_counter()
+    try:
+        with _time_bound(RECORDING_SECONDS):
+            found = _not_written(path, written)
+            if found is not None:
+                return found
+            return _command(replay_cli.main, ["check", str(path)], "rsstp-replay")
+    except _OverTime:
+        return f"over {RECORDING_SECONDS} s ({time.perf_counter() - began:.1f} s)"
+    except Exception as exc:
+        return f"{type(exc).__name__}: {str(exc)[:300]}"

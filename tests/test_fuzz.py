@@ -1,0 +1,58 @@
+"""Fuzzing, a short budget in the default run (``bench/fuzz.py`` runs a long one): any
+scenario file is a scenario or one line; any damage to a recording is read as what was
+written, or refused in one line (see ``tests/fuzzing.py`` for the properties)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+
+from fuzzing import (
+    Mutation,
+    Written,
+    check_recording,
+    check_scenario,
+    recording_mutations,
+    scenario_texts,
+)
+from rsstp_sim import load_scenario, make_strategy
+from rsstp_sim.recording import record
+
+SHORT = settings(
+    max_examples=80,
+    deadline=None,
+    database=None,
+    derandomize=True,  # the same cases in every CI run; bench/fuzz.py explores
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
+
+
+@SHORT
+@given(text=scenario_texts())
+def test_any_scenario_file_is_a_scenario_or_one_line(text: str, tmp_path: Path) -> None:
+    assert check_scenario(text, tmp_path) is None
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory: pytest.TempPathFactory) -> Written:
+    """A real recording of several chunks, model versions and events."""
+    path = tmp_path_factory.mktemp("fuzz") / "run.mcap"
+    record(
+        path,
+        load_scenario("three-joint"),
+        make_strategy("splitter"),
+        steps=300,
+        seed=3,
+        chunk_size=8_192,
+    )
+    return Written.read(path)
+
+
+@SHORT
+@given(mutations=recording_mutations())
+def test_damage_to_a_recording_never_returns_what_was_not_written(
+    mutations: list[Mutation], reference: Written, tmp_path: Path
+) -> None:
+    assert check_recording(mutations, reference, tmp_path) is None
