@@ -281,7 +281,7 @@ def _check_output(out: Path, *, force: bool) -> None:
 
 def _cmd_view(args: argparse.Namespace) -> int:
     from rsstp_replay._viewer_serve import check_port, ctrl_c_remembered, has_display
-    from rsstp_replay.viewer import ViewerWarning, view
+    from rsstp_replay.viewer import ViewerWarning, ViewResult, view
 
     save = Path(args.save) if args.save is not None else None
     spawn = args.spawn or (save is None and not args.serve_web)
@@ -296,27 +296,28 @@ def _cmd_view(args: argparse.Namespace) -> int:
         check_port(args.bind, args.web_port, option="--web-port")
         check_port(args.bind, args.grpc_port, option="--grpc-port")
     with ctrl_c_remembered() as pressed:  # a Ctrl-C lost in a finaliser still stops serving
-        with (
-            _open(args.file) as recording,
-            warnings.catch_warnings(record=True) as caught,
-            progress(
-                1, "reading, auditing, logging to Rerun", unit="view", quiet=args.quiet
-            ) as bar,
-        ):
-            warnings.simplefilter("always", ViewerWarning)
-            result = view(
-                recording,
-                save=save,
-                spawn=spawn,
-                serve_web=args.serve_web,
-                start=args.start,
-                end=args.end,
-                bind=args.bind,
-                web_port=args.web_port,
-                grpc_port=args.grpc_port,
-            )
-            bar.to(1)
-        try:  # the server runs from here: Ctrl-C at any moment stops it and removes its file
+        result: ViewResult | None = None
+        try:  # once the server runs, Ctrl-C at any moment stops it and removes its file
+            with (
+                _open(args.file) as recording,
+                warnings.catch_warnings(record=True) as caught,
+                progress(
+                    1, "reading, auditing, logging to Rerun", unit="view", quiet=args.quiet
+                ) as bar,
+            ):
+                warnings.simplefilter("always", ViewerWarning)
+                result = view(
+                    recording,
+                    save=save,
+                    spawn=spawn,
+                    serve_web=args.serve_web,
+                    start=args.start,
+                    end=args.end,
+                    bind=args.bind,
+                    web_port=args.web_port,
+                    grpc_port=args.grpc_port,
+                )
+                bar.to(1)
             for warning in caught:
                 print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
             print(result.to_text())
@@ -326,10 +327,11 @@ def _cmd_view(args: argparse.Namespace) -> int:
                 print(f"serving on {args.bind} until Ctrl-C", flush=True)
                 result.serve_forever(pressed)
         except KeyboardInterrupt:
-            if not args.serve_web:
+            if result is None or not args.serve_web:  # still reading: "interrupted"
                 raise
         finally:
-            result.close()
+            if result is not None:
+                result.close()
     if args.serve_web:
         print("stopped serving")
     return 0

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import select
 import signal
 import socket
 import subprocess
@@ -170,34 +171,58 @@ def _listening(port: int) -> set[str]:
     return found
 
 
-@pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
-def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(tmp_path: Path) -> None:
-    """A real server: the page answers on 127.0.0.1, nothing listens on another address,
-    SIGINT stops it with exit 0 and removes the temporary file it served."""
-    web, grpc = _free_port(), _free_port()
-    server = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "rsstp_replay",
-            "view",
-            str(REFERENCE),
-            "--serve-web",
-            "--web-port",
-            str(web),
-            "--grpc-port",
-            str(grpc),
-        ],
+def _serve(web: int, grpc: int, tmp_path: Path) -> subprocess.Popen[str]:
+    """``rsstp-replay view REFERENCE --serve-web`` on these ports, its temporary files in
+    ``tmp_path``."""
+    return subprocess.Popen(
+        [sys.executable, "-m", "rsstp_replay", "view", str(REFERENCE), "--serve-web"]
+        + ["--web-port", str(web), "--grpc-port", str(grpc)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
         env={**os.environ, "TMPDIR": str(tmp_path)},
     )
+
+
+@pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
+def test_ctrl_c_as_the_server_starts_leaves_no_server(tmp_path: Path) -> None:
+    """SIGINT the moment the port listens, before the command has said so: whether it ends
+    as "interrupted" (130) or as a stopped server (0), no server and no file stay behind."""
+    web, grpc = _free_port(), _free_port()
+    server = _serve(web, grpc, tmp_path)
+    deadline = time.monotonic() + 60
+    while time.monotonic() < deadline and not _listening(web) and server.poll() is None:
+        time.sleep(0.01)
+    server.send_signal(signal.SIGINT)
     try:
+        _, err = server.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        server.kill()
+        _, err = server.communicate()
+        pytest.fail(f"still running 60 s after Ctrl-C: {err[-500:]}")
+    assert server.returncode in (0, 130), err
+    assert "Traceback" not in err
+    time.sleep(0.5)  # the server's child has had its SIGTERM; give the kernel a moment
+    assert not _listening(web) and not _listening(grpc)
+    assert not list(tmp_path.glob("rsstp-view-*"))
+
+
+@pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
+def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(tmp_path: Path) -> None:
+    """A real server: once it says it serves, the page answers on 127.0.0.1, nothing listens
+    on another address, and SIGINT stops it with exit 0 and removes the temporary file it
+    served. (A Ctrl-C before that line, while the file is read, is "interrupted", exit 130.)"""
+    web, grpc = _free_port(), _free_port()
+    server = _serve(web, grpc, tmp_path)
+    said = b""  # read from the pipe itself: a text reader's buffer would hide what it holds
+    try:
+        assert server.stdout is not None
         deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and not _listening(web):
+        while time.monotonic() < deadline and b"until Ctrl-C" not in said:
             assert server.poll() is None, server.communicate()[1]
-            time.sleep(0.2)
+            if select.select([server.stdout], [], [], 0.2)[0]:
+                said += os.read(server.stdout.fileno(), 4096)
+        assert b"until Ctrl-C" in said, said  # the server is up
         assert _listening(web) == {"0100007F"}  # 127.0.0.1 only
         assert _listening(grpc) == {"0100007F"}
         page = urllib.request.urlopen(f"http://127.0.0.1:{web}/", timeout=10).read()
@@ -211,6 +236,7 @@ def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(tmp_path: Path) -> No
             server.kill()
             out, err = server.communicate()
             pytest.fail(f"still serving 60 s after Ctrl-C: {err[-500:]}")
+    out = said.decode() + out
     assert server.returncode == 0, err
     assert "serving the web viewer at http://127.0.0.1:" in out and "stopped serving" in out
     assert "Traceback" not in err
