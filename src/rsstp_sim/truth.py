@@ -37,6 +37,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from rsstp_sim.errors import ModelError, RsstpError
 from rsstp_sim.geometry import IntArray
+from rsstp_sim.moore import moore_classes
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.world_table import WorldTable, pose_space_size
@@ -249,7 +250,7 @@ def compute_truth(scenario: Scenario, *, max_poses: int = 2_000_000) -> GroundTr
     start_index = int(rank[0])
     blocked = next_pose == np.arange(len(pose_codes))[:, None]
 
-    classes = _refine(next_pose, sensation)
+    classes = moore_classes(next_pose, sensation)
     true_class, class_next, class_sensation = _canonical(classes, next_pose, sensation, start_index)
     return GroundTruth(
         scenario_name=scenario.name,
@@ -268,48 +269,6 @@ def compute_truth(scenario: Scenario, *, max_poses: int = 2_000_000) -> GroundTr
 
 
 # -------------------------------------------------------------- minimisation
-
-
-def _refine(next_pose: IntArray, sensation: BoolArray) -> IntArray:
-    """Moore's partition refinement: the coarsest stable partition, as a class per pose.
-
-    Each round splits classes by the signature (class, class of each successor). The
-    signature's numbers are packed into as few 64-bit words as their bit width allows (two
-    for 39,000 classes and 6 actions), and one lexicographic sort of those words per round
-    numbers the new classes: exact, with no hashing.
-    """
-    classes = np.unique(sensation, return_inverse=True)[1].astype(np.int64).ravel()
-    count = int(classes.max()) + 1
-    size = len(classes)
-    while True:
-        columns = [classes, *(classes[next_pose[:, k]] for k in range(next_pose.shape[1]))]
-        words = _packed(columns, bits=max(1, count.bit_length()))
-        order = np.lexsort(words[::-1])
-        sorted_words = [word[order] for word in words]
-        starts = np.zeros(size, np.bool_)
-        if size:
-            starts[0] = True
-            for word in sorted_words:
-                starts[1:] |= word[1:] != word[:-1]
-        refined = np.empty(size, np.int64)
-        refined[order] = np.cumsum(starts) - 1
-        width = int(refined.max(initial=-1)) + 1
-        if width == count:
-            return classes
-        classes, count = refined, width
-
-
-def _packed(columns: list[IntArray], *, bits: int) -> list[IntArray]:
-    """The columns' values (each below ``2**bits``) packed into 64-bit words, in order: the
-    words sort as the rows of the columns do."""
-    per_word = max(1, 63 // bits)
-    words = []
-    for first in range(0, len(columns), per_word):
-        word = np.zeros_like(columns[0])
-        for column in columns[first : first + per_word]:
-            word = (word << bits) | column
-        words.append(word)
-    return words
 
 
 def _canonical(

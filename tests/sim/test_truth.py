@@ -39,23 +39,6 @@ def one_joint(step: int, *, actions: Sequence[int] = (0, 1), feedback: str = "")
 # ------------------------------------------------------------ reference code
 
 
-def naive_equivalence(next_state: Sequence[Sequence[int]], labels: Sequence[bool]) -> list[int]:
-    """Equivalence of the states of a Moore machine by table filling (class = least member)."""
-    n = len(labels)
-    apart = {(p, q) for p in range(n) for q in range(n) if labels[p] != labels[q]}
-    changed = True
-    while changed:
-        changed = False
-        for p, q in itertools.product(range(n), repeat=2):
-            if (p, q) not in apart and any(
-                (row_p, row_q) in apart
-                for row_p, row_q in zip(next_state[p], next_state[q], strict=True)
-            ):
-                apart.add((p, q))
-                changed = True
-    return [min(q for q in range(n) if (p, q) not in apart) for p in range(n)]
-
-
 def reference_counterexample(
     model: TransitionSystem, labels: Mapping[int, bool], truth: GroundTruth, start: int
 ) -> tuple[int, ...] | None:
@@ -350,25 +333,6 @@ def test_equality_ignores_seconds_and_reports() -> None:
 # -------------------------------------------------------------- minimisation
 
 
-@settings(max_examples=200, deadline=None)
-@given(st.data())
-def test_refinement_matches_table_filling(data: st.DataObject) -> None:
-    n = data.draw(st.integers(1, 8))
-    n_actions = data.draw(st.integers(1, 3))
-    next_state = data.draw(
-        st.lists(
-            st.lists(st.integers(0, n - 1), min_size=n_actions, max_size=n_actions),
-            min_size=n,
-            max_size=n,
-        )
-    )
-    labels = data.draw(st.lists(st.booleans(), min_size=n, max_size=n))
-    classes = truth_module._refine(np.array(next_state, dtype=np.int64), np.array(labels))
-    expected = naive_equivalence(next_state, labels)
-    for p, q in itertools.product(range(n), repeat=2):
-        assert (classes[p] == classes[q]) == (expected[p] == expected[q])
-
-
 # --------------------------------------------------------------- equivalence
 
 
@@ -459,30 +423,3 @@ def test_random_cycles(
         assert replay_fails(model, labels, truth, 0, found)
         if len(found) <= 10:
             assert found == brute_force_counterexample(model, labels, truth, len(found))
-
-
-@settings(max_examples=60, deadline=None)
-@given(
-    poses=st.integers(1, 60),
-    actions=st.integers(1, 4),
-    seed=st.integers(0, 2**32 - 1),
-)
-def test_refinement_is_the_coarsest_stable_partition(poses: int, actions: int, seed: int):
-    """The packed-word refinement against plain Python Moore refinement on random machines:
-    the same partition (pose p and q in one class exactly when they are in one class)."""
-    from rsstp_sim.truth import _refine
-
-    rng = np.random.default_rng(seed)
-    next_pose = rng.integers(0, poses, size=(poses, actions)).astype(np.int64)
-    sensation = rng.random(poses) < 0.3
-    found = _refine(next_pose, sensation)
-    classes = [int(s) for s in sensation]
-    while True:
-        signatures = [(classes[p], *(classes[int(q)] for q in next_pose[p])) for p in range(poses)]
-        numbering = {sig: i for i, sig in enumerate(sorted(set(signatures)))}
-        refined = [numbering[sig] for sig in signatures]
-        if len(set(refined)) == len(set(classes)):
-            break
-        classes = refined
-    same = {(p, q) for p in range(poses) for q in range(poses) if classes[p] == classes[q]}
-    assert same == {(p, q) for p in range(poses) for q in range(poses) if found[p] == found[q]}

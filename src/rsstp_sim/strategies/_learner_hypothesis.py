@@ -19,6 +19,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import NDArray
 
+from rsstp_sim.moore import moore_classes
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["FAR", "Hypothesis"]
@@ -351,20 +352,9 @@ class Hypothesis:
         Returns the merges done, as ``(kept, gone)``; the oldest state of a class is kept.
         """
         states = np.flatnonzero(self.alive)
-        block = self.label[states].astype(np.int64)
         index = np.full(len(self.label), -1, dtype=np.int64)
         index[states] = np.arange(len(states))
-        successors = index[self.next[states]]
-        count = len(np.unique(block))
-        while True:
-            signature = np.concatenate([block[:, None], block[successors]], axis=1)
-            _, refined = np.unique(signature, axis=0, return_inverse=True)
-            refined = refined.ravel().astype(np.int64)
-            refined_count = int(refined.max()) + 1
-            block = refined
-            if refined_count == count:
-                break
-            count = refined_count
+        block = moore_classes(index[self.next[states]], self.label[states])
         merges: list[tuple[int, int]] = []
         first: dict[int, int] = {}
         for s, b in zip(states.tolist(), block.tolist(), strict=True):
