@@ -7,7 +7,7 @@ A script written for the 2023 platform runs after one changed import line::
 
 Method names, argument orders and meanings are the original's (including the
 misspelt ``delete_conection_between_nodes``); the behaviour is this project's,
-with the original platform's defects fixed (``DESIGN.md`` section 1). The
+with the original platform's defects fixed (``docs/world.md``). The
 differences a script can notice:
 
 - **Nodes are matrix indices**, as in the original: node ``i`` is row ``i`` of

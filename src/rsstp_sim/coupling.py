@@ -1,4 +1,4 @@
-"""Coupling the agent with the world, one step at a time (DESIGN.md section 2).
+"""Coupling the agent with the world, one step at a time (docs/model.md).
 
 One step: the strategy picks an action; the world executes it (blocked or
 not); the internal state moves to a successor of (current state, action),

@@ -51,7 +51,7 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
 
     ## Description
 
-    The world of the RSSTP platform (thesis chapter 3, ``DESIGN.md`` section 1)
+    The world of the RSSTP platform (thesis chapter 3, ``docs/world.md``)
     with nothing of the agent: the arm's base is at the origin, joint angles are
     integer degrees, and every action turns one joint by the scenario's step.
     A move that would make a link meet an obstacle, two non-adjacent links

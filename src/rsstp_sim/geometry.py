@@ -4,7 +4,7 @@ Everything here is vectorised over a batch of poses so that the world (one
 pose at a time, cached) and the ground-truth enumeration (whole frontiers at
 once) share one implementation.
 
-Conventions (``../shared/DESIGN.md`` section 1): joint angles are integer
+Conventions (``docs/world.md``): joint angles are integer
 degrees in ``[0, 360)``; angle ``i`` is relative to link ``i-1`` (the first to
 the +x axis); the base is at the origin; coordinates are float64. Positions
 arrays have ``n + 1`` rows: the base, then the tip of every link.

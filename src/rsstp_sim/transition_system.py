@@ -14,7 +14,7 @@ Every operation that changes the model is logged as an :class:`Operation`, so a
 recording can carry the operations and a replay can rebuild the model at any
 step with :meth:`TransitionSystem.apply`.
 
-Two defects of the original platform are fixed here (DESIGN.md section 1):
+Two defects of the original platform are fixed here (docs/world.md, defects 9 and 10):
 ``merge`` moves a current state that disappears onto the surviving state
 (defect 9), and a duplicated action label inside one matrix cell is one
 transition, not nondeterminism (defect 10).
@@ -498,24 +498,6 @@ class TransitionSystem:
             model._link(s, a, t)
         return model
 
-    def is_isomorphic(self, other: TransitionSystem, *, respect_current: bool = False) -> bool:
-        """Same shape up to a renaming of state ids (actions are not renamed).
-
-        With ``respect_current`` the renaming must also map current to current.
-        Colour refinement prunes a backtracking search: fine for the model
-        sizes of this project, exponential only on highly symmetric inputs.
-        """
-        if (
-            len(self) != len(other)
-            or self._actions != other._actions
-            or len(self.transitions()) != len(other.transitions())
-        ):
-            return False
-        colours_a, colours_b = _refine_jointly(self, other, respect_current=respect_current)
-        if sorted(colours_a.values()) != sorted(colours_b.values()):
-            return False
-        return _match(self, other, colours_a, colours_b)
-
     # -------------------------------------------------------------- internals
 
     def _check(self, s: object, operation: str) -> None:
@@ -572,88 +554,3 @@ def _as_list(value: object, what: str) -> list[object]:
     if isinstance(value, str | bytes | Mapping) or not isinstance(value, Iterable):
         raise ModelError(f"snapshot: {what} must be a list, got {value!r}")
     return list(value)
-
-
-def _edge_labels(model: TransitionSystem) -> dict[tuple[int, int], frozenset[int]]:
-    labels: dict[tuple[int, int], set[int]] = {}
-    for s, a, t in model.transitions():
-        labels.setdefault((s, t), set()).add(a)
-    return {edge: frozenset(actions) for edge, actions in labels.items()}
-
-
-def _refine_jointly(
-    a: TransitionSystem, b: TransitionSystem, *, respect_current: bool
-) -> tuple[dict[int, int], dict[int, int]]:
-    """Stable colours of both systems' states, comparable across the two (1-WL)."""
-    systems = (a, b)
-    colours: list[dict[int, int]] = [
-        {s: int(respect_current and s == m.current) for s in m.states} for m in systems
-    ]
-    n_classes = len({c for cs in colours for c in cs.values()})
-    while True:
-        signatures = [
-            {
-                s: (
-                    cs[s],
-                    tuple(sorted((act, cs[t]) for act, t in _out_pairs(m, s))),
-                    tuple(sorted((act, cs[u]) for u, act in _in_pairs(m, s))),
-                )
-                for s in m.states
-            }
-            for m, cs in zip(systems, colours, strict=True)
-        ]
-        palette = {
-            sig: i for i, sig in enumerate(sorted({x for sg in signatures for x in sg.values()}))
-        }
-        colours = [{s: palette[sig] for s, sig in sg.items()} for sg in signatures]
-        if len(palette) == n_classes:
-            return colours[0], colours[1]
-        n_classes = len(palette)
-
-
-def _out_pairs(model: TransitionSystem, s: int) -> list[tuple[int, int]]:
-    return [(a, t) for a, targets in model._out[s].items() for t in targets]
-
-
-def _in_pairs(model: TransitionSystem, t: int) -> list[tuple[int, int]]:
-    return [(u, a) for a, sources in model._in[t].items() for u in sources]
-
-
-def _match(
-    a: TransitionSystem, b: TransitionSystem, colours_a: dict[int, int], colours_b: dict[int, int]
-) -> bool:
-    """Backtracking search for a colour-preserving bijection that preserves every edge label."""
-    labels_a, labels_b = _edge_labels(a), _edge_labels(b)
-    by_colour: dict[int, list[int]] = {}
-    for s in b.states:
-        by_colour.setdefault(colours_b[s], []).append(s)
-    order = sorted(a.states, key=lambda s: (len(by_colour[colours_a[s]]), s))
-    mapping: dict[int, int] = {}
-    used: set[int] = set()
-    empty: frozenset[int] = frozenset()
-
-    def consistent(x: int, y: int) -> bool:
-        if labels_a.get((x, x), empty) != labels_b.get((y, y), empty):
-            return False
-        for u, v in mapping.items():
-            if labels_a.get((x, u), empty) != labels_b.get((y, v), empty):
-                return False
-            if labels_a.get((u, x), empty) != labels_b.get((v, y), empty):
-                return False
-        return True
-
-    def extend(k: int) -> bool:
-        if k == len(order):
-            return True
-        x = order[k]
-        for y in by_colour[colours_a[x]]:
-            if y not in used and consistent(x, y):
-                mapping[x] = y
-                used.add(y)
-                if extend(k + 1):
-                    return True
-                del mapping[x]
-                used.discard(y)
-        return False
-
-    return extend(0)

@@ -1,4 +1,4 @@
-"""Ground truth: the world as a finite Moore machine, minimised (DESIGN.md section 5).
+"""Ground truth: the world as a finite Moore machine, minimised (docs/model.md).
 
 Joint angles are integers, so the poses reachable from the start pose are
 finitely many. With a blocked move read as a self-loop, those poses and the

@@ -1,4 +1,4 @@
-"""One regression test per defect of the original platform (DESIGN.md section 1).
+"""One regression test per defect of the original platform (docs/world.md).
 
 Each test fails on the original behaviour it is named after.
 """

@@ -1,6 +1,6 @@
 """The recorder: real MCAP files written through the ``mcap`` library and read back with it.
 
-A recording is checked against the contract of DESIGN.md section 4 and ``schemas/README.md``
+A recording is checked against the contract of docs/contract.md and ``schemas/README.md``
 (topics and counts, metadata, attachment, schemas byte for byte, step times, no wall-clock),
 against a live run with the same seed (the hand-assembled step bytes equal the record types'
 bytes; agent view = memory, truth = the world's poses), for determinism, for a strategy that

@@ -1,4 +1,4 @@
-"""The recorder: writes a run to MCAP as it happens (DESIGN.md section 4).
+"""The recorder: writes a run to MCAP as it happens (docs/contract.md, schemas/README.md).
 
 A layer around :class:`~rsstp_sim.coupling.Runner`, the way a monitor wraps an
 environment: the world and the model do not know a file exists. The recorder

@@ -50,7 +50,7 @@ class RouletteStrategy(StrategyBase):
     52 after 100 and 152 after 300 (the true model has 4), one new state every two moves, without
     bound. The internal states in the memory run along a chain, never round a cycle, and the last
     state of each moment stands for several poses: the memory itself contradicts half of them
-    (75 of the 152 states at 300 moves, DESIGN.md section 3), however long it runs.
+    (75 of the 152 states at 300 moves), however long it runs.
     """
 
     name: ClassVar[str] = "roulette"

@@ -141,7 +141,7 @@ class SplitterStrategy(StrategyBase):
     every state's histories were every state's).
 
     **Split.** A state whose histories contradict (two visits, the same actions, the same
-    sensations, then a different sensation: DESIGN.md section 3, within the horizon) is split
+    sensations, then a different sensation: docs/model.md, within the horizon) is split
     in two: the state keeps the side of the contradiction its first visit was on, the new state
     takes the other side (the original made one copy per contradicting history; one per side is
     enough, two sides being all a boolean sensation has). As the original's trim did, a
