@@ -26,6 +26,7 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
+from rsstp_replay.errors import BadStep, ReplayError
 from rsstp_sim.geometry import ArmGeometry, joint_positions, obstacle_distances
 
 __all__ = ["BadStep", "StepColumns", "blocker_label", "pose_numbers"]
@@ -93,16 +94,6 @@ _DECODERS: dict[bool, tuple[msgspec.json.Decoder[Any], msgspec.json.Decoder[Any]
 _ARITY = {"fold": 1, "obstacle": 2, "links": 2}
 
 
-class BadStep(Exception):
-    """A step message breaks the contract: ``index`` in the last batch, or ``step``."""
-
-    def __init__(self, text: str, *, index: int | None = None, step: int | None = None) -> None:
-        super().__init__(text)
-        self.text = text
-        self.index = index
-        self.step = step
-
-
 def blocker_label(kind: str, indices: tuple[int, ...]) -> str:
     """The ``blocked_by`` column's text: ``fold joint 1``, ``obstacle 1 link 2``, ``links 0 2``."""
     if len(indices) != _ARITY[kind]:
@@ -132,7 +123,7 @@ class StepColumns:
         geometry: ArmGeometry | None = None,
     ) -> None:
         if truth and geometry is None:
-            raise ValueError("the ground truth columns need the scenario's geometry")
+            raise ReplayError("the ground truth columns need the scenario's geometry")
         self.geometry = geometry
         self.n_rows = n_rows
         self.n_joints = n_joints

@@ -13,6 +13,7 @@ import subprocess
 import warnings
 from collections.abc import Iterable, Sequence
 
+from rsstp_replay.errors import ViewerWarning
 from rsstp_sim.graph import plain_positions, run_graphviz
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
@@ -20,14 +21,9 @@ from rsstp_sim.transition_system import TransitionSystem
 __all__ = [
     "DOT_MAX_PAIRS",
     "DOT_TIMEOUT_S",
-    "ViewerWarning",
     "graph_positions",
     "union_model",
 ]
-
-
-class ViewerWarning(UserWarning):
-    """Something the viewer could not show as asked; it showed what it could instead."""
 
 
 def union_model(

@@ -9,6 +9,7 @@ from __future__ import annotations
 from rsstp_sim.errors import RsstpError
 
 __all__ = [
+    "ViewerWarning",
     "CorruptRecording",
     "ForeignRecording",
     "NotARecording",
@@ -45,3 +46,18 @@ class StepOutOfRange(ReplayError):
 
 class UnfinishedRecordingWarning(UserWarning):
     """The file has no footer (the writer was killed): only its complete chunks were read."""
+
+
+class ViewerWarning(UserWarning):
+    """Something the viewer could not show as asked; it showed what it could instead."""
+
+
+class BadStep(Exception):
+    """A step message breaks the contract: ``index`` in the last batch, or ``step``. Internal:
+    the reader turns it into :class:`CorruptRecording` with the file and the step."""
+
+    def __init__(self, text: str, *, index: int | None = None, step: int | None = None) -> None:
+        super().__init__(text)
+        self.text = text
+        self.index = index
+        self.step = step

@@ -42,9 +42,10 @@ from rsstp_replay._contract import (
     rebuild_scenario,
     rsstp_channels,
 )
-from rsstp_replay._decode import BadStep, StepColumns
+from rsstp_replay._decode import StepColumns
 from rsstp_replay._models import build_model, verify_chain
 from rsstp_replay.errors import (
+    BadStep,
     CorruptRecording,
     ReplayError,
     StepOutOfRange,

@@ -38,11 +38,11 @@ from rsstp_replay import _viewer_plots as plots_part
 from rsstp_replay import _viewer_world as world_part
 from rsstp_replay._viewer_blueprint import default_blueprint
 from rsstp_replay._viewer_chunks import TIMELINE
-from rsstp_replay._viewer_layout import ViewerWarning, graph_positions
+from rsstp_replay._viewer_layout import graph_positions
 from rsstp_replay._viewer_serve import DEFAULT_BIND, CtrlC, WebServer, check_port
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
-from rsstp_replay.errors import ReplayError, StepOutOfRange
+from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
 from rsstp_sim import graph
 from rsstp_sim.errors import RsstpError
 from rsstp_sim.files import side_file

@@ -14,13 +14,9 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
 
-from rsstp_sim.errors import RsstpError
+from rsstp_sim.errors import RsstpError, UsageError
 
 __all__ = ["Parser", "Progress", "UsageError", "progress", "run_command"]
-
-
-class UsageError(RsstpError):
-    """A command-line argument is invalid."""
 
 
 class Parser(argparse.ArgumentParser):

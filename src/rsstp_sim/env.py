@@ -27,7 +27,7 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec
 from numpy.typing import NDArray
 
-from rsstp_sim.errors import ActionError
+from rsstp_sim.errors import ActionError, EnvError
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario, load_scenario
 from rsstp_sim.world import Pose, World
@@ -144,14 +144,14 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
         step_cost: float = 0.0,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
+            raise EnvError(
                 f"render_mode must be None or one of {self.metadata['render_modes']}, "
                 f"got {render_mode!r}"
             )
         if reward not in _REWARDS:
-            raise ValueError(f"reward must be one of {list(_REWARDS)}, got {reward!r}")
+            raise EnvError(f"reward must be one of {list(_REWARDS)}, got {reward!r}")
         if isinstance(step_cost, bool) or not isinstance(step_cost, int | float):
-            raise ValueError(f"step_cost must be a number, got {step_cost!r}")
+            raise EnvError(f"step_cost must be a number, got {step_cost!r}")
         self._reward = reward
         self._step_cost = float(step_cost)
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)

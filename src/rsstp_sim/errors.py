@@ -14,6 +14,11 @@ __all__ = [
     "RecordingError",
     "RecordingWriteError",
     "ActionError",
+    "EnvError",
+    "RecordFormatError",
+    "TruthError",
+    "UnknownPose",
+    "UsageError",
 ]
 
 
@@ -65,3 +70,24 @@ class RecordingWriteError(RecordingError):
 
 class ActionError(RsstpError):
     """An action is not one of the scenario's actions."""
+
+
+class RecordFormatError(RsstpError):
+    """A message does not have the shape of its record: the message names the field path."""
+
+
+class UsageError(RsstpError):
+    """A command-line argument is invalid."""
+
+
+class TruthError(RsstpError):
+    """The ground truth cannot be computed (pose space too large) or does not know a pose."""
+
+
+class EnvError(RsstpError, ValueError):
+    """An argument of the Gymnasium environment is invalid (a ``ValueError`` too, as
+    Gymnasium's users expect)."""
+
+
+class UnknownPose(RsstpError, KeyError):
+    """A pose code the world has not reached (a ``KeyError`` too: a lookup that missed)."""

@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rsstp_sim.errors import ModelError, RsstpError
+from rsstp_sim.errors import ModelError, TruthError
 from rsstp_sim.geometry import IntArray
 from rsstp_sim.moore import moore_classes
 from rsstp_sim.scenario import Scenario
@@ -52,10 +52,6 @@ __all__ = [
 ]
 
 BoolArray = NDArray[np.bool_]
-
-
-class TruthError(RsstpError):
-    """The ground truth cannot be computed (pose space too large) or does not know a pose."""
 
 
 @dataclass(frozen=True, eq=False)

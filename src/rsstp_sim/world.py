@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from rsstp_sim.errors import ActionError
+from rsstp_sim.errors import ActionError, UnknownPose
 from rsstp_sim.geometry import Blocker, FloatArray
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.world_table import WorldTable
@@ -92,7 +92,7 @@ class World:
         """The :class:`Pose` of a pose code the world has reached (see :attr:`pose_code`)."""
         row = self.table.row_of(code)
         if row < 0:
-            raise KeyError(f"pose code {code} has not been reached")
+            raise UnknownPose(f"pose code {code} has not been reached")
         return self._pose_at(row)
 
     def _expand(self, row: int) -> None:

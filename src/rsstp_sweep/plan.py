@@ -35,16 +35,13 @@ from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import RsstpError
 from rsstp_sim.scenario import Scenario, load_scenario
 from rsstp_sim.strategies import make_strategy
+from rsstp_sweep.errors import SweepError
 
 __all__ = ["Run", "Sweep", "SweepError", "load_sweep", "parse_sweep"]
 
 _TOP_LEVEL = frozenset({"steps", "seeds", "scenarios", "strategy"})
 _STRATEGY_KEYS = frozenset({"name", "params", "grid"})
 _MAX_RUNS = 100_000
-
-
-class SweepError(RsstpError):
-    """A sweep file is invalid (the message names the file and the key)."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -27,7 +27,7 @@ from typing import Any
 
 import pandas as pd
 
-from rsstp_sim.errors import RsstpError
+from rsstp_sweep.errors import ReportError
 
 __all__ = [
     "GATE_METRICS",
@@ -40,10 +40,6 @@ __all__ = [
     "summarize",
     "summary_text",
 ]
-
-
-class ReportError(RsstpError):
-    """A sweep directory or a gate cannot be read."""
 
 
 _OPERATORS: dict[str, Callable[[float, float], bool]] = {

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any, ClassVar, Literal, Self, TypeVar
 
 import msgspec
 
-from rsstp_sim.errors import RsstpError
+from rsstp_sim.errors import RecordFormatError
 from rsstp_sim.transition_system import Operation
 
 if TYPE_CHECKING:
@@ -82,10 +82,6 @@ EventKind = Literal[
     "blocked", "no_transition", "split", "merge", "add", "delete", "note", "contradiction"
 ]
 Point = tuple[float, float]
-
-
-class RecordFormatError(RsstpError):
-    """A message does not have the shape of its record: the message names the field path."""
 
 
 class _Record:
