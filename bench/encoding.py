@@ -44,7 +44,8 @@ import msgspec
 import orjson
 
 from rsstp_sim.coupling import Runner, StepOutcome
-from rsstp_sim.recording.records import StepRecord, decode, encode, step_record
+from rsstp_sim.recording.builders import step_record
+from rsstp_sim.recording.records import StepRecord, decode, encode
 from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import RandomStrategy
 from rsstp_sim.world import Pose

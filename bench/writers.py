@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import io
 import sys
 import tempfile
 import time
@@ -31,34 +32,26 @@ from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
 from _recordings import random_three_joint
+from rsstp_sim.recording.output import WriteThrough
 
 BIN = Path(sys.executable).parent
 CHUNK = 1024 * 1024
 Message = tuple[str, int, bytes]  # topic, log time (ns), data
 
 
-class CountingFile:
-    """A write-through file that counts the writes (the recorder's unbuffered file)."""
+class CountingFile(WriteThrough):
+    """The recorder's write-through file, counting the writes."""
 
     def __init__(self, path: Path) -> None:
-        self.raw = open(path, "wb", buffering=0)  # noqa: SIM115 - closed in close()
+        super().__init__(io.FileIO(path, "w"), lambda: 0)
         self.writes = 0
 
-    def write(self, data: bytes) -> int:
+    def write(self, data: bytes | bytearray | memoryview) -> int:
         self.writes += 1
-        return self.raw.write(data) or 0
+        return super().write(data)
 
-    def seek(self, offset: int, whence: int = 0) -> int:
-        return self.raw.seek(offset, whence)
-
-    def tell(self) -> int:
-        return self.raw.tell()
-
-    def flush(self) -> None:
-        return None
-
-    def close(self) -> None:
-        self.raw.close()
+    def seek(self, offset: int, whence: int = 0) -> int:  # the foxglove writer seeks
+        return self._raw.seek(offset, whence)
 
 
 def messages_of(steps: int) -> tuple[list[Message], dict[str, tuple[str, bytes]]]:

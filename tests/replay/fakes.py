@@ -20,7 +20,7 @@ import pandas as pd
 from rsstp_sim import Runner, Scenario, Strategy
 from rsstp_sim.coupling import Event
 from rsstp_sim.memory import Memory
-from rsstp_sim.recording import records
+from rsstp_sim.recording import builders, records
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.strategies import AgentView, StrategyBase
 from rsstp_sim.transition_system import Operation, TransitionSystem
@@ -73,7 +73,7 @@ class FakeRecording:
             pose = runner.world.current
             if outcome.blocker is not None:
                 self._events.append(
-                    records.blocked_event(
+                    builders.blocked_event(
                         outcome.step, action=outcome.action, blocker=outcome.blocker
                     )
                 )
@@ -119,13 +119,13 @@ class FakeRecording:
 
     def _add_model(self, step: int, operations: Sequence[Operation]) -> None:
         self._models.append(
-            records.model_record(self.runner.model, step=step, operations=operations)
+            builders.model_record(self.runner.model, step=step, operations=operations)
         )
-        self._events.extend(records.operation_events(step, operations))
+        self._events.extend(builders.operation_events(step, operations))
 
     def _on_event(self, event: Event) -> None:
         if event.kind == "note":
-            self._events.append(records.note_event(event.step, event.text))
+            self._events.append(builders.note_event(event.step, event.text))
 
     # -- what a Recording offers ------------------------------------------------------------
 

@@ -30,7 +30,7 @@ from rsstp_replay.recording import open_recording
 from rsstp_sim import Memory, RandomStrategy, load_scenario
 from rsstp_sim.errors import MemoryRangeError, ModelError
 from rsstp_sim.memory import CompareKind
-from rsstp_sim.recording import records
+from rsstp_sim.recording import builders, records
 from rsstp_sim.recording.recorder import record as record_run
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -42,10 +42,10 @@ def versions(
 ) -> list[records.ModelRecord]:
     """Model messages: ``start`` at step 0 (with its operations), then one per change."""
     model = start
-    result = [records.model_record(model, step=0, operations=model.drain_operations())]
+    result = [builders.model_record(model, step=0, operations=model.drain_operations())]
     for step, change in changes:
         change(model)
-        result.append(records.model_record(model, step=step, operations=model.drain_operations()))
+        result.append(builders.model_record(model, step=step, operations=model.drain_operations()))
     return result
 
 

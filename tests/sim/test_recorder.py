@@ -41,7 +41,7 @@ from rsstp_sim import (
     load_scenario,
     make_strategy,
 )
-from rsstp_sim.recording import records, schemas
+from rsstp_sim.recording import builders, records, schemas
 from rsstp_sim.recording.recorder import (
     DEFAULT_CHUNK_SIZE,
     Recorder,
@@ -116,7 +116,7 @@ def live_run(scenario: Scenario, strategy: Strategy, *, steps: int, seed: int) -
     runner = Runner(scenario, strategy, seed=seed)
     model = runner.model
     step_records = [
-        records.step_record(
+        builders.step_record(
             0,
             runner.world.current,
             action=None,
@@ -136,7 +136,7 @@ def live_run(scenario: Scenario, strategy: Strategy, *, steps: int, seed: int) -
         outcomes.append(outcome)
         poses.append(runner.world.current)
         step_records.append(
-            records.step_record(
+            builders.step_record(
                 outcome.step,
                 runner.world.current,
                 action=outcome.action,
@@ -322,13 +322,13 @@ def test_truth_part_is_the_worlds_poses(messages: list[Message], live: LiveRun) 
         assert [list(p) for p in truth.joint_positions] == pose.joint_positions.tolist()
         assert [list(row) for row in truth.distances] == pose.distances.tolist()
         assert truth.blocked == (blocker is not None)
-        assert truth.blocked_by == records.blocked_by_record(blocker)
+        assert truth.blocked_by == builders.blocked_by_record(blocker)
 
 
 def test_blocked_events_are_the_blocked_moves(messages: list[Message], live: LiveRun) -> None:
     events = list(decoded(messages, "/rsstp/event"))
     expected = [
-        records.blocked_event(o.step, action=o.action, blocker=o.blocker)
+        builders.blocked_event(o.step, action=o.action, blocker=o.blocker)
         for o in live.outcomes
         if o.blocker is not None
     ]

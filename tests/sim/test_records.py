@@ -29,7 +29,17 @@ from hypothesis import strategies as st
 from jsonschema import Draft202012Validator
 
 from rsstp_sim.coupling import Event, Runner
-from rsstp_sim.recording import records, schemas
+from rsstp_sim.recording import builders, records, schemas
+from rsstp_sim.recording.builders import (
+    blocked_event,
+    contradiction_event,
+    event_record,
+    model_record,
+    note_event,
+    operation_events,
+    scenario_record,
+    step_record,
+)
 from rsstp_sim.recording.records import (
     RECORD_TYPES,
     AgentRecord,
@@ -41,16 +51,8 @@ from rsstp_sim.recording.records import (
     ScenarioRecord,
     StepRecord,
     TruthRecord,
-    blocked_event,
-    contradiction_event,
     decode,
     encode,
-    event_record,
-    model_record,
-    note_event,
-    operation_events,
-    scenario_record,
-    step_record,
 )
 from rsstp_sim.recording.schemas import (
     SCHEMA_NAMES,
@@ -587,7 +589,7 @@ def test_builders_refuse_what_cannot_be_recorded() -> None:
 
 
 def test_docstring_examples_run() -> None:
-    for module in (records, schemas):
+    for module in (records, builders, schemas):
         result = doctest.testmod(module)
         assert result.attempted > 0 and result.failed == 0
 

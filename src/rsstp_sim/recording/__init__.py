@@ -2,101 +2,18 @@
 
 Recording is a layer around the simulation: these records are built from the runner's
 outcomes and the world's poses, never from inside them. ``schemas/README.md`` is the
-contract's documentation; :mod:`~rsstp_sim.recording.records` holds the record classes,
-their JSON conversion and the builders; :mod:`~rsstp_sim.recording.schemas` the schema
-files, topics and version policy.
+contract's documentation. :mod:`~rsstp_sim.recording.records` holds the record classes and
+their JSON conversion, :mod:`~rsstp_sim.recording.builders` makes them from live objects,
+:mod:`~rsstp_sim.recording.schemas` holds the schema files, topics and version policy.
 """
 
 from __future__ import annotations
 
-from rsstp_sim.recording.recorder import (
-    DEFAULT_CHUNK_SIZE,
-    Recorder,
-    RecordResult,
-    environment_versions,
-    record,
-)
-from rsstp_sim.recording.records import (
-    RECORD_TYPES,
-    AgentRecord,
-    BlockedByRecord,
-    EventRecord,
-    FeedbackRecord,
-    MessageRecord,
-    ModelRecord,
-    ObstacleRecord,
-    OperationRecord,
-    RecordFormatError,
-    ScenarioRecord,
-    StepRecord,
-    StrategyRecord,
-    TruthRecord,
-    blocked_by_record,
-    blocked_event,
-    contradiction_event,
-    decode,
-    encode,
-    event_record,
-    model_record,
-    no_transition_event,
-    note_event,
-    operation_events,
-    operation_record,
-    scenario_record,
-    step_record,
-)
-from rsstp_sim.recording.schemas import (
-    SCHEMA_NAMES,
-    SCHEMA_VERSION,
-    TOPICS,
-    check_schema_version,
-    parse_version,
-    schema_bytes,
-    schema_json,
-    validate,
-    validator,
-)
+# The package's names are its modules' public names, each listed once, in its module.
+from rsstp_sim.recording import builders, recorder, records, schemas
+from rsstp_sim.recording.builders import *  # noqa: F403
+from rsstp_sim.recording.recorder import *  # noqa: F403
+from rsstp_sim.recording.records import *  # noqa: F403
+from rsstp_sim.recording.schemas import *  # noqa: F403
 
-__all__ = [
-    "DEFAULT_CHUNK_SIZE",
-    "RecordResult",
-    "Recorder",
-    "environment_versions",
-    "record",
-    "RECORD_TYPES",
-    "SCHEMA_NAMES",
-    "SCHEMA_VERSION",
-    "TOPICS",
-    "AgentRecord",
-    "BlockedByRecord",
-    "EventRecord",
-    "FeedbackRecord",
-    "MessageRecord",
-    "ModelRecord",
-    "ObstacleRecord",
-    "OperationRecord",
-    "RecordFormatError",
-    "ScenarioRecord",
-    "StepRecord",
-    "StrategyRecord",
-    "TruthRecord",
-    "blocked_by_record",
-    "blocked_event",
-    "check_schema_version",
-    "contradiction_event",
-    "decode",
-    "encode",
-    "event_record",
-    "model_record",
-    "no_transition_event",
-    "note_event",
-    "operation_events",
-    "operation_record",
-    "parse_version",
-    "scenario_record",
-    "schema_bytes",
-    "schema_json",
-    "step_record",
-    "validate",
-    "validator",
-]
+__all__ = [*builders.__all__, *recorder.__all__, *records.__all__, *schemas.__all__]

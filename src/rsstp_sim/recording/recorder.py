@@ -14,22 +14,14 @@ runner's callbacks and writes:
 ``log_time`` of step ``t`` is ``t * 1_000_000`` ns; no wall-clock time is
 written, so the same scenario, strategy and seed give the same bytes.
 
-Crash safety: the recording is written to a side file, ``<name>.partial`` beside the
-output, and renamed onto the output only when finished: an existing recording (``force``)
-survives until the new one is whole, and nothing half written ever has the output's name.
-The side file holds an exclusive lock while it is written, so a second recorder on the same
-output is refused. It is written without a user-space buffer, so every chunk the writer
-completes is on disk at once; after a SIGKILL, a full disk or a file-size limit, the side
-file stays and a sequential reader recovers all its complete chunks (a later recorder
-refuses to replace it without ``force``). :meth:`Recorder.request_stop` (what the CLI's
+Crash safety: the recording goes to a locked side file, renamed onto the output only when
+finished (:mod:`rsstp_sim.recording.output`). :meth:`Recorder.request_stop` (what the CLI's
 SIGINT/SIGTERM handlers call) ends the run after the current step and the file is finished
 properly.
 """
 
 from __future__ import annotations
 
-import fcntl
-import io
 import json
 import os
 import platform
@@ -43,8 +35,9 @@ from mcap.writer import CompressionType, Writer
 
 from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.errors import RecordingError, RecordingWriteError
-from rsstp_sim.files import irregular, side_file
-from rsstp_sim.recording import records
+from rsstp_sim.files import side_file
+from rsstp_sim.recording import builders, records
+from rsstp_sim.recording.output import WriteThrough, open_side_file
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_MEDIA_TYPE,
     ATTACHMENT_NAME,
@@ -101,89 +94,6 @@ class RecordResult:
     interrupted: bool
 
 
-class _UnbufferedFile:
-    """A write-through file for the MCAP writer: each completed chunk reaches the OS at once.
-
-    (The writer would wrap a raw file in a ``BufferedWriter``, which could keep
-    the tail of a chunk in memory when the process is killed.) ``safe_steps`` is the last
-    step whose messages are all in complete chunks, as of the last write (the writer writes
-    only when a chunk is complete): what a reader recovers from the file as it stands.
-    """
-
-    def __init__(self, raw: io.FileIO, steps_done: Callable[[], int]) -> None:
-        self._raw = raw
-        self._steps_done = steps_done
-        self.safe_steps = 0
-        self.error: OSError | None = None  # the write error, told apart from other OSErrors
-
-    def write(self, data: bytes | bytearray | memoryview) -> int:
-        view = memoryview(data)
-        while view:
-            try:
-                written = self._raw.write(view)
-            except OSError as exc:
-                self.error = exc
-                raise
-            if written is None:  # pragma: no cover - only for non-blocking files
-                continue
-            view = view[written:]
-        if data:  # the step being written may have messages after this chunk: not counted
-            self.safe_steps = max(0, self._steps_done() - 1)
-        return len(data)
-
-    def tell(self) -> int:
-        return self._raw.tell()
-
-    def flush(self) -> None:
-        return None
-
-    def close(self) -> None:
-        self._raw.close()
-
-
-def _open_output(path: Path, *, force: bool) -> io.FileIO:
-    """Open the side file of ``path`` for writing, locked; refuse what must not be replaced."""
-    parent = path.parent if str(path.parent) else Path(".")
-    if path.is_dir():
-        raise RecordingError(f"{path}: is a directory, not an output file")
-    partial = side_file(path)
-    for checked in (path, partial):
-        kind = irregular(checked)
-        if kind is not None:
-            raise RecordingError(
-                f"{checked}: {kind}: only a regular file is ever written or replaced"
-            )
-    if not parent.is_dir():
-        found = "is not a directory" if parent.exists() else "does not exist"
-        raise RecordingError(f"{path}: the output directory {parent} {found}")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise RecordingError(f"{path}: the output directory {parent} is not writable")
-    if path.exists() and not force:
-        raise RecordingError(f"{path}: already exists (use --force to overwrite)")
-    try:
-        fd = os.open(partial, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
-    except OSError as exc:
-        raise RecordingError(f"{path}: cannot open for writing: {exc.strerror or exc}") from None
-    try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            raise RecordingError(
-                f"{path}: another recording is being written there (its side file "
-                f"{partial.name} is locked)"
-            ) from None
-        if os.fstat(fd).st_size and not force:
-            raise RecordingError(
-                f"{partial}: left by an interrupted recording; read it with rsstp-replay, "
-                "move it away, or use --force to replace it"
-            )
-        os.ftruncate(fd, 0)
-        return io.FileIO(fd, "w", closefd=True)
-    except BaseException:
-        os.close(fd)
-        raise
-
-
 class Recorder:
     """Runs a strategy in a scenario and records every step to an MCAP file.
 
@@ -224,8 +134,8 @@ class Recorder:
         self._pose_parts: dict[int, tuple[bytes, bytes]] = {}
         self._counts = dict.fromkeys(TOPICS, 0)
         self.side_file = side_file(self.path)
-        self._raw = _open_output(self.path, force=force)
-        self._file = _UnbufferedFile(self._raw, lambda: self.runner.step_index)
+        self._raw = open_side_file(self.path, force=force)
+        self._file = WriteThrough(self._raw, lambda: self.runner.step_index)
         self._writer = Writer(
             self._file,  # type: ignore[arg-type]
             chunk_size=chunk_size,
@@ -249,11 +159,11 @@ class Recorder:
         # Steps with no transition are recorded from the step outcome (it has the
         # state and the action); the runner's events add the strategy notes.
         if event.kind == "note":
-            self._pending_events.append(records.note_event(event.step, event.text))
+            self._pending_events.append(builders.note_event(event.step, event.text))
 
     def _on_model_change(self, step: int, operations: Sequence[Operation]) -> None:
         self._pending_models.append((step, tuple(operations)))
-        self._pending_events.extend(records.operation_events(step, operations))
+        self._pending_events.extend(builders.operation_events(step, operations))
 
     # -- writing ----------------------------------------------------------------
 
@@ -280,7 +190,7 @@ class Recorder:
         writer.add_attachment(
             0, 0, ATTACHMENT_NAME, ATTACHMENT_MEDIA_TYPE, scenario.source.encode("utf-8")
         )
-        record = records.scenario_record(
+        record = builders.scenario_record(
             scenario, seed=seed, strategy_name=strategy.name, strategy_params=params
         )
         self._add("/rsstp/scenario", 0, records.encode(record))
@@ -359,11 +269,11 @@ class Recorder:
         lead = []
         if outcome.blocker is not None:
             lead.append(
-                records.blocked_event(outcome.step, action=outcome.action, blocker=outcome.blocker)
+                builders.blocked_event(outcome.step, action=outcome.action, blocker=outcome.blocker)
             )
         if outcome.no_transition:
             lead.append(
-                records.no_transition_event(
+                builders.no_transition_event(
                     outcome.step, state=outcome.state_before, action=outcome.action
                 )
             )
@@ -372,7 +282,7 @@ class Recorder:
     def _flush_pending(self, step: int) -> None:
         model = self.runner.model
         for model_step, operations in self._pending_models:
-            record = records.model_record(model, step=model_step, operations=operations)
+            record = builders.model_record(model, step=model_step, operations=operations)
             self._add("/rsstp/model", step, records.encode(record))
         for event in self._pending_events:
             self._add("/rsstp/event", event.step, records.encode(event))

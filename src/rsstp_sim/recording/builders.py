@@ -1,0 +1,288 @@
+"""Building records from the simulator's live objects: the scenario, a step's outcome and
+pose, a model version, and the events (blocked moves, missing transitions, refinements,
+contradictions, notes). :mod:`rsstp_sim.recording.records` says what the records are.
+
+>>> note_event(3, "exploring joint 1")
+EventRecord(step=3, kind='note', text='exploring joint 1', data={})
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Any
+
+import msgspec
+
+from rsstp_sim.errors import RecordFormatError
+from rsstp_sim.recording.records import (
+    AgentRecord,
+    BlockedByRecord,
+    EventRecord,
+    FeedbackRecord,
+    ModelRecord,
+    ObstacleRecord,
+    OperationRecord,
+    ScenarioRecord,
+    StepRecord,
+    StrategyRecord,
+    TruthRecord,
+    encode_json,
+)
+from rsstp_sim.transition_system import Operation
+
+if TYPE_CHECKING:
+    from rsstp_sim.coupling import Event
+    from rsstp_sim.geometry import Blocker
+    from rsstp_sim.scenario import Scenario
+    from rsstp_sim.transition_system import TransitionSystem
+    from rsstp_sim.world import Pose
+
+__all__ = [
+    "blocked_by_record",
+    "blocked_event",
+    "contradiction_event",
+    "event_record",
+    "model_record",
+    "no_transition_event",
+    "note_event",
+    "operation_events",
+    "operation_record",
+    "scenario_record",
+    "step_record",
+]
+
+
+def scenario_record(
+    scenario: Scenario, *, seed: int, strategy_name: str, strategy_params: Mapping[str, Any]
+) -> ScenarioRecord:
+    """The ``rsstp.Scenario`` message of a run.
+
+    ``origin`` keeps only the base name of a scenario file (recordings must not depend on
+    the directory they were made in); ``strategy_params`` must be JSON-serialisable.
+    """
+    try:
+        params = msgspec.json.decode(encode_json(dict(strategy_params)))
+    except (TypeError, msgspec.EncodeError) as exc:
+        raise RecordFormatError(
+            f"rsstp.Scenario: strategy.params: expected JSON values, found "
+            f"{dict(strategy_params)!r} ({exc})"
+        ) from None
+    target = scenario.feedback_target_deg
+    return ScenarioRecord(
+        name=scenario.name,
+        description=scenario.description,
+        origin=re.split(r"[\\/]", scenario.origin)[-1],
+        sha256=scenario.sha256,
+        n_joints=scenario.n_joints,
+        lengths=tuple(float(v) for v in scenario.lengths),
+        initial_deg=tuple(int(v) for v in scenario.initial_deg),
+        step_deg=int(scenario.step_deg),
+        actions=tuple(int(v) for v in scenario.actions),
+        obstacles=tuple(
+            ObstacleRecord((float(o.center[0]), float(o.center[1])), float(o.radius))
+            for o in scenario.obstacles
+        ),
+        feedback=FeedbackRecord(
+            mode=scenario.feedback_mode,
+            tolerance=float(scenario.tolerance),
+            tolerance_abs=float(scenario.tolerance * scenario.total_length),
+            points=tuple((float(x), float(y)) for x, y in scenario.feedback_points),
+            target_deg=None if target is None else tuple(int(v) for v in target),
+        ),
+        collision=scenario.collision,
+        seed=int(seed),
+        strategy=StrategyRecord(str(strategy_name), params),
+    )
+
+
+def step_record(
+    step: int,
+    pose: Pose,
+    *,
+    action: int | None,
+    state_before: int | None,
+    internal_state: int,
+    model_version: int,
+    no_transition: bool,
+    blocker: Blocker | None,
+) -> StepRecord:
+    """The ``rsstp.Step`` message of step ``step`` ending in the world pose ``pose``.
+
+    ``action`` and ``state_before`` are None at step 0 (the reset); ``blocker`` is the
+    world's answer to the move (None when the arm moved, and at step 0).
+    """
+    return StepRecord(
+        int(step),
+        AgentRecord(
+            None if action is None else int(action),
+            None if state_before is None else int(state_before),
+            int(internal_state),
+            bool(pose.sensation),
+            float(pose.feedback),
+            int(model_version),
+            bool(no_transition),
+        ),
+        _truth_record(pose, blocker),
+    )
+
+
+@functools.lru_cache(maxsize=1 << 12)
+def _truth_record(pose: Pose, blocker: Blocker | None) -> TruthRecord:
+    """A pose's truth (and the move's blocker); poses are cached read-only objects, so a
+    random walk revisiting them gets the same immutable record."""
+    positions: list[list[float]] = pose.joint_positions.tolist()
+    distances: list[list[float]] = pose.distances.tolist()
+    return TruthRecord(
+        tuple(int(v) for v in pose.angles_deg),
+        tuple((x, y) for x, y in positions),
+        blocker is not None,
+        blocked_by_record(blocker),
+        tuple(tuple(row) for row in distances),
+    )
+
+
+def blocked_by_record(blocker: Blocker | None) -> BlockedByRecord | None:
+    """The record of a :class:`~rsstp_sim.geometry.Blocker` (None stays None)."""
+    if blocker is None:
+        return None
+    return BlockedByRecord(blocker.kind, tuple(int(i) for i in blocker.indices))
+
+
+def operation_record(op: Operation) -> OperationRecord:
+    """The record of a model :class:`~rsstp_sim.transition_system.Operation`."""
+    return OperationRecord(
+        op.kind,
+        tuple(int(v) for v in op.args),
+        None if op.result is None else int(op.result),
+        bool(op.changed),
+    )
+
+
+def model_record(
+    model: TransitionSystem, *, step: int, operations: Iterable[Operation]
+) -> ModelRecord:
+    """The ``rsstp.Model`` message: ``model`` as it is at ``step``, after ``operations``."""
+    transitions = tuple(model.transitions())
+    pairs = 0
+    run = 0
+    previous: tuple[int, int] | None = None
+    for s, a, _ in transitions:
+        if (s, a) == previous:
+            run += 1
+            if run == 2:
+                pairs += 1
+        else:
+            previous, run = (s, a), 1
+    return ModelRecord(
+        version=int(model.version),
+        step=int(step),
+        states=model.states,
+        next_id=int(model.next_id),
+        current=int(model.current),
+        actions=model.actions,
+        transitions=transitions,
+        operations=tuple(operation_record(op) for op in operations),
+        deterministic=pairs == 0,
+        nondeterministic_pairs=pairs,
+    )
+
+
+def blocked_event(step: int, *, action: int, blocker: Blocker) -> EventRecord:
+    """A ``blocked`` event: ``action`` did not move the arm, because of ``blocker``."""
+    by = {"kind": blocker.kind, "indices": [int(i) for i in blocker.indices]}
+    return EventRecord(
+        int(step),
+        "blocked",
+        f"action {action} blocked: {blocker.describe()}",
+        {"action": int(action), "blocked_by": by},
+    )
+
+
+def no_transition_event(step: int, *, state: int, action: int) -> EventRecord:
+    """A ``no_transition`` event: the model had no transition from ``state`` by ``action``."""
+    return EventRecord(
+        int(step),
+        "no_transition",
+        f"no transition from state {state} by action {action}: the internal state stays",
+        {"state": int(state), "action": int(action)},
+    )
+
+
+def note_event(step: int, text: str) -> EventRecord:
+    """A strategy ``note`` (line breaks become spaces: an event is one line)."""
+    return EventRecord(int(step), "note", _one_line(text), {})
+
+
+def event_record(
+    event: Event, *, state: int | None = None, action: int | None = None
+) -> EventRecord:
+    """The record of a :class:`~rsstp_sim.coupling.Event` from the runner's ``on_event``.
+
+    A ``no_transition`` event needs the ``state`` that stayed and the ``action`` (the
+    runner's event only says them in its text); a ``note`` needs nothing more.
+    """
+    if event.kind == "note":
+        return note_event(event.step, event.text)
+    if state is None or action is None:
+        raise RecordFormatError(
+            f"rsstp.Event: a {event.kind} event needs state and action, "
+            f"found state={state!r}, action={action!r}"
+        )
+    return EventRecord(
+        int(event.step),
+        "no_transition",
+        _one_line(event.text),
+        {"state": int(state), "action": int(action)},
+    )
+
+
+def operation_events(step: int, operations: Iterable[Operation]) -> tuple[EventRecord, ...]:
+    """One ``split``/``merge``/``add``/``delete`` event per model operation."""
+    return tuple(
+        EventRecord(
+            int(step),
+            op.kind,
+            _describe_operation(op),
+            {
+                "args": [int(v) for v in op.args],
+                "result": None if op.result is None else int(op.result),
+            },
+        )
+        for op in operations
+    )
+
+
+def contradiction_event(
+    step: int, *, state: int, i: int, j: int, actions: Iterable[int], text: str | None = None
+) -> EventRecord:
+    """A ``contradiction`` event: steps ``i < j`` in ``state`` disagree after ``actions``."""
+    acts = [int(a) for a in actions]
+    line = (
+        text
+        if text is not None
+        else (
+            f"state {state} is contradictory: steps {i} and {j} then actions {acts} "
+            f"end in different sensations"
+        )
+    )
+    return EventRecord(
+        int(step),
+        "contradiction",
+        _one_line(line),
+        {"state": int(state), "i": int(i), "j": int(j), "actions": acts},
+    )
+
+
+def _describe_operation(op: Operation) -> str:
+    if op.kind == "split":
+        return f"split state {op.args[0]}: new state {op.result}"
+    if op.kind == "merge":
+        return f"merge state {op.args[1]} into state {op.args[0]}"
+    s, t, a = op.args
+    return f"{op.kind} transition {s} -{a}-> {t}"
+
+
+def _one_line(text: str) -> str:
+    return " ".join(text.splitlines()) if "\n" in text or "\r" in text else text
