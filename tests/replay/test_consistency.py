@@ -261,18 +261,18 @@ def test_bad_columns(columns: tuple[object, object, object], message: str) -> No
 def test_range_minima_and_nearest_smaller_against_brute_force(values: list[int], seed: int):
     """The O(n)-memory range minima (blocks of 256) and the pointer-jumping nearest position
     with a value at most one's own, against plain Python."""
-    from rsstp_replay.audits.consistency import _nearest_at_most, _RangeMin
+    from rsstp_replay.audits._suffixes import RangeMin, nearest_at_most
 
     array = np.array(values, dtype=np.int64)
     rng = np.random.default_rng(seed)
     first = rng.integers(0, len(array), 300)
     last = np.minimum(first + rng.integers(0, 1200, 300), len(array) - 1)
-    found = _RangeMin(array).query(first, last)
+    found = RangeMin(array).query(first, last)
     assert found.tolist() == [min(values[f : e + 1]) for f, e in zip(first, last, strict=True)]
     fenced = np.array([-1, *values, -1], dtype=np.int64)  # as boundary_lcp: -1 at both ends
     inner = np.arange(1, len(fenced) - 1)
-    before = _nearest_at_most(fenced, inner, step=-1)
-    after = _nearest_at_most(fenced, inner, step=1)
+    before = nearest_at_most(fenced, inner, step=-1)
+    after = nearest_at_most(fenced, inner, step=1)
     for p, b, a in zip(inner.tolist(), before.tolist(), after.tolist(), strict=True):
         assert b == max(c for c in range(p) if fenced[c] <= fenced[p])
         assert a == min(c for c in range(p + 1, len(fenced)) if fenced[c] <= fenced[p])
