@@ -16,6 +16,7 @@ import pandas as pd
 import rerun as rr
 
 from rsstp_replay._viewer_chunks import send_rows
+from rsstp_sim import palette
 from rsstp_sim.scenario import Scenario
 
 __all__ = [
@@ -39,13 +40,6 @@ FEEDBACK_POINTS = "world/feedback_points"
 SENSOR = "world/sensor"
 BLOCKED = "world/blocked"
 
-_ARM_COLOR = (70, 130, 200)
-_BLOCKED_COLOR = (230, 40, 40)
-_JOINT_COLOR = (40, 40, 40)
-_OBSTACLE_FILL = (225, 140, 140)
-_OBSTACLE_EDGE = (190, 60, 60)
-_FEEDBACK_COLOR = (40, 170, 80)
-_SENSOR_COLORS = ((230, 150, 30), (150, 90, 200), (30, 160, 160), (200, 90, 130))
 
 _Floats = npt.NDArray[np.float64]
 
@@ -60,17 +54,19 @@ def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
         labels = [f"obstacle {j}" for j in range(len(radii))]
         stream.log(
             OBSTACLES,
-            rr.Points2D(centers, radii=radii, colors=_OBSTACLE_FILL, labels=labels, draw_order=1.0),
+            rr.Points2D(
+                centers, radii=radii, colors=palette.OBSTACLE, labels=labels, draw_order=1.0
+            ),
             rr.Ellipses2D(
                 centers=centers,
                 half_sizes=np.stack([radii, radii], axis=1),
-                colors=_OBSTACLE_EDGE,
+                colors=palette.OBSTACLE_EDGE,
                 line_radii=rr.Radius.ui_points(1.5),
                 draw_order=2.0,
             ),
             static=True,
         )
-        colors = [_SENSOR_COLORS[j % len(_SENSOR_COLORS)] for j in range(len(radii))]
+        colors = [palette.SENSORS[j % len(palette.SENSORS)] for j in range(len(radii))]
         stream.log(
             SENSOR,
             rr.LineStrips2D.from_fields(
@@ -86,7 +82,7 @@ def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
         rr.Points2D(
             points,
             radii=rr.Radius.ui_points(5.0),
-            colors=_FEEDBACK_COLOR,
+            colors=palette.FEEDBACK,
             labels=[f"f{k}" for k in range(len(points))],
             draw_order=4.0,
         ),
@@ -96,14 +92,14 @@ def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
         ARM,
         rr.LineStrips2D.from_fields(radii=rr.Radius.ui_points(3.0), draw_order=5.0),
         rr.Points2D.from_fields(
-            radii=rr.Radius.ui_points(4.0), colors=_JOINT_COLOR, draw_order=6.0
+            radii=rr.Radius.ui_points(4.0), colors=palette.JOINT, draw_order=6.0
         ),
         static=True,
     )
     stream.log(
         BLOCKED,
         rr.Points2D.from_fields(
-            radii=rr.Radius.ui_points(8.0), colors=_BLOCKED_COLOR, draw_order=7.0
+            radii=rr.Radius.ui_points(8.0), colors=palette.ARM_BLOCKED, draw_order=7.0
         ),
         static=True,
     )
@@ -151,7 +147,7 @@ def log_world(
     moved = np.r_[True, (positions[1:] != positions[:-1]).any(axis=(1, 2))]
     arm_rows = np.flatnonzero(moved | np.r_[True, blocked[1:] != blocked[:-1]])
     strips = positions[arm_rows].astype(np.float32)  # what Rerun stores
-    colors = np.where(blocked[arm_rows, None], _BLOCKED_COLOR, _ARM_COLOR).astype(np.uint8)
+    colors = np.where(blocked[arm_rows, None], palette.ARM_BLOCKED, palette.ARM).astype(np.uint8)
     logged = {
         ARM: send_rows(
             stream,

@@ -27,6 +27,7 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec
 from numpy.typing import NDArray
 
+from rsstp_sim import palette
 from rsstp_sim.errors import ActionError, EnvError
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario, load_scenario
@@ -260,12 +261,6 @@ def register_envs() -> None:
 # -- rgb_array drawing, numpy only ---------------------------------------------------------
 
 _SIZE_PX = 400
-_WHITE = (255, 255, 255)
-_OBSTACLE = (200, 200, 200)
-_FEEDBACK = (44, 160, 44)
-_ARM = (31, 119, 180)
-_ARM_BLOCKED = (255, 127, 14)
-_JOINT = (40, 40, 40)
 
 
 class _Canvas:
@@ -275,12 +270,14 @@ class _Canvas:
         self.half_width = 1.1 * scenario.total_length  # the arm always fits
         self.px_per_unit = _SIZE_PX / (2.0 * self.half_width)
         background = np.empty((_SIZE_PX, _SIZE_PX, 3), dtype=np.uint8)
-        background[:] = _WHITE
+        background[:] = palette.BACKGROUND
         for obstacle in scenario.obstacles:
-            self._disk(background, obstacle.center, obstacle.radius * self.px_per_unit, _OBSTACLE)
+            self._disk(
+                background, obstacle.center, obstacle.radius * self.px_per_unit, palette.OBSTACLE
+            )
         for point in scenario.feedback_points:
-            self._disk(background, point, 6.0, _FEEDBACK)
-            self._disk(background, point, 3.5, _WHITE)
+            self._disk(background, point, 6.0, palette.FEEDBACK)
+            self._disk(background, point, 3.5, palette.BACKGROUND)
         self.background = background
 
     def to_px(self, xy: tuple[float, float] | NDArray[np.float64]) -> tuple[float, float]:
@@ -330,11 +327,11 @@ class _Canvas:
 
     def draw(self, joint_positions: NDArray[np.float64], *, blocked: bool) -> NDArray[np.uint8]:
         image = self.background.copy()
-        color = _ARM_BLOCKED if blocked else _ARM
+        color = palette.ARM_BLOCKED if blocked else palette.ARM
         for k in range(len(joint_positions) - 1):
             self._segment(image, joint_positions[k], joint_positions[k + 1], 3.0, color)
         for point in joint_positions:
-            self._disk(image, point, 4.5, _JOINT)
+            self._disk(image, point, 4.5, palette.JOINT)
         return image
 
 

@@ -10,6 +10,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from rsstp_sim import env as env_module
+from rsstp_sim import palette
 from rsstp_sim.env import ENV_ID, MAX_EPISODE_STEPS, ArmEnv, register_envs
 from rsstp_sim.errors import ActionError, ScenarioError
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
@@ -242,14 +243,14 @@ def test_render() -> None:
     assert isinstance(frame, np.ndarray)
     assert frame.shape == (400, 400, 3) and frame.dtype == np.uint8
     assert (frame == 255).all(axis=2).mean() > 0.5  # mostly white background
-    blue = (frame == (31, 119, 180)).all(axis=2).sum()
+    blue = (frame == palette.ARM).all(axis=2).sum()
     assert blue > 100  # the arm
     for _ in range(5):
         arm_env.step(MINUS)  # the last move is blocked
     blocked = arm_env.render()
     assert isinstance(blocked, np.ndarray)
-    assert (blocked == (31, 119, 180)).all(axis=2).sum() == 0
-    assert (blocked == (255, 127, 14)).all(axis=2).sum() > 100
+    assert (blocked == palette.ARM).all(axis=2).sum() == 0
+    assert (blocked == palette.ARM_BLOCKED).all(axis=2).sum() > 100
 
 
 def test_bad_constructor_arguments() -> None:
