@@ -33,6 +33,7 @@ from fuzzing import (  # noqa: E402 (the test suite's folder goes on the path fi
     check_scenario,
     recording_mutations,
     scenario_texts,
+    splitter_run,
 )
 from rsstp_sim import load_scenario, make_strategy  # noqa: E402
 from rsstp_sim.recording import record  # noqa: E402
@@ -94,18 +95,9 @@ def explore(
 
 
 def reference_recordings(folder: Path) -> list[Written]:
-    three = folder / "three-joint-splitter.mcap"
-    record(
-        three,
-        load_scenario("three-joint"),
-        make_strategy("splitter"),
-        steps=300,
-        seed=3,
-        chunk_size=8_192,
-    )
     two = folder / "two-joint-learner.mcap"
     record(two, load_scenario("two-joint-30"), make_strategy("learner"), steps=400, seed=5)
-    return [Written.read(three), Written.read(two)]
+    return [splitter_run(folder), Written.read(two)]
 
 
 def main() -> int:

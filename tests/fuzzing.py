@@ -33,8 +33,9 @@ from hypothesis import strategies as st
 from conftest import VALID_SCENARIO, toml_text
 from rsstp_replay import ReplayError, UnfinishedRecordingWarning, open_recording
 from rsstp_replay import cli as replay_cli
-from rsstp_sim import RsstpError, parse_scenario
+from rsstp_sim import RsstpError, load_scenario, make_strategy, parse_scenario
 from rsstp_sim import cli as sim_cli
+from rsstp_sim.recording import record
 
 SCENARIO_SECONDS = 10.0
 """Time bound of one scenario case: validate, then run and record a few steps."""
@@ -328,6 +329,21 @@ class Written:
         return f"Written({len(self.raw):,} bytes, {len(self.steps):,} steps)"
 
 
+def splitter_run(folder: Path) -> Written:
+    """The recording the fuzz cases damage: a three-joint splitter run of 300 steps in chunks of
+    8 KiB, so it holds several chunks, model versions and events."""
+    path = folder / "three-joint-splitter.mcap"
+    record(
+        path,
+        load_scenario("three-joint"),
+        make_strategy("splitter"),
+        steps=300,
+        seed=3,
+        chunk_size=8_192,
+    )
+    return Written.read(path)
+
+
 def _event_set(events: pd.DataFrame) -> set[tuple[int, str, str, str]]:
     return set(
         zip(
@@ -367,9 +383,9 @@ def _not_written(path: Path, written: Written) -> str | None:
     if not steps.reset_index(drop=True).equals(expected):
         changed = steps.reset_index(drop=True).compare(expected)
         return f"steps read back differ from those written: {changed.head(3).to_dict()}"
-    for record in models:
-        if written.models.get(record.version) != record:
-            return f"model version {record.version} differs from the one written"
+    for model in models:
+        if written.models.get(model.version) != model:
+            return f"model version {model.version} differs from the one written"
     extra = _event_set(events) - written.events
     if extra:
         return f"events never written: {sorted(extra)[:2]}"

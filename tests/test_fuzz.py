@@ -16,9 +16,8 @@ from fuzzing import (
     check_scenario,
     recording_mutations,
     scenario_texts,
+    splitter_run,
 )
-from rsstp_sim import load_scenario, make_strategy
-from rsstp_sim.recording import record
 
 SHORT = settings(
     max_examples=80,
@@ -37,17 +36,7 @@ def test_any_scenario_file_is_a_scenario_or_one_line(text: str, tmp_path: Path) 
 
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory: pytest.TempPathFactory) -> Written:
-    """A real recording of several chunks, model versions and events."""
-    path = tmp_path_factory.mktemp("fuzz") / "run.mcap"
-    record(
-        path,
-        load_scenario("three-joint"),
-        make_strategy("splitter"),
-        steps=300,
-        seed=3,
-        chunk_size=8_192,
-    )
-    return Written.read(path)
+    return splitter_run(tmp_path_factory.mktemp("fuzz"))
 
 
 @SHORT

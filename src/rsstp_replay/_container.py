@@ -248,12 +248,8 @@ def _scan(path: Path, stream: BinaryIO, size: int, *, finished: bool) -> Contain
                 container.attachments.append(
                     _attachment(path, RECORD.pack(opcode, length) + raw, offset)
                 )
-            elif opcode == Opcode.SCHEMA:
-                schema = Schema.read(_stream(raw))
-                container.schemas[schema.id] = schema
-            elif opcode == Opcode.CHANNEL:
-                channel = Channel.read(_stream(raw))
-                container.channels[channel.id] = channel
+            elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL):
+                _register(container, opcode, raw)
             elif opcode in (Opcode.DATA_END, Opcode.FOOTER):
                 container.data_complete = True
                 offset = end
@@ -269,6 +265,16 @@ def _scan(path: Path, stream: BinaryIO, size: int, *, finished: bool) -> Contain
             f"{path}: the data section is truncated at byte {offset} (expected a data end record)"
         )
     return container
+
+
+def _register(container: Container, opcode: int, body: bytes) -> None:
+    """Keep a schema or channel record, met in the data section or inside a chunk."""
+    if opcode == Opcode.SCHEMA:
+        schema = Schema.read(_stream(body))
+        container.schemas[schema.id] = schema
+    else:
+        channel = Channel.read(_stream(body))
+        container.channels[channel.id] = channel
 
 
 def _scan_chunk(container: Container, data: bytes, offset: int, length: int) -> ChunkRef:
@@ -294,12 +300,8 @@ def _scan_chunk(container: Container, data: bytes, offset: int, length: int) -> 
                 container.tail[channel] = (log_time, last[1] + 1)
             start_ns = log_time if start_ns < 0 else min(start_ns, log_time)
             end_ns = max(end_ns, log_time)
-        elif opcode == Opcode.SCHEMA:
-            schema = Schema.read(_stream(body))
-            container.schemas[schema.id] = schema
-        elif opcode == Opcode.CHANNEL:
-            channel_record = Channel.read(_stream(body))
-            container.channels[channel_record.id] = channel_record
+        elif opcode in (Opcode.SCHEMA, Opcode.CHANNEL):
+            _register(container, opcode, body)
         position += RECORD.size + size
     return ChunkRef(offset, length, max(start_ns, 0), max(end_ns, 0), frozenset(channels))
 

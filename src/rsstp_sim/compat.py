@@ -59,7 +59,6 @@ from __future__ import annotations
 
 import math
 import numbers
-import operator
 from collections.abc import Iterable, Sequence
 from pathlib import Path
 from typing import Any, SupportsIndex
@@ -68,11 +67,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rsstp_sim import graph
-from rsstp_sim.errors import MemoryRangeError, ModelError, ScenarioError
+from rsstp_sim.errors import MemoryRangeError, ModelError, RsstpError, ScenarioError
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.memory import CompareKind, Memory
 from rsstp_sim.scenario import Scenario, parse_scenario
-from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.transition_system import TransitionSystem, as_int
 from rsstp_sim.world import World
 
 __all__ = ["THESIS_GOAL_TOLERANCE", "robot_arm"]
@@ -397,25 +396,16 @@ class _ExternalView:
 # -- arguments ---------------------------------------------------------------------------------
 
 
-def _integer(value: object, what: str, error: type[Exception]) -> int:
-    if isinstance(value, bool | np.bool_):
-        raise error(f"{what} must be an integer, got {value!r}")
-    try:
-        return operator.index(value)  # type: ignore[arg-type]
-    except TypeError:
-        raise error(f"{what} must be an integer, got {value!r}") from None
-
-
 def _node(value: object, operation: str) -> int:
-    return _integer(value, f"{operation}: a node (matrix index)", ModelError)
+    return as_int(value, f"{operation}: a node (matrix index)", ModelError)
 
 
 def _index(value: object, operation: str) -> int:
-    return _integer(value, f"{operation}: a memory index", MemoryRangeError)
+    return as_int(value, f"{operation}: a memory index", MemoryRangeError)
 
 
-def _action(value: object, operation: str, *, error: type[Exception] = ModelError) -> int:
-    return _integer(value, f"{operation}: an action", error)
+def _action(value: object, operation: str, *, error: type[RsstpError] = ModelError) -> int:
+    return as_int(value, f"{operation}: an action", error)
 
 
 def _is_number(value: object) -> bool:

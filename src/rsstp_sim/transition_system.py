@@ -42,7 +42,9 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Literal
 
-from rsstp_sim.errors import ModelError
+import numpy as np
+
+from rsstp_sim.errors import ModelError, RsstpError
 
 __all__ = ["DeterminismReport", "Operation", "TransitionSystem"]
 
@@ -90,18 +92,19 @@ class DeterminismReport:
         return not self.nondeterministic and not self.empty
 
 
-def _as_int(value: object, what: str) -> int:
-    """``value`` as an int (numpy integers welcome, bools and floats refused)."""
-    if isinstance(value, bool):
-        raise ModelError(f"{what} must be an integer, got {value!r}")
+def as_int(value: object, what: str, error: type[RsstpError] = ModelError) -> int:
+    """``value`` as an int (numpy integers welcome; bools, numpy bools and floats refused
+    with ``error``). The model's and the thesis facade's one check of an integer argument."""
+    if isinstance(value, bool | np.bool_):
+        raise error(f"{what} must be an integer, got {value!r}")
     try:
         return operator.index(value)  # type: ignore[arg-type]
     except TypeError:
-        raise ModelError(f"{what} must be an integer, got {value!r}") from None
+        raise error(f"{what} must be an integer, got {value!r}") from None
 
 
 def _as_action(value: object, what: str) -> int:
-    action = _as_int(value, what)
+    action = as_int(value, what)
     if action < 0:
         raise ModelError(f"{what} must be an integer >= 0, got {action}")
     return action
@@ -133,7 +136,7 @@ class TransitionSystem:
     __hash__ = None  # type: ignore[assignment]
 
     def __init__(self, n_states: int = 1, *, actions: Iterable[int] = ()) -> None:
-        n = _as_int(n_states, "n_states")
+        n = as_int(n_states, "n_states")
         if n < 1:
             raise ModelError(f"a transition system needs n_states >= 1, got {n}")
         # _out[s][a]: sorted tuple of successors (no empty entries);
@@ -463,15 +466,15 @@ class TransitionSystem:
         for key in ("states", "next_id", "current", "actions", "transitions"):
             if key not in data:
                 raise ModelError(f"snapshot: missing key {key!r}")
-        states = [_as_int(s, "snapshot: states[]") for s in _as_list(data["states"], "states")]
+        states = [as_int(s, "snapshot: states[]") for s in _as_list(data["states"], "states")]
         if not states or len(set(states)) != len(states) or min(states) < 0:
             raise ModelError(
                 f"snapshot: states must be distinct non-negative ids, at least one; got {states}"
             )
-        next_id = _as_int(data["next_id"], "snapshot: next_id")
+        next_id = as_int(data["next_id"], "snapshot: next_id")
         if next_id <= max(states):
             raise ModelError(f"snapshot: next_id {next_id} must exceed every state id")
-        current = _as_int(data["current"], "snapshot: current")
+        current = as_int(data["current"], "snapshot: current")
         if current not in states:
             raise ModelError(f"snapshot: current {current} is not one of the states")
         actions = {
@@ -483,13 +486,13 @@ class TransitionSystem:
         model._states_changed()
         model._current = current
         model._next_id = next_id
-        model._version = _as_int(version, "version")
+        model._version = as_int(version, "version")
         for k, item in enumerate(_as_list(data["transitions"], "transitions")):
             where = f"snapshot: transitions[{k}]"
             triple = _as_list(item, f"transitions[{k}]")
             if len(triple) != 3:
                 raise ModelError(f"{where} must be [source, action, target], got {item!r}")
-            s, t = _as_int(triple[0], where), _as_int(triple[2], where)
+            s, t = as_int(triple[0], where), as_int(triple[2], where)
             a = _as_action(triple[1], f"{where} action")
             if s not in model._out or t not in model._out:
                 raise ModelError(f"{where} refers to an unknown state: {item!r}")

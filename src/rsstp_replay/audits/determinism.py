@@ -38,7 +38,7 @@ import pandas as pd
 
 from rsstp_sim.errors import ModelError
 from rsstp_sim.recording.records import ModelRecord
-from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.transition_system import DeterminismReport, TransitionSystem
 
 __all__ = [
     "DeterminismFindings",
@@ -62,30 +62,17 @@ class HasModelVersions(Protocol):
     def model_versions(self) -> Sequence[ModelRecord]: ...
 
 
-@dataclass(frozen=True, slots=True)
-class VersionDeterminism:
-    """The determinism of one model version, the model after step ``step``.
-
-    ``nondeterministic`` lists ``(state, action, successors)`` and ``empty`` lists
-    ``(state, action)``, both sorted, as in :class:`~rsstp_sim.transition_system.DeterminismReport`.
-    """
+@dataclass(frozen=True, slots=True, kw_only=True)
+class VersionDeterminism(DeterminismReport):
+    """The determinism of one model version, the model after step ``step``: a
+    :class:`~rsstp_sim.transition_system.DeterminismReport` (``nondeterministic`` lists
+    ``(state, action, successors)`` and ``empty`` lists ``(state, action)``, both sorted) with
+    the version's place and size."""
 
     version: int
     step: int
     states: int
     transitions: int
-    nondeterministic: tuple[NondeterministicPair, ...]
-    empty: tuple[EmptyPair, ...]
-
-    @property
-    def deterministic(self) -> bool:
-        """Every (state, action) has at most one successor."""
-        return not self.nondeterministic
-
-    @property
-    def complete(self) -> bool:
-        """Deterministic, and every (state, action) has exactly one successor."""
-        return not self.nondeterministic and not self.empty
 
     def to_json(self, *, pairs: bool = True) -> dict[str, Any]:
         """A JSON-ready dict; without ``pairs`` only the counts."""
