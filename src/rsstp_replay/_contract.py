@@ -1,19 +1,35 @@
-"""What a file must hold to be a recording: the checks :func:`open_recording` makes.
+"""What a file must hold to be a recording: the reader's middle layer.
 
 The ``/rsstp/*`` channels (one per topic, with their schemas, encodings and a ``1.x``
 version), the ``rsstp`` metadata record, and the ``scenario.toml`` attachment agreeing with the
 ``/rsstp/scenario`` message and the metadata (``schemas/README.md`` is the contract).
+
+Opening a recording goes down the reader's layers once: :func:`~rsstp_replay.open_recording`
+calls :func:`check_file` (this module) on what
+:func:`~rsstp_replay._container.open_container` found (the file's records and chunks, each
+chunk's bytes read by :mod:`rsstp_replay._chunks`). After that,
+:class:`~rsstp_replay.recording.Recording` reads messages through :meth:`CheckedFile.chunks`.
 """
 
 from __future__ import annotations
 
 import hashlib
 import json
+from collections.abc import Generator
+from contextlib import closing
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
-from rsstp_replay._container import Container
+import msgspec
+import numpy as np
+import numpy.typing as npt
+
+from rsstp_replay._chunks import log_times_at, messages_at, split_messages
+from rsstp_replay._container import ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
 from rsstp_sim.errors import ScenarioError
-from rsstp_sim.recording.records import RecordFormatError, ScenarioRecord
+from rsstp_sim.recording.records import RecordFormatError, ScenarioRecord, decode
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_NAME,
     MESSAGE_ENCODING,
@@ -21,13 +37,149 @@ from rsstp_sim.recording.schemas import (
     METADATA_NAME,
     SCHEMA_ENCODING,
     SCHEMA_VERSION,
+    STEP_NS,
     TOPICS,
     check_schema_version,
     parse_version,
 )
 from rsstp_sim.scenario import Scenario, parse_scenario
 
-__all__ = ["check_schemas", "cut_time", "read_metadata", "rebuild_scenario", "rsstp_channels"]
+__all__ = ["CheckedFile", "check_file"]
+
+_Ints = npt.NDArray[np.int64]
+
+
+@dataclass(frozen=True, slots=True)
+class CheckedFile:
+    """A file that holds a recording, as :func:`check_file` found it: its channels by topic,
+    schema versions, metadata, message counts per topic (an unfinished file's cut at
+    ``limit_ns``, its last recovered step), the last step, and the scenario. It reads the
+    messages of a topic chunk by chunk for :class:`~rsstp_replay.recording.Recording`."""
+
+    container: Container
+    channels: dict[str, int]
+    schema_versions: dict[str, str]
+    metadata: dict[str, str]
+    topic_counts: dict[str, int]
+    limit_ns: int | None
+    n_steps: int
+    scenario_record: ScenarioRecord
+    scenario: Scenario
+
+    def chunks(
+        self, topic: str, *, step: int | None = None
+    ) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
+        """The chunks with messages of ``topic`` (or only those around ``step``'s log time),
+        each with its records, those messages' bytes and their log times."""
+        return _topic_chunks(self.container, self.channels, self.limit_ns, topic, step=step)
+
+    def decode_one(self, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
+        """The record of one message of ``topic``."""
+        return _decode_one(self.container.path, topic, part, log_time, ref)
+
+
+def check_file(container: Container) -> CheckedFile:
+    """Check what ``container`` holds against the contract (topics, schemas, metadata, the
+    scenario message and attachment, at least the reset step); what it found."""
+    path = container.path
+    if not container.finished and not container.chunks:
+        raise CorruptRecording(
+            f"{path}: the file was not finished and holds no complete chunk (read "
+            f"{container.recovered_bytes} of {container.size} bytes): nothing to recover"
+        )
+    channels = rsstp_channels(container)
+    schema_versions = check_schemas(container, channels)
+    metadata = read_metadata(container)
+    counts = container.counts if container.counts is not None else container.count_messages()
+    limit_ns: int | None = None
+    if not container.data_complete:
+        limit_ns = cut_time(container, channels["/rsstp/step"])
+        counts = dict(counts)
+        for channel, (log_time, at_time) in container.tail.items():
+            if log_time >= limit_ns:
+                counts[channel] = counts.get(channel, 0) - at_time
+    topic_counts = {
+        channel.topic: counts.get(channel_id, 0)
+        for channel_id, channel in sorted(container.channels.items())
+    }
+    n_step_messages = counts.get(channels["/rsstp/step"], 0)
+    if n_step_messages == 0:
+        what = "no complete step" if not container.finished else "no step message"
+        raise CorruptRecording(f"{path}: {what} to read (expected step 0, the reset)")
+    record = _scenario_message(container, channels, topic_counts, limit_ns)
+    return CheckedFile(
+        container,
+        channels,
+        schema_versions,
+        metadata,
+        topic_counts,
+        limit_ns,
+        n_step_messages - 1,
+        record,
+        rebuild_scenario(container, record, metadata),
+    )
+
+
+def _scenario_message(
+    container: Container, channels: dict[str, int], counts: dict[str, int], limit_ns: int | None
+) -> ScenarioRecord:
+    """The one ``/rsstp/scenario`` message."""
+    count = counts.get("/rsstp/scenario", 0)
+    if count != 1:
+        raise CorruptRecording(
+            f"{container.path}: expected one /rsstp/scenario message, found {count}"
+        )
+    with closing(_topic_chunks(container, channels, limit_ns, "/rsstp/scenario")) as chunks:
+        for ref, _, parts, times in chunks:
+            if parts:
+                record = _decode_one(container.path, "/rsstp/scenario", parts[0], times[0], ref)
+                assert isinstance(record, ScenarioRecord)
+                return record
+    raise CorruptRecording(f"{container.path}: the /rsstp/scenario message is missing")
+
+
+def _topic_chunks(
+    container: Container,
+    channels: dict[str, int],
+    limit_ns: int | None,
+    topic: str,
+    *,
+    step: int | None = None,
+) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
+    """:meth:`CheckedFile.chunks`: a finished file's step messages are found through each
+    chunk's message index, anything else by walking the chunk's records; an unfinished file's
+    messages stop at ``limit_ns``."""
+    path, channel = container.path, channels[topic]
+    with container.open() as stream:
+        for ref in container.chunks:
+            if ref.channels is not None and channel not in ref.channels:
+                continue
+            if step is not None and not ref.start_ns <= step * STEP_NS <= ref.end_ns:
+                continue
+            if limit_ns is not None and ref.start_ns >= limit_ns:
+                break
+            data = container.chunk_data(stream, ref)
+            cut = limit_ns if limit_ns is not None and ref.end_ns >= limit_ns else None
+            if topic == "/rsstp/step" and cut is None:
+                offsets = container.message_offsets(stream, ref, channel)
+                if offsets is not None:
+                    found = messages_at(path, data, offsets, channel, where=ref.offset)
+                    yield ref, data, found, log_times_at(data, offsets)
+                    continue
+            parts: dict[int, list[memoryview]] = {channel: []}
+            times: dict[int, list[int]] = {channel: []}
+            split_messages(path, data, parts, where=ref.offset, limit_ns=cut, times=times)
+            yield ref, data, parts[channel], np.array(times[channel], np.int64)
+
+
+def _decode_one(path: Path, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
+    try:
+        return decode(TOPICS[topic], bytes(part))
+    except (RecordFormatError, msgspec.DecodeError) as exc:
+        raise CorruptRecording(
+            f"{path}: the {topic} message at step {log_time / STEP_NS:g} (chunk at byte "
+            f"{ref.offset}) is invalid: {exc}"
+        ) from None
 
 
 def rsstp_channels(container: Container) -> dict[str, int]:

@@ -32,16 +32,9 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
-from rsstp_replay._chunks import log_times_at, message_times, messages_at
-from rsstp_replay._chunks import split_messages as _split
-from rsstp_replay._container import ChunkRef, Container, open_container
-from rsstp_replay._contract import (
-    check_schemas,
-    cut_time,
-    read_metadata,
-    rebuild_scenario,
-    rsstp_channels,
-)
+from rsstp_replay._chunks import message_times
+from rsstp_replay._container import ChunkRef, open_container
+from rsstp_replay._contract import CheckedFile, check_file
 from rsstp_replay._decode import StepColumns
 from rsstp_replay._models import build_model, verify_chain
 from rsstp_replay.errors import (
@@ -57,13 +50,9 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import (
     EventRecord,
     ModelRecord,
-    RecordFormatError,
-    ScenarioRecord,
-    decode,
 )
 from rsstp_sim.recording.schemas import (
     STEP_NS,
-    TOPICS,
 )
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, compute_truth
@@ -96,14 +85,14 @@ def open_recording(path: str | os.PathLike[str]) -> Recording:
     :class:`~rsstp_replay.errors.CorruptRecording`; warns with
     :class:`~rsstp_replay.errors.UnfinishedRecordingWarning` when the file was not finished.
     """
-    recording = Recording(open_container(path))
+    recording = Recording(check_file(open_container(path)))
     if recording.recovered_steps is not None:
         warnings.warn(
             UnfinishedRecordingWarning(
                 f"{recording.path}: the file was not finished; recovered "
                 f"{recording.recovered_steps} steps from its complete chunks "
-                f"(read {recording._container.recovered_bytes} of "
-                f"{recording._container.size} bytes)"
+                f"(read {recording._file.container.recovered_bytes} of "
+                f"{recording._file.container.size} bytes)"
             ),
             stacklevel=2,
         )
@@ -126,39 +115,17 @@ class Recording:
     (unless the scan reached the end of the data section).
     """
 
-    def __init__(self, container: Container) -> None:
-        self._container = container
+    def __init__(self, file: CheckedFile) -> None:
+        self._file = file
         self._closed = False
         self._ground_truth: GroundTruth | None = None
-        path = container.path
-        if not container.finished and not container.chunks:
-            raise CorruptRecording(
-                f"{path}: the file was not finished and holds no complete chunk (read "
-                f"{container.recovered_bytes} of {container.size} bytes): nothing to recover"
-            )
-        self._channels = rsstp_channels(container)
-        self.schema_versions = check_schemas(container, self._channels)
-        self.metadata = read_metadata(container)
-        counts = container.counts if container.counts is not None else container.count_messages()
-        self._limit_ns: int | None = None
-        if not container.data_complete:
-            self._limit_ns = cut_time(container, self._channels["/rsstp/step"])
-            counts = dict(counts)
-            for channel, (log_time, at_time) in container.tail.items():
-                if log_time >= self._limit_ns:
-                    counts[channel] = counts.get(channel, 0) - at_time
-        self.topic_counts = {
-            channel.topic: counts.get(channel_id, 0)
-            for channel_id, channel in sorted(container.channels.items())
-        }
-        n_step_messages = counts.get(self._channels["/rsstp/step"], 0)
-        if n_step_messages == 0:
-            what = "no complete step" if not container.finished else "no step message"
-            raise CorruptRecording(f"{path}: {what} to read (expected step 0, the reset)")
-        self.n_steps = n_step_messages - 1
-        self.recovered_steps: int | None = None if container.finished else self.n_steps
-        self.scenario_record = self._read_scenario()
-        self.scenario = rebuild_scenario(container, self.scenario_record, self.metadata)
+        self.schema_versions = file.schema_versions
+        self.metadata = file.metadata
+        self.topic_counts = file.topic_counts
+        self.n_steps = file.n_steps
+        self.recovered_steps: int | None = None if file.container.finished else self.n_steps
+        self.scenario_record = file.scenario_record
+        self.scenario = file.scenario
         self._agent_cache: dict[int, StepColumns] = {}
         self._agent: StepColumns | None = None
         self._models: tuple[ModelRecord, ...] | None = None
@@ -167,11 +134,11 @@ class Recording:
 
     @property
     def path(self) -> Path:
-        return self._container.path
+        return self._file.container.path
 
     @property
     def finished(self) -> bool:
-        return self._container.finished
+        return self._file.container.finished
 
     @property
     def seed(self) -> int:
@@ -276,10 +243,11 @@ class Recording:
         """Read, decompress and CRC-check every chunk; the number of chunks. Raises
         :class:`~rsstp_replay.errors.CorruptRecording` naming the first that fails."""
         self._check_open()
-        with self._container.open() as stream:
-            for ref in self._container.chunks:
-                self._container.chunk_data(stream, ref)
-        return len(self._container.chunks)
+        container = self._file.container
+        with container.open() as stream:
+            for ref in container.chunks:
+                container.chunk_data(stream, ref)
+        return len(container.chunks)
 
     # -- the model ---------------------------------------------------------------------------
 
@@ -344,45 +312,8 @@ class Recording:
     def _chunks(
         self, topic: str, *, step: int | None = None
     ) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
-        """The chunks with messages of ``topic`` (or only those around ``step``'s log time),
-        each with its records, those messages' bytes and their log times."""
         self._check_open()
-        channel = self._channels[topic]
-        limit = self._limit_ns
-        with self._container.open() as stream:
-            for ref in self._container.chunks:
-                if ref.channels is not None and channel not in ref.channels:
-                    continue
-                if step is not None and not ref.start_ns <= step * STEP_NS <= ref.end_ns:
-                    continue
-                if limit is not None and ref.start_ns >= limit:
-                    break
-                data = self._container.chunk_data(stream, ref)
-                cut = limit if limit is not None and ref.end_ns >= limit else None
-                if topic == "/rsstp/step" and cut is None:
-                    offsets = self._container.message_offsets(stream, ref, channel)
-                    if offsets is not None:  # a finished file: its index says where they are
-                        found = messages_at(self.path, data, offsets, channel, where=ref.offset)
-                        yield ref, data, found, log_times_at(data, offsets)
-                        continue
-                parts: dict[int, list[memoryview]] = {channel: []}
-                times: dict[int, list[int]] = {channel: []}
-                _split(self.path, data, parts, where=ref.offset, limit_ns=cut, times=times)
-                yield ref, data, parts[channel], np.array(times[channel], np.int64)
-
-    def _read_scenario(self) -> ScenarioRecord:
-        count = self.topic_counts.get("/rsstp/scenario", 0)
-        if count != 1:
-            raise CorruptRecording(
-                f"{self.path}: expected one /rsstp/scenario message, found {count}"
-            )
-        with closing(self._chunks("/rsstp/scenario")) as chunks:
-            for ref, _, parts, times in chunks:
-                if parts:
-                    record = self._decode_one("/rsstp/scenario", parts[0], times[0], ref)
-                    assert isinstance(record, ScenarioRecord)
-                    return record
-        raise CorruptRecording(f"{self.path}: the /rsstp/scenario message is missing")
+        return self._file.chunks(topic, step=step)
 
     def _records(self, topic: str, keep: Callable[[Any], Any] | None = None) -> list[Any]:
         """Every message of ``topic`` as its record (passed through ``keep`` as soon as it is
@@ -390,7 +321,7 @@ class Recording:
         found: list[Any] = []
         for ref, _, parts, times in self._chunks(topic):
             for part, log_time in zip(parts, times, strict=True):
-                record = self._decode_one(topic, part, log_time, ref)
+                record = self._file.decode_one(topic, part, log_time, ref)
                 assert isinstance(record, EventRecord | ModelRecord)
                 if record.step * STEP_NS != log_time:
                     raise CorruptRecording(
@@ -407,15 +338,6 @@ class Recording:
             )
         return found
 
-    def _decode_one(self, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
-        try:
-            return decode(TOPICS[topic], bytes(part))
-        except (RecordFormatError, msgspec.DecodeError) as exc:
-            raise CorruptRecording(
-                f"{self.path}: the {topic} message at step {log_time / STEP_NS:g} (chunk at "
-                f"byte {ref.offset}) is invalid: {exc}"
-            ) from None
-
     def _decode_steps(
         self,
         columns: StepColumns,
@@ -427,7 +349,7 @@ class Recording:
         try:
             columns.add(parts, log_times)
         except BadStep as exc:
-            times = message_times(data, self._channels["/rsstp/step"])
+            times = message_times(data, self._file.channels["/rsstp/step"])
             at = f"at step {times[exc.index] // STEP_NS} " if exc.index is not None else ""
             raise CorruptRecording(
                 f"{self.path}: the step message {at}(chunk at byte {ref.offset}) is invalid: "

@@ -432,7 +432,7 @@ def test_a_message_index_that_points_elsewhere_is_refused(original: Path, tmp_pa
     container = open_container(original)
     ref = container.chunks[1]
     with open_recording(original) as recording:
-        step_channel = recording._channels["/rsstp/step"]
+        step_channel = recording._file.channels["/rsstp/step"]
     assert ref.indexes is not None
     at = ref.indexes[step_channel]
     raw = bytearray(original.read_bytes())
