@@ -146,7 +146,7 @@ def _topic_chunks(
     *,
     step: int | None = None,
 ) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
-    """:meth:`CheckedFile.chunks`: a finished file's step messages are found through each
+    """:meth:`CheckedFile.chunks`: a finished file's messages are found through each
     chunk's message index, anything else by walking the chunk's records; an unfinished file's
     messages stop at ``limit_ns``."""
     path, channel = container.path, channels[topic]
@@ -160,7 +160,7 @@ def _topic_chunks(
                 break
             data = container.chunk_data(stream, ref)
             cut = limit_ns if limit_ns is not None and ref.end_ns >= limit_ns else None
-            if topic == "/rsstp/step" and cut is None:
+            if cut is None:
                 offsets = container.message_offsets(stream, ref, channel)
                 if offsets is not None:
                     found = messages_at(path, data, offsets, channel, where=ref.offset)

@@ -128,6 +128,7 @@ class Recording:
         self.scenario = file.scenario
         self._agent_cache: dict[int, StepColumns] = {}
         self._agent: StepColumns | None = None
+        self._log_times: _Ints | None = None
         self._models: tuple[ModelRecord, ...] | None = None
 
     # -- properties ------------------------------------------------------------------------
@@ -160,6 +161,7 @@ class Recording:
         """Drop the cached tables; later calls raise :class:`ReplayError`."""
         self._closed = True
         self._agent = None
+        self._log_times = None
         self._agent_cache.clear()
         self._models = None
 
@@ -196,7 +198,9 @@ class Recording:
         do not read: a tenth of the memory per step).
         """
         self._check_open()
-        frame = self._step_columns(truth=True).frame(geometry=geometry)
+        columns = self._step_columns(truth=True)
+        self._log_times = _read_only(columns.log_time)  # the contract check needs no 2nd pass
+        frame = columns.frame(geometry=geometry)
         if truth:
             from rsstp_replay.audits.truth import step_true_classes
 
@@ -205,8 +209,10 @@ class Recording:
 
     def step_log_times(self) -> _Ints:
         """The log time of each step message, in step order (the contract wants step x
-        1,000,000 ns: :func:`~rsstp_replay.audits.contract.check_contract`)."""
-        return self._agent_columns().log_time
+        1,000,000 ns: :func:`~rsstp_replay.audits.contract.check_contract`); read-only."""
+        if self._log_times is None:
+            self._log_times = _read_only(self._agent_columns().log_time)
+        return self._log_times
 
     def ground_truth(self) -> GroundTruth:
         """The scenario's ground truth (computed once per recording; may take seconds)."""
@@ -438,6 +444,12 @@ def _row(columns: StepColumns, step: int) -> _AgentRow | None:
         int(columns.internal_state[index]),
         int(columns.model_version[index]),
     )
+
+
+def _read_only(array: _Ints) -> _Ints:
+    view = array.view()
+    view.flags.writeable = False
+    return view
 
 
 @contextmanager
