@@ -27,14 +27,7 @@ from hypothesis import strategies as st
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from fuzzing import (  # noqa: E402 (the test suite's folder goes on the path first)
-    Written,
-    check_recording,
-    check_scenario,
-    recording_mutations,
-    scenario_texts,
-    splitter_run,
-)
+import fuzzing  # noqa: E402 (the test suite's folder goes on the path first)
 from rsstp_sim import load_scenario, make_strategy  # noqa: E402
 from rsstp_sim.recording import record  # noqa: E402
 
@@ -94,10 +87,10 @@ def explore(
     run()
 
 
-def reference_recordings(folder: Path) -> list[Written]:
+def reference_recordings(folder: Path) -> list[fuzzing.Written]:
     two = folder / "two-joint-learner.mcap"
     record(two, load_scenario("two-joint-30"), make_strategy("learner"), steps=400, seed=5)
-    return [splitter_run(folder), Written.read(two)]
+    return [fuzzing.splitter_run(folder), fuzzing.Written.read(two)]
 
 
 def main() -> int:
@@ -108,16 +101,17 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as name:
         folder = Path(name)
         scenarios = Tally("scenario files", args.scenarios)
-        explore(scenarios, scenario_texts(), lambda text: check_scenario(text, folder))
+        texts = fuzzing.scenario_texts()
+        explore(scenarios, texts, lambda text: fuzzing.check_scenario(text, folder))
         scenarios.report()
 
         recordings = Tally("damaged recordings", args.recordings)
         references = reference_recordings(folder)
-        cases = st.tuples(st.sampled_from(range(len(references))), recording_mutations())
+        cases = st.tuples(st.sampled_from(range(len(references))), fuzzing.recording_mutations())
         explore(
             recordings,
             cases,
-            lambda case: check_recording(case[1], references[case[0]], folder),
+            lambda case: fuzzing.check_recording(case[1], references[case[0]], folder),
         )
         recordings.report()
     return 1 if scenarios.failures or recordings.failures else 0
