@@ -29,7 +29,7 @@ import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 from rsstp_replay.errors import BadStep, ReplayError
 from rsstp_sim.geometry import ArmGeometry, joint_positions, obstacle_distances
 
-__all__ = ["BadStep", "StepColumns", "blocker_label", "pose_numbers"]
+__all__ = ["StepColumns", "blocker_label", "pose_numbers"]
 
 _Count = Annotated[int, msgspec.Meta(ge=0)]
 _Angle = Annotated[int, msgspec.Meta(ge=0, le=359)]

@@ -47,13 +47,8 @@ from rsstp_replay.errors import (
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
-from rsstp_sim.recording.records import (
-    EventRecord,
-    ModelRecord,
-)
-from rsstp_sim.recording.schemas import (
-    STEP_NS,
-)
+from rsstp_sim.recording.records import EventRecord, ModelRecord
+from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, compute_truth
 
@@ -199,7 +194,7 @@ class Recording:
         """
         self._check_open()
         columns = self._step_columns(truth=True)
-        self._log_times = _read_only(columns.log_time)  # the contract check needs no 2nd pass
+        self._log_times = columns.log_time  # kept: the contract check needs no second pass
         frame = columns.frame(geometry=geometry)
         if truth:
             from rsstp_replay.audits.truth import step_true_classes
@@ -209,9 +204,9 @@ class Recording:
 
     def step_log_times(self) -> _Ints:
         """The log time of each step message, in step order (the contract wants step x
-        1,000,000 ns: :func:`~rsstp_replay.audits.contract.check_contract`); read-only."""
+        1,000,000 ns: :func:`~rsstp_replay.audits.contract.check_contract`)."""
         if self._log_times is None:
-            self._log_times = _read_only(self._agent_columns().log_time)
+            self._log_times = self._agent_columns().log_time
         return self._log_times
 
     def ground_truth(self) -> GroundTruth:
@@ -444,12 +439,6 @@ def _row(columns: StepColumns, step: int) -> _AgentRow | None:
         int(columns.internal_state[index]),
         int(columns.model_version[index]),
     )
-
-
-def _read_only(array: _Ints) -> _Ints:
-    view = array.view()
-    view.flags.writeable = False
-    return view
 
 
 @contextmanager
