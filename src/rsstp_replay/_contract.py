@@ -41,6 +41,7 @@ from rsstp_sim.recording.schemas import (
     TOPICS,
     check_schema_version,
     parse_version,
+    version_refusal,
 )
 from rsstp_sim.scenario import Scenario, parse_scenario
 
@@ -229,10 +230,7 @@ def check_schemas(container: Container, channels: dict[str, int]) -> dict[str, s
         except (ValueError, AttributeError, RecordFormatError):
             major = supported
         if major != supported:
-            raise UnsupportedVersion(
-                f"{where}: schema {name} version {version} is not supported (this reader "
-                f"understands {supported}.x)"
-            )
+            raise UnsupportedVersion(f"{where}: schema {name} {version_refusal(version)}")
         try:
             major, minor = check_schema_version(name, schema.data)
         except RecordFormatError as exc:

@@ -84,7 +84,7 @@ def _difference(rebuilt: TransitionSystem, record: ModelRecord) -> str:
     if rebuilt.actions != tuple(record.actions):
         return f"actions {list(rebuilt.actions)}, the snapshot has {list(record.actions)}"
     made = tuple(rebuilt.transitions())
-    found = tuple(record.transitions)
+    found = record.triples()
     if made != found and made != tuple(sorted(found)):  # the writer sorts them
         extra = sorted(set(made) - set(found))[:3]
         missing = sorted(set(found) - set(made))[:3]

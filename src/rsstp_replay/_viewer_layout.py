@@ -15,7 +15,7 @@ from collections.abc import Iterable, Sequence
 
 from rsstp_replay.errors import ViewerWarning
 from rsstp_sim.graph import plain_positions, run_graphviz
-from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.recording.records import ModelRecord, TransitionRecord
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = [
@@ -33,7 +33,7 @@ def union_model(
     ``extra_states``): the one graph whose layout fixes every node's place."""
     states: set[int] = set(extra_states)
     actions: set[int] = set()
-    transitions: set[tuple[int, int, int]] = set()
+    transitions: set[TransitionRecord] = set()
     for record in versions:
         states.update(record.states)
         actions.update(record.actions)

@@ -3,12 +3,12 @@ live runs (through a recording-like fake) and, end to end, a real recording."""
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 import json
 from collections.abc import Callable
 from pathlib import Path
 
+import msgspec
 import numpy as np
 import pandas as pd
 import pytest
@@ -201,13 +201,13 @@ def test_determinism_refuses_inconsistent_messages() -> None:
     with pytest.raises(ModelError, match=r"model version 3 \(step 7\): its operations do not"):
         audit_determinism(skipped)
     wrong = models[1]
-    bad_states = dataclasses.replace(wrong, states=(0, 1, 2))
+    bad_states = msgspec.structs.replace(wrong, states=(0, 1, 2))
     with pytest.raises(ModelError, match=r"model version 2 \(step 4\): its operations give"):
         audit_determinism([models[0], bad_states])
-    bad_pairs = dataclasses.replace(wrong, nondeterministic_pairs=0)
+    bad_pairs = msgspec.structs.replace(wrong, nondeterministic_pairs=0)
     with pytest.raises(ModelError, match="has 2 pairs with several successors, the message says 0"):
         audit_determinism([models[0], bad_pairs])
-    bad_version = dataclasses.replace(wrong, version=9)
+    bad_version = msgspec.structs.replace(wrong, version=9)
     with pytest.raises(ModelError, match="to version 2, not 9"):
         audit_determinism([models[0], bad_version])
 

@@ -181,10 +181,11 @@ CASES: dict[str, Case] = {
         r"foreign\.mcap: an MCAP file, but not an rsstp recording: no /rsstp/\* topic "
         r"\(its topics: /camera\)",
     ),
-    "version2": Case(
+    "version1": Case(
         UnsupportedVersion,
-        r"version2\.mcap: channel /rsstp/step: schema rsstp\.Step version 2\.0 is not "
-        r"supported \(this reader understands 1\.x\)",
+        r"version1\.mcap: channel /rsstp/step: schema rsstp\.Step version 1\.0 is not "
+        r"supported \(this reader understands 2\.x; re-record the run with rsstp-sim record: "
+        r"its scenario\.toml is attached\)",
     ),
     "in-magic": Case(CorruptRecording, r"in-magic\.mcap: truncated: the file ends at byte 5"),
     "in-header": Case(
@@ -268,12 +269,12 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
     files["text"].write_text("step,action\n0,\n", encoding="utf-8")
     foreign_mcap(files["foreign"])
 
-    def version2(name: str, data: bytes) -> bytes:
+    def version1(name: str, data: bytes) -> bytes:
         return (
-            data.replace(b'"version": "1.0"', b'"version": "2.0"') if name == "rsstp.Step" else data
+            data.replace(b'"version": "2.0"', b'"version": "1.0"') if name == "rsstp.Step" else data
         )
 
-    rewrite(original, files["version2"], schema=version2)
+    rewrite(original, files["version1"], schema=version1)
     raw = original.read_bytes()
     files["in-magic"].write_bytes(raw[:5])
     files["in-header"].write_bytes(raw[:40])
@@ -288,7 +289,7 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
     rewrite(original, files["bad-step"], message=edit_json("/rsstp/step", 17, set_action))
 
     def move_the_tip(step: dict[str, Any]) -> None:
-        step["truth"]["joint_positions"][-1][0] += 1e-9  # the first message of the first chunk
+        step["truth"]["joint_positions"][-1]["x"] += 1e-9  # the first message of the chunk
 
     rewrite(original, files["moved-joint"], message=edit_json("/rsstp/step", 0, move_the_tip))
 
@@ -315,8 +316,9 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
 
 def _determinism(model: dict[str, Any]) -> tuple[bool, int]:
     pairs: dict[tuple[int, int], int] = {}
-    for s, a, _ in model["transitions"]:
-        pairs[(s, a)] = pairs.get((s, a), 0) + 1
+    for transition in model["transitions"]:
+        pair = (transition["source"], transition["action"])
+        pairs[pair] = pairs.get(pair, 0) + 1
     count = sum(1 for n in pairs.values() if n > 1)
     return count == 0, count
 
@@ -339,11 +341,11 @@ def test_api_raises_a_one_line_error(name: str, damaged: dict[str, Path]) -> Non
 
 def test_a_later_minor_version_with_new_fields_is_read(original: Path, tmp_path: Path) -> None:
     def minor(name: str, data: bytes) -> bytes:
-        return data.replace(b'"version": "1.0"', b'"version": "1.3"')
+        return data.replace(b'"version": "2.0"', b'"version": "2.3"')
 
     def extra_fields(topic: str, log_time: int, data: bytes) -> bytes:
         value = json.loads(data)
-        value["added_in_1_3"] = {"anything": [1, 2]}
+        value["added_in_2_3"] = {"anything": [1, 2]}
         if topic == "/rsstp/step":
             value["agent"]["confidence"] = 0.5
             value["truth"]["velocity"] = [0.0, 0.0]
@@ -351,7 +353,7 @@ def test_a_later_minor_version_with_new_fields_is_read(original: Path, tmp_path:
 
     newer = rewrite(original, tmp_path / "newer.mcap", schema=minor, message=extra_fields)
     with open_recording(newer) as recording, open_recording(original) as before:
-        assert recording.schema_versions["rsstp.Step"] == "1.3"
+        assert recording.schema_versions["rsstp.Step"] == "2.3"
         assert recording.memory() == before.memory()
         assert recording.steps().equals(before.steps())
         assert recording.events().equals(before.events())

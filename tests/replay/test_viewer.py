@@ -271,7 +271,7 @@ def test_states_sit_where_the_arm_was_in_their_last_version(refined: tuple[Recor
 
 def _outs(record: Any) -> dict[int, list[tuple[int, int]]]:
     outs: dict[int, list[tuple[int, int]]] = {s: [] for s in record.states}
-    for s, a, t in sorted(record.transitions, key=lambda sat: (sat[0], sat[1], sat[2])):
+    for s, a, t in sorted(record.triples()):
         outs[s].append((a, t))
     return outs
 

@@ -211,6 +211,9 @@ def test_metadata_record_rsstp(recording: Path, three_joint: Scenario) -> None:
     assert values["seed"] == str(SEED)
     assert values["strategy"] == "random"
     assert json.loads(values["strategy_params"]) == {}
+    assert values["strategy_import_path"] == "rsstp_sim.strategies.random_walk:RandomStrategy"
+    assert values["strategy_distribution"] == "rsstp"
+    assert values["strategy_version"] == values["package_version"]
     assert values["scenario_sha256"] == three_joint.sha256
     for key, version in environment_versions().items():
         assert values[key] == version
@@ -319,8 +322,8 @@ def test_truth_part_is_the_worlds_poses(messages: list[Message], live: LiveRun) 
     for step, pose, blocker in zip(steps, live.poses, blockers, strict=True):
         truth = step.truth
         assert truth.angles_deg == pose.angles_deg
-        assert [list(p) for p in truth.joint_positions] == pose.joint_positions.tolist()
-        assert [list(row) for row in truth.distances] == pose.distances.tolist()
+        assert [[p.x, p.y] for p in truth.joint_positions] == pose.joint_positions.tolist()
+        assert [list(tip.obstacles) for tip in truth.distances] == pose.distances.tolist()
         assert truth.blocked == (blocker is not None)
         assert truth.blocked_by == builders.blocked_by_record(blocker)
 
@@ -458,7 +461,7 @@ def test_model_messages_are_live_copies_of_the_model(
                 for op in m.operations
                 if op.kind == event.kind and list(op.args) == event.data["args"]
             )
-            assert event.data["result"] == op.result
+            assert event.data.get("result") == op.result
 
 
 # -------------------------------------------------------------------- 4. bad input

@@ -28,6 +28,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from jsonschema import Draft202012Validator
 
+import rsstp_sim
 from rsstp_sim.coupling import Event, Runner
 from rsstp_sim.recording import builders, records, schemas
 from rsstp_sim.recording.builders import (
@@ -44,9 +45,11 @@ from rsstp_sim.recording.records import (
     RECORD_TYPES,
     AgentRecord,
     BlockedByRecord,
+    DistancesRecord,
     EventRecord,
     MessageRecord,
     ModelRecord,
+    PointRecord,
     RecordFormatError,
     ScenarioRecord,
     StepRecord,
@@ -65,7 +68,7 @@ from rsstp_sim.recording.schemas import (
     validate,
 )
 from rsstp_sim.scenario import builtin_scenarios, load_scenario
-from rsstp_sim.strategies import RandomStrategy
+from rsstp_sim.strategies import RandomStrategy, strategy_origin
 from rsstp_sim.transition_system import TransitionSystem
 
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "schemas"
@@ -120,7 +123,8 @@ def test_every_property_has_a_description_and_objects_are_open(name: str) -> Non
             assert sub.get("description"), f"{where}.{key} has no description"
         if "type" in schema:  # the allOf branches only add requirements
             assert schema.get("additionalProperties") is True, where
-            assert schema["required"] == list(schema["properties"]), where
+            required = schema.get("required", [])
+            assert required == [k for k in schema["properties"] if k in required], where
 
 
 def test_topics_schemas_and_record_types_agree() -> None:
@@ -130,17 +134,25 @@ def test_topics_schemas_and_record_types_agree() -> None:
     assert schemas.log_time_ns(7) == 7_000_000
 
 
+def _is_record(hint: object) -> bool:
+    return isinstance(hint, type) and issubclass(hint, msgspec.Struct)
+
+
 def _mirror(cls: type, schema: Mapping[str, Any], where: str) -> None:
-    """The record class's fields are the schema's properties, in order, recursively."""
-    names = [field.name for field in dataclasses.fields(cls)]
-    assert names == list(schema["properties"]) == schema["required"], where
+    """The record class's fields are the schema's properties, in order, recursively; the
+    fields with a default (None: left out of the JSON) are the ones the schema does not
+    require."""
+    fields = msgspec.structs.fields(cls)
+    names = [field.name for field in fields]
+    assert names == list(schema["properties"]), where
+    assert [f.name for f in fields if f.required] == schema["required"], where
     hints = typing.get_type_hints(cls)
     for name in names:
         hint, sub = hints[name], schema["properties"][name]
         inner = [a for a in typing.get_args(hint) if a is not type(None) and a is not Ellipsis]
-        if dataclasses.is_dataclass(hint):
+        if _is_record(hint):
             _mirror(typing.cast(type, hint), sub, f"{where}.{name}")
-        elif inner and dataclasses.is_dataclass(inner[0]):
+        elif inner and _is_record(inner[0]):
             target = sub["items"] if typing.get_origin(hint) is tuple else sub
             _mirror(typing.cast(type, inner[0]), target, f"{where}.{name}")
 
@@ -173,14 +185,18 @@ def _with_version(name: str, version: str) -> bytes:
 
 
 @pytest.mark.parametrize("name", SCHEMA_NAMES)
-def test_a_reader_accepts_any_1_x(name: str) -> None:
-    assert check_schema_version(name, schema_bytes(name)) == (1, 0)
-    assert check_schema_version(name, _with_version(name, "1.7")) == (1, 7)
+def test_a_reader_accepts_any_2_x(name: str) -> None:
+    assert check_schema_version(name, schema_bytes(name)) == (2, 0)
+    assert check_schema_version(name, _with_version(name, "2.7")) == (2, 7)
 
 
 def test_a_reader_refuses_another_major_version_or_a_foreign_schema() -> None:
-    with pytest.raises(RecordFormatError, match=r"rsstp.Step: schema version 2.0 is not supported"):
-        check_schema_version("rsstp.Step", _with_version("rsstp.Step", "2.0"))
+    for other in ("1.0", "3.0"):
+        with pytest.raises(
+            RecordFormatError,
+            match=rf"rsstp.Step: schema version {other} is not supported .*re-record",
+        ):
+            check_schema_version("rsstp.Step", _with_version("rsstp.Step", other))
     with pytest.raises(
         RecordFormatError, match=r"title: expected 'rsstp.Step', found 'rsstp.Model'"
     ):
@@ -252,6 +268,7 @@ def record_run(name: str) -> Corpus:
             seed=1,
             strategy_name="random",
             strategy_params={"block": 4096, "tags": ("a", "b")},
+            strategy_origin=strategy_origin(RandomStrategy()),
         ),
     )
     first = model_record(runner.model, step=0, operations=())
@@ -304,7 +321,9 @@ def corpus(request: pytest.FixtureRequest) -> Corpus:
 def _round_trip(record: MessageRecord) -> None:
     name = record.schema_name
     data = record.to_json()
-    assert list(data) == list(schema_json(name)["properties"])
+    schema = schema_json(name)
+    assert list(data) == [key for key in schema["properties"] if key in data]
+    assert set(schema["required"]) <= set(data)
     validate(name, data)
     again = type(record).from_json(data)
     assert again == record
@@ -341,15 +360,21 @@ def test_step_records_carry_the_pose_and_the_outcome(corpus: Corpus) -> None:
     for step in corpus.of(StepRecord):
         truth, agent = step.truth, step.agent
         assert len(truth.angles_deg) == n
-        assert len(truth.joint_positions) == n + 1 and truth.joint_positions[0] == (0.0, 0.0)
-        assert len(truth.distances) == n and all(len(row) == m for row in truth.distances)
+        assert len(truth.joint_positions) == n + 1
+        assert truth.joint_positions[0] == PointRecord(x=0.0, y=0.0)
+        assert len(truth.distances) == n
+        assert all(len(tip.obstacles) == m for tip in truth.distances)
         assert truth.blocked == (truth.blocked_by is not None)
         assert (agent.action is None) == (agent.state_before is None) == (step.step == 0)
         assert agent.sensation == (agent.feedback == 1.0) or not agent.sensation
     scenario_message = corpus.of(ScenarioRecord)[0]
     assert scenario_message.n_joints == n and scenario_message.origin == corpus.scenario
     assert scenario_message.sha256 == scenario.sha256
-    assert scenario_message.strategy.params == {"block": 4096, "tags": ["a", "b"]}
+    strategy = scenario_message.strategy
+    assert strategy.param_values() == {"block": 4096, "tags": ["a", "b"]}
+    assert [p.value for p in strategy.params] == ["4096", '["a","b"]']
+    assert strategy.import_path == "rsstp_sim.strategies.random_walk:RandomStrategy"
+    assert (strategy.distribution, strategy.version) == ("rsstp", rsstp_sim.__version__)
 
 
 def test_the_model_is_rebuilt_from_the_model_messages(corpus: Corpus) -> None:
@@ -371,8 +396,8 @@ def test_ground_truth_floats_survive_json_exactly(corpus: Corpus) -> None:
         for step in corpus.of(StepRecord)
         for value in (
             step.agent.feedback,
-            *(c for point in step.truth.joint_positions for c in point),
-            *(d for row in step.truth.distances for d in row),
+            *(c for point in step.truth.joint_positions for c in (point.x, point.y)),
+            *(d for tip in step.truth.distances for d in tip.obstacles),
         )
     ]
     bits = [struct.pack("<d", v) for v in floats]
@@ -393,7 +418,11 @@ def test_origin_is_the_file_base_name_never_a_directory(tmp_path: Path, corpus: 
     path.parent.mkdir()
     path.write_text(text, encoding="utf-8")
     record = scenario_record(
-        load_scenario(path), seed=3, strategy_name="random", strategy_params={}
+        load_scenario(path),
+        seed=3,
+        strategy_name="random",
+        strategy_params={},
+        strategy_origin=strategy_origin(RandomStrategy()),
     )
     assert record.origin == "my arm.toml"
     assert str(tmp_path) not in encode(record).decode()
@@ -431,7 +460,7 @@ def _required_paths(
 ) -> Iterator[tuple[Any, ...]]:
     """Paths (keys and indices) of every required field of ``value`` under ``schema``."""
     if "properties" in schema and isinstance(value, dict):
-        for key in schema["required"]:
+        for key in schema.get("required", ()):
             yield (*path, key)
             yield from _required_paths(value[key], schema["properties"][key], (*path, key))
     elif isinstance(schema.get("items"), Mapping) and isinstance(value, list) and value:
@@ -475,15 +504,15 @@ def test_a_missing_field_fails_validation_and_from_json(name: str, path: tuple[A
         ("rsstp.Step", ("agent", "action"), 1.5, r"agent.action: expected `int \| null`"),
         (
             "rsstp.Step",
-            ("truth", "joint_positions", 1, 0),
+            ("truth", "joint_positions", 1, "x"),
             "x",
-            r"truth.joint_positions\[1\]\[0\]: expected `float`, got `str`",
+            r"truth.joint_positions\[1\].x: expected `float`, got `str`",
         ),
         (
             "rsstp.Step",
             ("truth", "joint_positions", 1),
-            [1.0],
-            r"truth.joint_positions\[1\]: expected `array` of length 2",
+            [1.0, 2.0],
+            r"truth.joint_positions\[1\]: expected `object`, got `array`",
         ),
         (
             "rsstp.Step",
@@ -494,8 +523,8 @@ def test_a_missing_field_fails_validation_and_from_json(name: str, path: tuple[A
         (
             "rsstp.Model",
             ("transitions", 0),
-            [0, 1],
-            r"transitions\[0\]: expected `array` of length 3",
+            [0, 1, 2],
+            r"transitions\[0\]: expected `object`, got `array`",
         ),
         ("rsstp.Model", ("operations", 0, "kind"), "swap", r"operations\[0\].kind: invalid enum"),
         ("rsstp.Scenario", ("feedback", "mode"), "int", r"feedback.mode: invalid enum value"),
@@ -530,7 +559,7 @@ def test_a_mistyped_field_is_refused_with_its_path(
     [
         ("blocked", {"action": 1}, r"data.blocked_by: missing \(kind 'blocked'\)"),
         ("no_transition", {"state": 0}, r"data.action: missing"),
-        ("split", {"args": [0]}, r"data.result: missing"),
+        ("split", {"result": 1}, r"data.args: missing"),
         (
             "contradiction",
             {"state": 0, "i": 1, "j": 2, "actions": ["x"]},
@@ -550,7 +579,7 @@ def test_event_data_is_checked_by_kind(kind: str, data: dict[str, Any], message:
 def test_unknown_fields_are_ignored(name: str) -> None:
     data = copy.deepcopy(SAMPLES[name])
     expected = RECORD_TYPES[name].from_json(data)
-    data["added_in_1_1"] = {"anything": [1, 2]}
+    data["added_in_2_1"] = {"anything": [1, 2]}
     for key, value in data.items():
         if isinstance(value, dict) and key != "data":  # an event's data keeps every key
             value["also_new"] = None
@@ -581,7 +610,13 @@ def test_bad_bytes_and_bad_shapes_are_refused() -> None:
 def test_builders_refuse_what_cannot_be_recorded() -> None:
     scenario = load_scenario("three-joint")
     with pytest.raises(RecordFormatError, match=r"^rsstp.Scenario: strategy.params: expected"):
-        scenario_record(scenario, seed=0, strategy_name="x", strategy_params={"f": object()})
+        scenario_record(
+            scenario,
+            seed=0,
+            strategy_name="x",
+            strategy_params={"f": object()},
+            strategy_origin=strategy_origin(RandomStrategy()),
+        )
     with pytest.raises(RecordFormatError, match=r"no_transition event needs state and action"):
         event_record(Event(3, "no_transition", "no transition"))
     assert note_event(2, "two\nlines").text == "two lines"
@@ -613,28 +648,32 @@ def step_records(draw: st.DrawFn) -> StepRecord:
             st.none()
             | st.builds(
                 BlockedByRecord,
-                st.sampled_from(["fold", "obstacle", "links"]),
-                st.lists(st.integers(min_value=0, max_value=50), min_size=1, max_size=2).map(tuple),
+                kind=st.sampled_from(["fold", "obstacle", "links"]),
+                indices=st.lists(st.integers(0, 50), min_size=1, max_size=2).map(tuple),
             )
         )
     )
     agent = AgentRecord(
-        None if first else draw(st.integers(min_value=0, max_value=7)),
-        None if first else draw(ids),
-        draw(ids),
-        draw(st.booleans()),
-        draw(st.floats(min_value=0.0, max_value=1.0)),
-        draw(ids),
-        False if first else draw(st.booleans()),
+        action=None if first else draw(st.integers(min_value=0, max_value=7)),
+        state_before=None if first else draw(ids),
+        internal_state=draw(ids),
+        sensation=draw(st.booleans()),
+        feedback=draw(st.floats(min_value=0.0, max_value=1.0)),
+        model_version=draw(ids),
+        no_transition=False if first else draw(st.booleans()),
     )
+    points = draw(st.lists(st.tuples(finite, finite), min_size=n + 1, max_size=n + 1))
     truth = TruthRecord(
-        tuple(draw(st.lists(st.integers(0, 359), min_size=n, max_size=n))),
-        tuple(draw(st.lists(st.tuples(finite, finite), min_size=n + 1, max_size=n + 1))),
-        blocker is not None,
-        blocker,
-        tuple(tuple(draw(st.lists(finite, min_size=m, max_size=m))) for _ in range(n)),
+        angles_deg=tuple(draw(st.lists(st.integers(0, 359), min_size=n, max_size=n))),
+        joint_positions=tuple(PointRecord(x=x, y=y) for x, y in points),
+        blocked=blocker is not None,
+        blocked_by=blocker,
+        distances=tuple(
+            DistancesRecord(obstacles=tuple(draw(st.lists(finite, min_size=m, max_size=m))))
+            for _ in range(n)
+        ),
     )
-    return StepRecord(step, agent, truth)
+    return StepRecord(step=step, agent=agent, truth=truth)
 
 
 @settings(max_examples=300, deadline=None)
@@ -643,6 +682,8 @@ def test_random_step_records_round_trip(record: StepRecord) -> None:
     _round_trip(record)
     payload = encode(record)
     assert StepRecord.from_json(json.loads(payload)) == record
-    floats = [c for p in record.truth.joint_positions for c in p]
-    back = [c for p in decode("rsstp.Step", payload).truth.joint_positions for c in p]  # type: ignore[union-attr]
+    floats = [c for p in record.truth.joint_positions for c in (p.x, p.y)]
+    decoded = decode("rsstp.Step", payload)
+    assert isinstance(decoded, StepRecord)
+    back = [c for p in decoded.truth.joint_positions for c in (p.x, p.y)]
     assert [struct.pack("<d", v) for v in back] == [struct.pack("<d", v) for v in floats]

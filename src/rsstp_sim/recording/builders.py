@@ -19,14 +19,19 @@ from rsstp_sim.errors import RecordFormatError
 from rsstp_sim.recording.records import (
     AgentRecord,
     BlockedByRecord,
+    DistancesRecord,
+    EventKind,
     EventRecord,
     FeedbackRecord,
     ModelRecord,
     ObstacleRecord,
     OperationRecord,
+    ParamRecord,
+    PointRecord,
     ScenarioRecord,
     StepRecord,
     StrategyRecord,
+    TransitionRecord,
     TruthRecord,
     encode_json,
 )
@@ -36,6 +41,7 @@ if TYPE_CHECKING:
     from rsstp_sim.coupling import Event
     from rsstp_sim.geometry import Blocker
     from rsstp_sim.scenario import Scenario
+    from rsstp_sim.strategies import StrategyOrigin
     from rsstp_sim.transition_system import TransitionSystem
     from rsstp_sim.world import Pose
 
@@ -51,24 +57,33 @@ __all__ = [
     "operation_record",
     "scenario_record",
     "step_record",
+    "truth_record",
 ]
 
 
 def scenario_record(
-    scenario: Scenario, *, seed: int, strategy_name: str, strategy_params: Mapping[str, Any]
+    scenario: Scenario,
+    *,
+    seed: int,
+    strategy_name: str,
+    strategy_params: Mapping[str, Any],
+    strategy_origin: StrategyOrigin,
 ) -> ScenarioRecord:
     """The ``rsstp.Scenario`` message of a run.
 
     ``origin`` keeps only the base name of a scenario file (recordings must not depend on
-    the directory they were made in); ``strategy_params`` must be JSON-serialisable.
+    the directory they were made in); ``strategy_params`` must be JSON-serialisable, and are
+    written in name order, each value as JSON text.
     """
-    try:
-        params = msgspec.json.decode(encode_json(dict(strategy_params)))
-    except (TypeError, msgspec.EncodeError) as exc:
-        raise RecordFormatError(
-            f"rsstp.Scenario: strategy.params: expected JSON values, found "
-            f"{dict(strategy_params)!r} ({exc})"
-        ) from None
+    params: list[ParamRecord] = []
+    for name, value in sorted(strategy_params.items()):
+        try:
+            params.append(ParamRecord(name=str(name), value=encode_json(value).decode()))
+        except (TypeError, msgspec.EncodeError) as exc:
+            raise RecordFormatError(
+                f"rsstp.Scenario: strategy.params: expected JSON values, found "
+                f"{name}={value!r} ({exc})"
+            ) from None
     target = scenario.feedback_target_deg
     return ScenarioRecord(
         name=scenario.name,
@@ -81,20 +96,30 @@ def scenario_record(
         step_deg=int(scenario.step_deg),
         actions=tuple(int(v) for v in scenario.actions),
         obstacles=tuple(
-            ObstacleRecord((float(o.center[0]), float(o.center[1])), float(o.radius))
+            ObstacleRecord(center=_point(o.center), radius=float(o.radius))
             for o in scenario.obstacles
         ),
         feedback=FeedbackRecord(
             mode=scenario.feedback_mode,
             tolerance=float(scenario.tolerance),
             tolerance_abs=float(scenario.tolerance * scenario.total_length),
-            points=tuple((float(x), float(y)) for x, y in scenario.feedback_points),
+            points=tuple(_point(xy) for xy in scenario.feedback_points),
             target_deg=None if target is None else tuple(int(v) for v in target),
         ),
         collision=scenario.collision,
         seed=int(seed),
-        strategy=StrategyRecord(str(strategy_name), params),
+        strategy=StrategyRecord(
+            name=str(strategy_name),
+            import_path=strategy_origin.import_path,
+            distribution=strategy_origin.distribution,
+            version=strategy_origin.version,
+            params=tuple(params),
+        ),
     )
+
+
+def _point(xy: Any) -> PointRecord:
+    return PointRecord(x=float(xy[0]), y=float(xy[1]))
 
 
 def step_record(
@@ -114,32 +139,33 @@ def step_record(
     world's answer to the move (None when the arm moved, and at step 0).
     """
     return StepRecord(
-        int(step),
-        AgentRecord(
-            None if action is None else int(action),
-            None if state_before is None else int(state_before),
-            int(internal_state),
-            bool(pose.sensation),
-            float(pose.feedback),
-            int(model_version),
-            bool(no_transition),
+        step=int(step),
+        agent=AgentRecord(
+            action=None if action is None else int(action),
+            state_before=None if state_before is None else int(state_before),
+            internal_state=int(internal_state),
+            sensation=bool(pose.sensation),
+            feedback=float(pose.feedback),
+            model_version=int(model_version),
+            no_transition=bool(no_transition),
         ),
-        _truth_record(pose, blocker),
+        truth=truth_record(pose, blocker),
     )
 
 
 @functools.lru_cache(maxsize=1 << 12)
-def _truth_record(pose: Pose, blocker: Blocker | None) -> TruthRecord:
-    """A pose's truth (and the move's blocker); poses are cached read-only objects, so a
-    random walk revisiting them gets the same immutable record."""
+def truth_record(pose: Pose, blocker: Blocker | None) -> TruthRecord:
+    """The truth record of a step ending in ``pose`` after a move that ``blocker`` blocked
+    (None: it moved). Poses are cached read-only objects, so a random walk revisiting them
+    gets the same immutable record."""
     positions: list[list[float]] = pose.joint_positions.tolist()
     distances: list[list[float]] = pose.distances.tolist()
     return TruthRecord(
-        tuple(int(v) for v in pose.angles_deg),
-        tuple((x, y) for x, y in positions),
-        blocker is not None,
-        blocked_by_record(blocker),
-        tuple(tuple(row) for row in distances),
+        angles_deg=tuple(int(v) for v in pose.angles_deg),
+        joint_positions=tuple(PointRecord(x=x, y=y) for x, y in positions),
+        blocked=blocker is not None,
+        blocked_by=blocked_by_record(blocker),
+        distances=tuple(DistancesRecord(obstacles=tuple(row)) for row in distances),
     )
 
 
@@ -147,16 +173,16 @@ def blocked_by_record(blocker: Blocker | None) -> BlockedByRecord | None:
     """The record of a :class:`~rsstp_sim.geometry.Blocker` (None stays None)."""
     if blocker is None:
         return None
-    return BlockedByRecord(blocker.kind, tuple(int(i) for i in blocker.indices))
+    return BlockedByRecord(kind=blocker.kind, indices=tuple(int(i) for i in blocker.indices))
 
 
 def operation_record(op: Operation) -> OperationRecord:
     """The record of a model :class:`~rsstp_sim.transition_system.Operation`."""
     return OperationRecord(
-        op.kind,
-        tuple(int(v) for v in op.args),
-        None if op.result is None else int(op.result),
-        bool(op.changed),
+        kind=op.kind,
+        args=tuple(int(v) for v in op.args),
+        result=None if op.result is None else int(op.result),
+        changed=bool(op.changed),
     )
 
 
@@ -182,7 +208,9 @@ def model_record(
         next_id=int(model.next_id),
         current=int(model.current),
         actions=model.actions,
-        transitions=transitions,
+        transitions=tuple(
+            TransitionRecord(source=s, action=a, target=t) for s, a, t in transitions
+        ),
         operations=tuple(operation_record(op) for op in operations),
         deterministic=pairs == 0,
         nondeterministic_pairs=pairs,
@@ -192,7 +220,7 @@ def model_record(
 def blocked_event(step: int, *, action: int, blocker: Blocker) -> EventRecord:
     """A ``blocked`` event: ``action`` did not move the arm, because of ``blocker``."""
     by = {"kind": blocker.kind, "indices": [int(i) for i in blocker.indices]}
-    return EventRecord(
+    return _event(
         int(step),
         "blocked",
         f"action {action} blocked: {blocker.describe()}",
@@ -202,7 +230,7 @@ def blocked_event(step: int, *, action: int, blocker: Blocker) -> EventRecord:
 
 def no_transition_event(step: int, *, state: int, action: int) -> EventRecord:
     """A ``no_transition`` event: the model had no transition from ``state`` by ``action``."""
-    return EventRecord(
+    return _event(
         int(step),
         "no_transition",
         f"no transition from state {state} by action {action}: the internal state stays",
@@ -212,7 +240,7 @@ def no_transition_event(step: int, *, state: int, action: int) -> EventRecord:
 
 def note_event(step: int, text: str) -> EventRecord:
     """A strategy ``note`` (line breaks become spaces: an event is one line)."""
-    return EventRecord(int(step), "note", _one_line(text), {})
+    return _event(step, "note", _one_line(text), {})
 
 
 def event_record(
@@ -230,7 +258,7 @@ def event_record(
             f"rsstp.Event: a {event.kind} event needs state and action, "
             f"found state={state!r}, action={action!r}"
         )
-    return EventRecord(
+    return _event(
         int(event.step),
         "no_transition",
         _one_line(event.text),
@@ -241,14 +269,12 @@ def event_record(
 def operation_events(step: int, operations: Iterable[Operation]) -> tuple[EventRecord, ...]:
     """One ``split``/``merge``/``add``/``delete`` event per model operation."""
     return tuple(
-        EventRecord(
-            int(step),
+        _event(
+            step,
             op.kind,
             _describe_operation(op),
-            {
-                "args": [int(v) for v in op.args],
-                "result": None if op.result is None else int(op.result),
-            },
+            {"args": [int(v) for v in op.args]}
+            | ({} if op.result is None else {"result": int(op.result)}),
         )
         for op in operations
     )
@@ -267,12 +293,16 @@ def contradiction_event(
             f"end in different sensations"
         )
     )
-    return EventRecord(
+    return _event(
         int(step),
         "contradiction",
         _one_line(line),
         {"state": int(state), "i": int(i), "j": int(j), "actions": acts},
     )
+
+
+def _event(step: int, kind: EventKind, text: str, data: dict[str, Any]) -> EventRecord:
+    return EventRecord(step=int(step), kind=kind, text=text, data=data)
 
 
 def _describe_operation(op: Operation) -> str:

@@ -26,7 +26,7 @@ import json
 import os
 import platform
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
 
@@ -49,7 +49,7 @@ from rsstp_sim.recording.schemas import (
     schema_bytes,
 )
 from rsstp_sim.scenario import Scenario
-from rsstp_sim.strategies import Strategy
+from rsstp_sim.strategies import Strategy, strategy_origin
 from rsstp_sim.transition_system import Operation
 from rsstp_sim.world import Pose
 
@@ -178,12 +178,18 @@ class Recorder:
         for topic, name in TOPICS.items():
             self._channels[topic] = writer.register_channel(topic, "json", schema_ids[name])
         params = dict(strategy.params())
+        origin = strategy_origin(strategy)
+        if origin.distribution == "rsstp":  # ours: the version the metadata names
+            origin = replace(origin, version=self._versions["package_version"])
         meta = {
             "package": "rsstp",
             **self._versions,
             "seed": str(seed),
             "strategy": strategy.name,
             "strategy_params": json.dumps(params, sort_keys=True),
+            "strategy_import_path": origin.import_path,
+            "strategy_distribution": origin.distribution or "",
+            "strategy_version": origin.version or "",
             "scenario_sha256": scenario.sha256,
         }
         writer.add_metadata(METADATA_NAME, {key: meta[key] for key in METADATA_KEYS})
@@ -191,7 +197,11 @@ class Recorder:
             0, 0, ATTACHMENT_NAME, ATTACHMENT_MEDIA_TYPE, scenario.source.encode("utf-8")
         )
         record = builders.scenario_record(
-            scenario, seed=seed, strategy_name=strategy.name, strategy_params=params
+            scenario,
+            seed=seed,
+            strategy_name=strategy.name,
+            strategy_params=params,
+            strategy_origin=origin,
         )
         self._add("/rsstp/scenario", 0, records.encode(record))
         if not self._pending_models:  # step 0 always has the initial model
@@ -207,44 +217,28 @@ class Recorder:
         """The pose's truth fields as JSON fragments, around the per-step blocked fields."""
         parts = self._pose_parts.get(pose.code)
         if parts is None:
-            before = _json(
-                {
-                    "angles_deg": list(pose.angles_deg),
-                    "joint_positions": pose.joint_positions.tolist(),
-                }
-            )
-            after = _json({"distances": pose.distances.tolist()})
-            parts = (before[1:-1] + b",", b"," + after[1:-1])
+            truth = records.encode_json(builders.truth_record(pose, None))
+            before, _, after = truth[1:-1].partition(b',"blocked":false,')
+            parts = (before + b",", b"," + after)
             self._pose_parts[pose.code] = parts
         return parts
 
     def _step_bytes(self, step: int, outcome: StepOutcome | None, pose: Pose) -> bytes:
         """Encode one ``rsstp.Step`` message (the same bytes as ``records.encode``)."""
         runner = self.runner
+        model = runner.model
         if outcome is None:
-            agent = {
-                "action": None,
-                "state_before": None,
-                "internal_state": runner.model.current,
-                "sensation": pose.sensation,
-                "feedback": pose.feedback,
-                "model_version": runner.model.version,
-                "no_transition": False,
-            }
-            blocked = b'"blocked":false,"blocked_by":null'
+            agent = b'{"internal_state":%d' % model.current
+            blocked = b'"blocked":false'
         else:
-            agent = {
-                "action": outcome.action,
-                "state_before": outcome.state_before,
-                "internal_state": outcome.state_after,
-                "sensation": pose.sensation,
-                "feedback": pose.feedback,
-                "model_version": runner.model.version,
-                "no_transition": outcome.no_transition,
-            }
+            agent = b'{"action":%d,"state_before":%d,"internal_state":%d' % (
+                outcome.action,
+                outcome.state_before,
+                outcome.state_after,
+            )
             blocker = outcome.blocker
             if blocker is None:
-                blocked = b'"blocked":false,"blocked_by":null'
+                blocked = b'"blocked":false'
             else:
                 blocked = b'"blocked":true,"blocked_by":' + _json(
                     {"kind": blocker.kind, "indices": list(blocker.indices)}
@@ -255,8 +249,14 @@ class Recorder:
                 b'{"step":',
                 str(step).encode(),
                 b',"agent":',
-                _json(agent),
-                b',"truth":{',
+                agent,
+                b',"sensation":',
+                b"true" if pose.sensation else b"false",
+                b',"feedback":',
+                _json(pose.feedback),
+                b',"model_version":%d,"no_transition":' % model.version,
+                b"true" if outcome is not None and outcome.no_transition else b"false",
+                b'},"truth":{',
                 before,
                 blocked,
                 after,

@@ -1,12 +1,14 @@
-"""The records of a recording: plain dataclasses that mirror ``schemas/*.json`` one to one.
+"""The records of a recording: msgspec structs that mirror ``schemas/*.json`` one to one.
 
 Each message schema (``rsstp.Scenario``, ``rsstp.Step``, ``rsstp.Model``, ``rsstp.Event``)
 has a record class, and each nested object of a schema has one too. Field names, order and
-types are those of the schema: JSON arrays are tuples, JSON objects whose keys are free
-(``strategy.params``, an event's ``data``) are dicts of JSON values, ``null`` is ``None``.
+types are those of the schema: JSON arrays are tuples, points are :class:`PointRecord`
+``{x, y}``, transitions are :class:`TransitionRecord` ``{source, action, target}``. A field the
+schema makes optional is ``None`` in Python and left out of the JSON (schema 2.0 writes no
+``null``: see ``schemas/README.md``); an event's ``data`` is a dict of the fields its kind has.
 
 - ``record.to_json()`` gives the JSON-ready dict (keys in schema order, arrays as lists);
-- ``Record.from_json(data)`` reads one back, ignoring keys it does not know (a later 1.x may
+- ``Record.from_json(data)`` reads one back, ignoring keys it does not know (a later 2.x may
   add fields) and refusing missing or mistyped ones with a :class:`RecordFormatError` that
   names the field path; value ranges are the schema's business
   (:func:`rsstp_sim.recording.schemas.validate`);
@@ -16,19 +18,21 @@ types are those of the schema: JSON arrays are tuples, JSON objects whose keys a
 
 :mod:`rsstp_sim.recording.builders` makes records from the simulator's live objects.
 
->>> record = EventRecord(3, "note", "exploring joint 1", {})
+>>> record = EventRecord(step=3, kind="note", text="exploring joint 1", data={})
 >>> encode(record)
 b'{"step":3,"kind":"note","text":"exploring joint 1","data":{}}'
 >>> decode("rsstp.Event", encode(record)) == record
 True
+>>> encode(AgentRecord(internal_state=0, sensation=False, feedback=0.5, model_version=0,
+...                    no_transition=False))
+b'{"internal_state":0,"sensation":false,"feedback":0.5,"model_version":0,"no_transition":false}'
 """
 
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, ClassVar, Literal, Self, TypeVar
+from collections.abc import Iterator, Mapping
+from typing import Any, ClassVar, Literal, Self, TypeVar
 
 import msgspec
 
@@ -37,23 +41,24 @@ from rsstp_sim.geometry import BlockerKind
 from rsstp_sim.scenario import CollisionMode, FeedbackMode
 from rsstp_sim.transition_system import Operation, OperationKind
 
-if TYPE_CHECKING:
-    pass
-
 __all__ = [
     "AgentRecord",
     "BlockedByRecord",
+    "DistancesRecord",
     "EventRecord",
     "FeedbackRecord",
     "MessageRecord",
     "ModelRecord",
     "ObstacleRecord",
     "OperationRecord",
+    "ParamRecord",
+    "PointRecord",
     "RECORD_TYPES",
     "RecordFormatError",
     "ScenarioRecord",
     "StepRecord",
     "StrategyRecord",
+    "TransitionRecord",
     "TruthRecord",
     "decode",
     "encode",
@@ -62,16 +67,14 @@ __all__ = [
 EventKind = Literal[
     "blocked", "no_transition", "split", "merge", "add", "delete", "note", "contradiction"
 ]
-Point = tuple[float, float]
 
 
-class _Record:
+class _Record(msgspec.Struct, frozen=True, omit_defaults=True, kw_only=True):
     """JSON conversion, shared by every record class."""
 
-    __slots__ = ()
-
     def to_json(self) -> dict[str, Any]:
-        """The JSON-ready dict: keys in schema order, arrays as lists, ``None`` for null.
+        """The JSON-ready dict: keys in schema order, arrays as lists, optional fields that
+        are ``None`` left out.
 
         Exactly what the record's message bytes decode to.
         """
@@ -89,42 +92,66 @@ class _Record:
         """Checks beyond the field types (where the schema has them)."""
 
 
+# ---------------------------------------------------------------- shared shapes
+
+
+class PointRecord(_Record, frozen=True, kw_only=True):
+    """A point ``{x, y}`` in the world frame (length units)."""
+
+    x: float
+    y: float
+
+
 # ---------------------------------------------------------------- rsstp.Scenario
 
 
-@dataclass(frozen=True, slots=True)
-class ObstacleRecord(_Record):
-    """A circular obstacle: ``center`` ``[x, y]`` and ``radius``, in length units."""
+class ObstacleRecord(_Record, frozen=True, kw_only=True):
+    """A circular obstacle: ``center`` ``{x, y}`` and ``radius``, in length units."""
 
-    center: Point
+    center: PointRecord
     radius: float
 
 
-@dataclass(frozen=True, slots=True)
-class FeedbackRecord(_Record):
-    """Where the tips must be for the sensation (``points``: one ``[x, y]`` per joint).
+class FeedbackRecord(_Record, frozen=True, kw_only=True):
+    """Where the tips must be for the sensation (``points``: one ``{x, y}`` per joint).
 
     ``tolerance`` is relative to the total arm length; ``tolerance_abs`` is in length
-    units; ``target_deg`` is the pose defining the points, or ``None`` if they were given.
+    units; ``target_deg`` is the pose defining the points, or ``None`` (absent) if they were
+    given.
     """
 
     mode: FeedbackMode
     tolerance: float
     tolerance_abs: float
-    points: tuple[Point, ...]
-    target_deg: tuple[int, ...] | None
+    points: tuple[PointRecord, ...]
+    target_deg: tuple[int, ...] | None = None
 
 
-@dataclass(frozen=True, slots=True)
-class StrategyRecord(_Record):
-    """The strategy's name and its parameters (JSON values)."""
+class ParamRecord(_Record, frozen=True, kw_only=True):
+    """One strategy parameter: its ``name`` and its value as JSON text (``"0.1"``,
+    ``"[0, 1]"``), so every parameter has the same type whatever its value."""
 
     name: str
-    params: dict[str, Any]
+    value: str
 
 
-@dataclass(frozen=True, slots=True)
-class ScenarioRecord(_Record):
+class StrategyRecord(_Record, frozen=True, kw_only=True):
+    """The strategy: its name, where its class lives (``import_path``, ``package.module:Class``)
+    and the distribution that provides it with that distribution's version (absent for a
+    module that no installed distribution provides), and its parameters in name order."""
+
+    name: str
+    import_path: str
+    distribution: str | None = None
+    version: str | None = None
+    params: tuple[ParamRecord, ...]
+
+    def param_values(self) -> dict[str, Any]:
+        """The parameters as the strategy took them: name -> JSON value."""
+        return {p.name: _DECODE_JSON(p.value) for p in self.params}
+
+
+class ScenarioRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Scenario`` on ``/rsstp/scenario``: the run's world, seed and strategy."""
 
     schema_name: ClassVar[str] = "rsstp.Scenario"
@@ -148,12 +175,12 @@ class ScenarioRecord(_Record):
 # -------------------------------------------------------------------- rsstp.Step
 
 
-@dataclass(frozen=True, slots=True)
-class AgentRecord(_Record):
-    """What the agent knows after a step (``action`` and ``state_before`` None at step 0)."""
+class AgentRecord(_Record, frozen=True, kw_only=True):
+    """What the agent knows after a step (``action`` and ``state_before`` None, absent from
+    the JSON, at step 0)."""
 
-    action: int | None
-    state_before: int | None
+    action: int | None = None
+    state_before: int | None = None
     internal_state: int
     sensation: bool
     feedback: float
@@ -161,8 +188,7 @@ class AgentRecord(_Record):
     no_transition: bool
 
 
-@dataclass(frozen=True, slots=True)
-class BlockedByRecord(_Record):
+class BlockedByRecord(_Record, frozen=True, kw_only=True):
     """Why a move was blocked: ``fold`` ``[joint]``, ``obstacle`` ``[link, obstacle]``,
     ``links`` ``[link_i, link_j]``."""
 
@@ -170,19 +196,25 @@ class BlockedByRecord(_Record):
     indices: tuple[int, ...]
 
 
-@dataclass(frozen=True, slots=True)
-class TruthRecord(_Record):
-    """Ground truth after a step: angles (degrees), positions and distances (length units)."""
+class DistancesRecord(_Record, frozen=True, kw_only=True):
+    """The distances from one link tip to each obstacle's surface (length units), in
+    scenario order."""
+
+    obstacles: tuple[float, ...]
+
+
+class TruthRecord(_Record, frozen=True, kw_only=True):
+    """Ground truth after a step: angles (degrees), positions and distances (length units);
+    ``blocked_by`` None (absent) when the arm moved."""
 
     angles_deg: tuple[int, ...]
-    joint_positions: tuple[Point, ...]
+    joint_positions: tuple[PointRecord, ...]
     blocked: bool
-    blocked_by: BlockedByRecord | None
-    distances: tuple[tuple[float, ...], ...]
+    blocked_by: BlockedByRecord | None = None
+    distances: tuple[DistancesRecord, ...]
 
 
-@dataclass(frozen=True, slots=True)
-class StepRecord(_Record):
+class StepRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Step`` on ``/rsstp/step``: one step (0 = the reset), agent view and truth."""
 
     schema_name: ClassVar[str] = "rsstp.Step"
@@ -195,13 +227,29 @@ class StepRecord(_Record):
 # ------------------------------------------------------------------- rsstp.Model
 
 
-@dataclass(frozen=True, slots=True)
-class OperationRecord(_Record):
-    """One model operation, as :class:`~rsstp_sim.transition_system.Operation`."""
+class TransitionRecord(_Record, frozen=True, kw_only=True, order=True, gc=False):
+    """One transition ``source -action-> target`` (state ids and an action id). It unpacks
+    like the ``(source, action, target)`` triples of
+    :meth:`~rsstp_sim.transition_system.TransitionSystem.transitions`."""
+
+    source: int
+    action: int
+    target: int
+
+    def __iter__(self) -> Iterator[int]:
+        return iter((self.source, self.action, self.target))
+
+    def triple(self) -> tuple[int, int, int]:
+        return (self.source, self.action, self.target)
+
+
+class OperationRecord(_Record, frozen=True, kw_only=True):
+    """One model operation, as :class:`~rsstp_sim.transition_system.Operation` (``result``
+    None, absent, for the operations that create nothing)."""
 
     kind: OperationKind
     args: tuple[int, ...]
-    result: int | None
+    result: int | None = None
     changed: bool
 
     def to_operation(self) -> Operation:
@@ -209,8 +257,7 @@ class OperationRecord(_Record):
         return Operation(self.kind, self.args, self.result, self.changed)
 
 
-@dataclass(frozen=True, slots=True)
-class ModelRecord(_Record):
+class ModelRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Model`` on ``/rsstp/model``: the model after a change, and the operations since
     the previous model message."""
 
@@ -222,10 +269,14 @@ class ModelRecord(_Record):
     next_id: int
     current: int
     actions: tuple[int, ...]
-    transitions: tuple[tuple[int, int, int], ...]
+    transitions: tuple[TransitionRecord, ...]
     operations: tuple[OperationRecord, ...]
     deterministic: bool
     nondeterministic_pairs: int
+
+    def triples(self) -> tuple[tuple[int, int, int], ...]:
+        """The transitions as ``(source, action, target)`` triples, sorted as written."""
+        return tuple(t.triple() for t in self.transitions)
 
     def snapshot(self) -> dict[str, object]:
         """The model in :meth:`TransitionSystem.snapshot` form (for ``from_snapshot``)."""
@@ -234,20 +285,20 @@ class ModelRecord(_Record):
             "next_id": self.next_id,
             "current": self.current,
             "actions": list(self.actions),
-            "transitions": [list(triple) for triple in self.transitions],
+            "transitions": [list(t) for t in self.triples()],
         }
 
 
 # ------------------------------------------------------------------- rsstp.Event
 
 
-@dataclass(frozen=True, slots=True)
-class EventRecord(_Record):
+class EventRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Event`` on ``/rsstp/event``: one line of log (``text``), ``data`` by ``kind``:
 
     - ``blocked``: ``{action, blocked_by: {kind, indices}}``;
     - ``no_transition``: ``{state, action}``;
-    - ``split``, ``merge``, ``add``, ``delete``: ``{args, result}`` as in :class:`OperationRecord`;
+    - ``split``, ``merge``, ``add``, ``delete``: ``{args}`` and ``result`` when the operation
+      created a state, as in :class:`OperationRecord`;
     - ``note``: ``{}``;
     - ``contradiction``: ``{state, i, j, actions}``.
     """
@@ -285,7 +336,7 @@ _DECODERS = {name: msgspec.json.Decoder(cls) for name, cls in RECORD_TYPES.items
 def encode(record: MessageRecord) -> bytes:
     """The message bytes: compact UTF-8 JSON, keys in schema order, shortest float reprs.
 
-    msgspec serialises the dataclass directly, without building a dict (the fastest of
+    msgspec serialises the struct directly, without building a dict (the fastest of
     json, orjson and msgspec: ``bench/encoding.py``); the JSON equals ``record.to_json()``.
     """
     return _ENCODER.encode(record)
@@ -347,31 +398,26 @@ def _convert(data: object, cls: type[_R], label: str) -> _R:
     return record
 
 
-@dataclass(frozen=True, slots=True)
-class _BlockedData:
+class _BlockedData(msgspec.Struct):
     action: int
     blocked_by: BlockedByRecord
 
 
-@dataclass(frozen=True, slots=True)
-class _NoTransitionData:
+class _NoTransitionData(msgspec.Struct):
     state: int
     action: int
 
 
-@dataclass(frozen=True, slots=True)
-class _NoteData:
+class _NoteData(msgspec.Struct):
     pass
 
 
-@dataclass(frozen=True, slots=True)
-class _OperationData:
+class _OperationData(msgspec.Struct):
     args: tuple[int, ...]
-    result: int | None
+    result: int | None = None
 
 
-@dataclass(frozen=True, slots=True)
-class _ContradictionData:
+class _ContradictionData(msgspec.Struct):
     state: int
     i: int
     j: int

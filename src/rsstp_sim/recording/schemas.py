@@ -2,7 +2,7 @@
 
 A recording registers each schema's file byte for byte (:func:`schema_bytes`), so the
 files are part of the contract; ``schemas/README.md`` documents every field, the topics,
-the metadata record, the attachment and the version policy: a reader accepts any ``1.x``
+the metadata record, the attachment and the version policy: a reader accepts any ``2.x``
 (ignoring fields it does not know) and refuses another major version
 (:func:`check_schema_version`).
 
@@ -46,9 +46,10 @@ __all__ = [
     "schema_json",
     "validate",
     "validator",
+    "version_refusal",
 ]
 
-SCHEMA_VERSION = "1.0"
+SCHEMA_VERSION = "2.0"
 """The version (``major.minor``) of the schemas this package writes."""
 
 SCHEMA_NAMES = ("rsstp.Scenario", "rsstp.Step", "rsstp.Model", "rsstp.Event")
@@ -79,6 +80,9 @@ METADATA_KEYS = (
     "seed",
     "strategy",
     "strategy_params",
+    "strategy_import_path",
+    "strategy_distribution",
+    "strategy_version",
     "scenario_sha256",
 )
 """The keys of the ``rsstp`` metadata record (every value a string)."""
@@ -131,7 +135,7 @@ def validate(name: str, instance: Mapping[str, Any]) -> None:
 
 
 def check_schema_version(name: str, data: bytes) -> tuple[int, int]:
-    """Check a schema found in a recording: title ``name`` and a ``1.x`` version.
+    """Check a schema found in a recording: title ``name`` and a ``2.x`` version.
 
     Returns ``(major, minor)``. A later minor version is accepted (its new fields are
     ignored); another major version, or a schema that is not ours, is refused.
@@ -149,11 +153,16 @@ def check_schema_version(name: str, data: bytes) -> tuple[int, int]:
         raise RecordFormatError(f"{name}: {exc}") from None
     supported, _ = parse_version(SCHEMA_VERSION)
     if major != supported:
-        raise RecordFormatError(
-            f"{name}: schema version {major}.{minor} is not supported "
-            f"(this reader understands {supported}.x)"
-        )
+        raise RecordFormatError(f"{name}: schema {version_refusal(f'{major}.{minor}')}")
     return major, minor
+
+
+def version_refusal(version: object) -> str:
+    """Why a recording's schema ``version`` of another major is not read, and what to do."""
+    return (
+        f"version {version} is not supported (this reader understands {SCHEMA_VERSION[0]}.x; "
+        f"re-record the run with rsstp-sim record: its scenario.toml is attached)"
+    )
 
 
 def _known(name: str) -> str:

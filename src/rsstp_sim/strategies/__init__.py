@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from importlib import metadata
 from typing import Any
 
@@ -33,9 +34,11 @@ __all__ = [
     "Strategy",
     "StrategyBase",
     "ENTRY_POINT_GROUP",
+    "StrategyOrigin",
     "builtin_strategies",
     "make_strategy",
     "plugin_strategies",
+    "strategy_origin",
 ]
 
 _BUILTIN: dict[str, Callable[..., Strategy]] = {
@@ -83,6 +86,37 @@ def make_strategy(name: str, params: Mapping[str, Any] | None = None) -> Strateg
             f"{', '.join(missing) or 'name'}; subclass rsstp_sim.StrategyBase)"
         )
     return strategy
+
+
+@dataclass(frozen=True, slots=True)
+class StrategyOrigin:
+    """Where a strategy's class comes from: ``import_path`` (``package.module:Class``), and
+    the installed distribution that provides its top-level package with that
+    distribution's version (None for a module found on ``sys.path`` that no distribution
+    provides)."""
+
+    import_path: str
+    distribution: str | None
+    version: str | None
+
+
+def strategy_origin(strategy: Strategy) -> StrategyOrigin:
+    """The :class:`StrategyOrigin` of ``strategy`` (what a recording states of it)."""
+    cls = type(strategy)
+    import_path = f"{cls.__module__}:{cls.__qualname__}"
+    top = cls.__module__.partition(".")[0]
+    if top == "rsstp_sim":  # ours: no scan of the installed distributions
+        from rsstp_sim import __version__
+
+        return StrategyOrigin(import_path, "rsstp", __version__)
+    names = sorted(set(metadata.packages_distributions().get(top, ())))
+    if not names:
+        return StrategyOrigin(import_path, None, None)
+    try:
+        version = metadata.version(names[0])
+    except metadata.PackageNotFoundError:
+        version = None
+    return StrategyOrigin(import_path, names[0], version)
 
 
 _METHODS = ("params", "initial_model", "reset", "choose_action", "refine")
