@@ -1,5 +1,5 @@
 """``rsstp-replay``: look into a recording: ``info``, ``check``, ``table``, ``events``,
-``audit``, ``compare``, ``view``, ``graph``.
+``audit``, ``compare``, ``view``, ``graph``, ``export``.
 
 Bad input (a missing or damaged file, a file from another tool, a schema version this reader
 does not know, a step out of range) gets one line on stderr naming the file and the problem,
@@ -349,6 +349,22 @@ def _cmd_graph(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_export(args: argparse.Namespace) -> int:
+    from rsstp_replay.foxglove_scene import export_foxglove
+
+    out = Path(args.output)
+    if out.suffix.lower() != ".mcap":
+        raise UsageError(
+            f"{out}: a Foxglove scene is an .mcap file, not {out.suffix or '(no suffix)'!r}"
+        )
+    if out.resolve() == Path(args.foxglove).resolve():
+        raise UsageError(f"{out}: is the recording being exported: give another output")
+    _check_output(out, force=args.force)
+    with _open(args.foxglove) as recording:
+        print(export_foxglove(recording, out).to_text())
+    return 0
+
+
 def _integer(text: str) -> int:
     try:
         return int(text)
@@ -463,6 +479,17 @@ def _build_parser() -> Parser:
     p.add_argument("m", type=_integer, metavar="M", help="second start step")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_cmd_compare)
+
+    p = sub.add_parser("export", help="write a recording for another viewer: a Foxglove scene")
+    p.add_argument(
+        "--foxglove",
+        required=True,
+        metavar="FILE",
+        help="the .mcap recording to write as a Foxglove scene (SceneUpdate, FrameTransforms, Log)",
+    )
+    p.add_argument("-o", "--output", required=True, help="the scene file (.mcap)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output file")
+    p.set_defaults(func=_cmd_export)
 
     from rsstp_sweep.commands import add_report_parser  # the sweep's report (no Dask needed)
 

@@ -1,0 +1,394 @@
+"""A recording as a Foxglove scene: a companion MCAP of well-known Foxglove schemas (protobuf).
+
+>>> with open_recording("run.mcap") as recording:  # doctest: +SKIP
+...     export_foxglove(recording, "run.scene.mcap")
+
+The recording itself is JSON described by this project's schemas: Foxglove plots it, but its
+3D panel has nothing to draw. The scene file tells the same run in schemas the viewers know:
+
+- ``/rsstp/scene`` (``foxglove.SceneUpdate``): entity ``arm`` in frame ``world``, a line strip
+  through the joint positions (base first) with a sphere at every joint; at step 0 and then
+  only at the steps where the arm moved (a blocked move leaves it where it was: nothing is
+  sent). Each update replaces the previous ``arm``; no lifetime (it stays until replaced).
+- ``/rsstp/scene/static`` (``foxglove.SceneUpdate``): once, at step 0, no lifetime: entity
+  ``obstacles`` (flat cylinders of the obstacles' radii) and entity ``feedback`` (a small
+  sphere at every feedback point). A topic of its own: a viewer that jumps on the timeline
+  shows the latest message of each topic, and on the arm's topic they would vanish.
+- ``/rsstp/transforms`` (``foxglove.FrameTransforms``): at step 0, ``world -> base``
+  (identity) and ``link{n-1} -> tip`` (the last link's length along x); at step 0 and at every
+  step the arm moved, ``base -> link0 -> ... -> link{n-1}``: link ``k``'s frame sits at the
+  end of link ``k - 1`` (at the base for ``k = 0``), turned by ``angle_deg_k`` about z.
+- ``/rsstp/log`` (``foxglove.Log``): one per event, at its step: ``name`` the kind, ``message``
+  its text; level WARNING for ``blocked`` and ``contradiction``, INFO for the others.
+
+A metadata record ``rsstp.scene`` names what the scene was made from (scenario and its
+SHA-256, strategy, seed, steps) and by which ``rsstp``. The world is the plane z = 0, in the
+recording's length unit. The ``log_time`` (and ``publish_time``) and the ``timestamp`` of
+every message of step ``t`` are ``t * 1,000,000`` ns, as in the recording, and nothing else
+holds a time: the same recording gives the same bytes (with the same foxglove-sdk, whose name
+and version the file's header gives).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+from foxglove.channels import FrameTransformsChannel, LogChannel, SceneUpdateChannel
+from foxglove.messages import (
+    Color,
+    CylinderPrimitive,
+    FrameTransform,
+    FrameTransforms,
+    LinePrimitive,
+    LinePrimitiveLineType,
+    Log,
+    LogLevel,
+    Point3,
+    Pose,
+    Quaternion,
+    SceneEntity,
+    SceneUpdate,
+    SpherePrimitive,
+    Timestamp,
+    Vector3,
+)
+
+from rsstp_replay._foxglove_writer import open_scene
+from rsstp_replay.errors import ReplayError
+from rsstp_sim import __version__, palette
+from rsstp_sim.files import written_whole
+from rsstp_sim.recording.schemas import STEP_NS
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+    from rsstp_replay.recording import Recording
+    from rsstp_sim.scenario import Scenario
+
+__all__ = [
+    "ARM_TOPIC",
+    "LOG_TOPIC",
+    "STATIC_TOPIC",
+    "TRANSFORMS_TOPIC",
+    "SceneExport",
+    "export_foxglove",
+]
+
+ARM_TOPIC = "/rsstp/scene"
+STATIC_TOPIC = "/rsstp/scene/static"
+TRANSFORMS_TOPIC = "/rsstp/transforms"
+LOG_TOPIC = "/rsstp/log"
+WORLD_FRAME = "world"
+_WARNING_KINDS = frozenset({"blocked", "contradiction"})
+
+# Sizes relative to the arm's total length, so that every scenario reads alike.
+_LINE_THICKNESS = 0.015
+_JOINT_DIAMETER = 0.04
+_FEEDBACK_DIAMETER = 0.03
+_OBSTACLE_HEIGHT = 0.01
+
+_BLOCK = 65_536
+"""Poses turned into Python numbers at a time."""
+_CACHED_POSES = 65_536
+"""Arm poses whose primitives are kept (three-joint has 39,232 reachable poses)."""
+
+
+@dataclass(frozen=True)
+class SceneExport:
+    """What :func:`export_foxglove` wrote: ``path``; ``steps`` (the recording's, the reset
+    included); ``arm_poses`` (``/rsstp/scene`` updates: step 0 and every step the arm moved);
+    ``logs`` (``/rsstp/log`` messages, one per event); ``size`` (bytes)."""
+
+    path: Path
+    steps: int
+    arm_poses: int
+    logs: int
+    size: int
+
+    def to_text(self) -> str:
+        return (
+            f"wrote {self.path} ({self.size:,} bytes): the arm at {self.arm_poses:,} of "
+            f"{self.steps:,} steps (where it moved), {self.logs:,} events as log messages"
+        )
+
+
+def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> SceneExport:
+    """Write ``recording`` as a Foxglove scene to ``path`` (see the module's docstring).
+
+    The recording is read whole before the file is opened, so a damaged one raises its
+    :class:`~rsstp_replay.errors.ReplayError` and writes nothing. The file goes to a side file
+    renamed onto ``path`` when whole (:func:`rsstp_sim.files.written_whole`): a failed write
+    is an :class:`~rsstp_sim.errors.OutputError` and leaves ``path`` as it was.
+    """
+    out = Path(path)
+    scenario = recording.scenario
+    steps = recording.steps()
+    n_steps = len(steps)
+    poses = _ArmPoses.from_steps(steps, scenario.n_joints, source=recording.path)
+    del steps  # the poses where the arm moved are all that is kept of it
+    events = recording.events()
+    metadata = {
+        "package": "rsstp",
+        "package_version": __version__,
+        "scenario": scenario.name,
+        "scenario_sha256": scenario.sha256,
+        "strategy": recording.strategy,
+        "seed": str(recording.seed),
+        "steps": str(recording.n_steps),
+    }
+    draw = _Drawing(scenario)
+
+    with written_whole(out) as side, open_scene(side) as scene:
+        scene.writer.write_metadata("rsstp.scene", metadata)
+        context = scene.context
+        arm = SceneUpdateChannel(ARM_TOPIC, context=context)
+        static = SceneUpdateChannel(STATIC_TOPIC, context=context)
+        transforms = FrameTransformsChannel(TRANSFORMS_TOPIC, context=context)
+        logs = _EventLogs(events, LogChannel(LOG_TOPIC, context=context))
+        static.log(draw.static_scene(), log_time=0)
+        transforms.log(draw.fixed_transforms(), log_time=0)
+        for step, points, angles_deg in poses.rows():
+            logs.write_before(step)
+            log_time = step * STEP_NS
+            stamp = _timestamp(step)
+            arm.log(draw.arm(stamp, points), log_time=log_time)
+            transforms.log(draw.links(stamp, angles_deg), log_time=log_time)
+            scene.check()
+        logs.write_before(math.inf)
+    return SceneExport(
+        path=out,
+        steps=n_steps,
+        arm_poses=len(poses),
+        logs=len(events),
+        size=out.stat().st_size,
+    )
+
+
+class _EventLogs:
+    """The events as ``foxglove.Log`` messages on ``channel``, written in step order."""
+
+    def __init__(self, events: pd.DataFrame, channel: LogChannel) -> None:
+        self.steps: list[int] = events["step"].to_numpy(np.int64).tolist()
+        self.kinds: list[str] = events["kind"].astype(str).tolist()
+        self.texts: list[str] = events["text"].astype(str).tolist()
+        self.channel = channel
+        self.written = 0
+
+    def write_before(self, step: float) -> None:
+        """Write the events of the steps before ``step`` not yet written."""
+        steps, kinds, texts = self.steps, self.kinds, self.texts
+        while self.written < len(steps) and steps[self.written] < step:
+            at, kind = steps[self.written], kinds[self.written]
+            level = LogLevel.Warning if kind in _WARNING_KINDS else LogLevel.Info
+            message = Log(
+                timestamp=_timestamp(at), level=level, message=texts[self.written], name=kind
+            )
+            self.channel.log(message, log_time=at * STEP_NS)
+            self.written += 1
+
+
+@dataclass(frozen=True)
+class _ArmPoses:
+    """The arm at step 0 and at every step where it moved: ``steps`` (m), ``points`` (m rows of
+    the ``n + 1`` joint positions, base first, as x0, y0, x1, y1, ...) and ``angles_deg`` (m
+    rows of the ``n`` relative joint angles)."""
+
+    steps: npt.NDArray[np.int64]
+    points: npt.NDArray[np.float64]
+    angles_deg: npt.NDArray[np.int64]
+
+    @classmethod
+    def from_steps(cls, steps: pd.DataFrame, n_joints: int, *, source: Path) -> _ArmPoses:
+        numbers = _step_numbers(steps, source=source)
+        columns = [f"joint{k}_{axis}" for k in range(n_joints + 1) for axis in "xy"]
+        points = steps[columns].to_numpy(np.float64)
+        angles = steps[[f"angle_deg_{j}" for j in range(n_joints)]].to_numpy(np.int64)
+        moved = np.ones(len(numbers), bool)
+        moved[1:] = (angles[1:] != angles[:-1]).any(axis=1) | (points[1:] != points[:-1]).any(
+            axis=1
+        )
+        return cls(numbers[moved], points[moved], angles[moved])
+
+    def __len__(self) -> int:
+        return len(self.steps)
+
+    def rows(self) -> Iterator[tuple[int, list[float], list[int]]]:
+        """``(step, points, angles_deg)`` as Python numbers, a block of rows at a time."""
+        for start in range(0, len(self.steps), _BLOCK):
+            block = slice(start, start + _BLOCK)
+            yield from zip(
+                self.steps[block].tolist(),
+                self.points[block].tolist(),
+                self.angles_deg[block].tolist(),
+                strict=True,
+            )
+
+
+def _step_numbers(steps: pd.DataFrame, *, source: Path) -> npt.NDArray[np.int64]:
+    """The step of every row: the ``step`` column, or an index named ``step``."""
+    if "step" in steps.columns:
+        return steps["step"].to_numpy(np.int64)
+    if steps.index.name == "step":
+        return steps.index.to_numpy(np.int64)
+    raise ReplayError(f"{source}: the steps table has neither a step column nor a step index")
+
+
+def _timestamp(step: int) -> Timestamp:
+    sec, nsec = divmod(step * STEP_NS, 1_000_000_000)
+    return Timestamp(sec, nsec)
+
+
+def _color(rgb: palette.Colour, alpha: float = 1.0) -> Color:
+    r, g, b = rgb
+    return Color(r=r / 255, g=g / 255, b=b / 255, a=alpha)
+
+
+def _turn(angle_deg: int) -> Quaternion:
+    """The rotation by ``angle_deg`` about z (counter-clockwise seen from +z), ``w >= 0``."""
+    half = math.radians((angle_deg + 180) % 360 - 180) / 2
+    return Quaternion(x=0.0, y=0.0, z=math.sin(half), w=math.cos(half))
+
+
+class _Drawing:
+    """The scene's messages for one scenario; what never changes is built once."""
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.scenario = scenario
+        self.n_joints = scenario.n_joints
+        total = scenario.total_length
+        self.thickness = _LINE_THICKNESS * total
+        diameter = _JOINT_DIAMETER * total
+        self.joint_size = Vector3(x=diameter, y=diameter, z=diameter)
+        self.arm_color = _color(palette.ARM)
+        self.joint_color = _color(palette.JOINT)
+        self.upright = Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)
+        self.identity = Pose(position=Vector3(x=0.0, y=0.0, z=0.0), orientation=self.upright)
+        self.turns = [_turn(angle) for angle in range(360)]
+        self.link_frames = [f"link{k}" for k in range(self.n_joints)]
+        self.parents = ["base", *self.link_frames[:-1]]
+        origin = Vector3(x=0.0, y=0.0, z=0.0)
+        ends = [Vector3(x=length, y=0.0, z=0.0) for length in scenario.lengths]
+        self.origin, self.tip_offset = origin, ends[-1]
+        self.link_offsets = [origin, *ends[:-1]]  # link k starts where link k - 1 ends
+        self._primitives: dict[
+            tuple[float, ...], tuple[list[LinePrimitive], list[SpherePrimitive]]
+        ] = {}
+
+    def static_scene(self) -> SceneUpdate:
+        """The obstacles and the feedback points, in ``world``, forever."""
+        total = self.scenario.total_length
+        stamp = _timestamp(0)
+        height = _OBSTACLE_HEIGHT * total
+        cylinders = [
+            CylinderPrimitive(
+                pose=Pose(
+                    position=Vector3(x=o.center[0], y=o.center[1], z=0.0),
+                    orientation=self.upright,
+                ),
+                size=Vector3(x=2 * o.radius, y=2 * o.radius, z=height),
+                bottom_scale=1.0,
+                top_scale=1.0,
+                color=_color(palette.OBSTACLE, 0.8),
+            )
+            for o in self.scenario.obstacles
+        ]
+        diameter = _FEEDBACK_DIAMETER * total
+        spheres = [
+            SpherePrimitive(
+                pose=Pose(position=Vector3(x=x, y=y, z=0.0), orientation=self.upright),
+                size=Vector3(x=diameter, y=diameter, z=diameter),
+                color=_color(palette.FEEDBACK),
+            )
+            for x, y in self.scenario.feedback_points
+        ]
+        return SceneUpdate(
+            entities=[
+                SceneEntity(
+                    timestamp=stamp, frame_id=WORLD_FRAME, id="obstacles", cylinders=cylinders
+                ),
+                SceneEntity(timestamp=stamp, frame_id=WORLD_FRAME, id="feedback", spheres=spheres),
+            ]
+        )
+
+    def fixed_transforms(self) -> FrameTransforms:
+        """``world -> base`` and ``link{n-1} -> tip``, which never change."""
+        stamp = _timestamp(0)
+        return FrameTransforms(
+            transforms=[
+                FrameTransform(
+                    timestamp=stamp,
+                    parent_frame_id=WORLD_FRAME,
+                    child_frame_id="base",
+                    translation=self.origin,
+                    rotation=self.upright,
+                ),
+                FrameTransform(
+                    timestamp=stamp,
+                    parent_frame_id=self.link_frames[-1],
+                    child_frame_id="tip",
+                    translation=self.tip_offset,
+                    rotation=self.upright,
+                ),
+            ]
+        )
+
+    def links(self, stamp: Timestamp, angles_deg: list[int]) -> FrameTransforms:
+        """Every link's frame in its parent's at one pose (relative angles, base first)."""
+        return FrameTransforms(
+            transforms=[
+                FrameTransform(
+                    timestamp=stamp,
+                    parent_frame_id=parent,
+                    child_frame_id=child,
+                    translation=offset,
+                    rotation=self.turns[angle % 360],
+                )
+                for parent, child, offset, angle in zip(
+                    self.parents, self.link_frames, self.link_offsets, angles_deg, strict=True
+                )
+            ]
+        )
+
+    def arm(self, stamp: Timestamp, points: list[float]) -> SceneUpdate:
+        """The arm at one pose (``x0, y0, x1, y1, ...``): a line strip through the joints, a
+        sphere on each. A walk comes back to its poses: their primitives are kept (a bounded
+        number of them) and only the entity is new."""
+        key = tuple(points)
+        primitives = self._primitives.get(key)
+        if primitives is None:
+            if len(self._primitives) >= _CACHED_POSES:
+                self._primitives.clear()
+            primitives = self._primitives[key] = self._arm_primitives(points)
+        line, joints = primitives
+        entity = SceneEntity(
+            timestamp=stamp, frame_id=WORLD_FRAME, id="arm", lines=line, spheres=joints
+        )
+        return SceneUpdate(entities=[entity])
+
+    def _arm_primitives(
+        self, points: list[float]
+    ) -> tuple[list[LinePrimitive], list[SpherePrimitive]]:
+        xs, ys = points[0::2], points[1::2]
+        line = LinePrimitive(
+            type=LinePrimitiveLineType.LineStrip,
+            pose=self.identity,
+            thickness=self.thickness,
+            points=[Point3(x=x, y=y, z=0.0) for x, y in zip(xs, ys, strict=True)],
+            color=self.arm_color,
+        )
+        joints = [
+            SpherePrimitive(
+                pose=Pose(position=Vector3(x=x, y=y, z=0.0), orientation=self.upright),
+                size=self.joint_size,
+                color=self.joint_color,
+            )
+            for x, y in zip(xs, ys, strict=True)
+        ]
+        return [line], joints
