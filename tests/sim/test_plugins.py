@@ -4,6 +4,8 @@ entry points of installed distributions; a strategy that fails stops the run in 
 from __future__ import annotations
 
 import os
+import re
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -39,6 +41,17 @@ class Wanders(StrategyBase):
         return 99
 
 
+class Corrupts(StrategyBase):
+    name = "corrupts"
+
+    def choose_action(self, agent: AgentView) -> int:
+        return agent.actions[0]
+
+    def refine(self, agent: AgentView) -> None:
+        if agent.step == 5:
+            agent.model.merge(0, 99)
+
+
 class NotOne:
     pass
 """
@@ -62,6 +75,7 @@ def mine(tmp_path: Path) -> Path:
     info = tmp_path / "my_strategies-1.2.dist-info"
     info.mkdir()
     (info / "METADATA").write_text("Metadata-Version: 2.1\nName: my-strategies\nVersion: 1.2\n")
+    (info / "top_level.txt").write_text("my_strategies\n")
     (info / "entry_points.txt").write_text(
         "[rsstp.strategies]\nclockwise = my_strategies:Clockwise\n"
     )
@@ -78,7 +92,28 @@ def test_a_class_by_its_import_path_records_and_audits(mine: Path) -> None:
     with open_recording(out) as recording:
         assert recording.strategy == "clockwise"
         assert recording.n_steps == 20
+        strategy = recording.scenario_record.strategy
+        assert strategy.import_path == "my_strategies:Clockwise"
+        assert (strategy.distribution, strategy.version) == ("my-strategies", "1.2")
     assert cli("rsstp_replay", "audit", str(out), path=mine).returncode == 0
+
+
+def test_a_module_no_distribution_provides_is_recorded_without_one(mine: Path) -> None:
+    (mine / "my_strategies-1.2.dist-info" / "top_level.txt").unlink()
+    out = mine / "run.mcap"
+    done = cli(
+        "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Clockwise",
+        "--steps", "3", "-o", str(out), path=mine,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    with open_recording(out) as recording:
+        strategy = recording.scenario_record.strategy
+        assert (strategy.import_path, strategy.distribution, strategy.version) == (
+            "my_strategies:Clockwise",
+            None,
+            None,
+        )
+        assert recording.metadata["strategy_distribution"] == ""
 
 
 def test_an_entry_point_is_listed_and_runs_by_name(mine: Path) -> None:
@@ -89,6 +124,12 @@ def test_an_entry_point_is_listed_and_runs_by_name(mine: Path) -> None:
               path=mine)  # fmt: skip
     assert ran.returncode == 0, ran.stderr
     assert "sensations seen: false: 6, true: 3" in ran.stdout  # the start, then every 4 moves
+    out = mine / "by-name.mcap"
+    recorded = cli("rsstp_sim", "record", "thesis-roulette", "--strategy", "clockwise",
+                   "--steps", "4", "-o", str(out), path=mine)  # fmt: skip
+    assert recorded.returncode == 0, recorded.stderr
+    info = cli("rsstp_replay", "info", str(out), path=mine)
+    assert "  class: my_strategies:Clockwise (from my-strategies 1.2)" in info.stdout
 
 
 def test_a_failing_strategy_stops_in_one_line_and_keeps_a_valid_file(mine: Path) -> None:
@@ -104,6 +145,48 @@ def test_a_failing_strategy_stops_in_one_line_and_keeps_a_valid_file(mine: Path)
     with open_recording(out) as recording:
         assert recording.finished and recording.n_steps == 6
     assert cli("rsstp_replay", "check", str(out), path=mine).returncode == 0
+
+
+def test_a_strategy_breaking_the_models_invariants_stops_in_one_line(mine: Path) -> None:
+    out = mine / "corrupt.mcap"
+    done = cli(
+        "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Corrupts",
+        "--steps", "50", "-o", str(out), path=mine,
+    )  # fmt: skip
+    assert done.returncode == 2
+    assert done.stderr.strip() == (
+        "rsstp-sim: error: strategy 'corrupts' failed in refine at step 5: "
+        "ModelError: merge: unknown state 99 (states: [0])"
+    )
+    with open_recording(out) as recording:
+        assert recording.finished and recording.n_steps == 4
+    assert cli("rsstp_replay", "check", str(out), path=mine).returncode == 0
+
+
+def test_the_readme_strategy_records_and_learns_its_world(tmp_path: Path) -> None:
+    """The README's complete strategy, run with the README's own commands."""
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    code = next(b for b in re.findall(r"```python\n(.*?)```", readme, re.S) if "class Cycle" in b)
+    (tmp_path / "my_strategies.py").write_text(code)
+    commands = re.search(r"```sh\n(PYTHONPATH=\. rsstp-sim record .*?)```", readme, re.S)
+    assert commands is not None
+    outputs = []
+    for line in commands[1].splitlines():
+        words = shlex.split(line, comments=True)
+        words = words[1:] if words[0] == "PYTHONPATH=." else words
+        program = {"rsstp-sim": "rsstp_sim", "rsstp-replay": "rsstp_replay"}[words[0]]
+        done = subprocess.run(
+            [sys.executable, "-m", program, *words[1:]],
+            capture_output=True, text=True, timeout=120, cwd=tmp_path,
+            env={**os.environ, "PYTHONPATH": str(tmp_path)},
+        )  # fmt: skip
+        assert done.returncode == 0, done.stderr
+        outputs.append(done.stdout)
+    expected = "verdict: learned: equivalent to the minimal model (4 states) from step 4 to the end"
+    assert outputs[-1].splitlines()[0] == expected
+    assert expected in commands[1]  # what the README says it prints
+    with open_recording(tmp_path / "cycle.mcap") as recording:
+        assert recording.scenario_record.strategy.import_path == "my_strategies:Cycle"
 
 
 @pytest.mark.parametrize(

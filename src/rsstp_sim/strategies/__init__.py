@@ -100,10 +100,20 @@ class StrategyOrigin:
     version: str | None
 
 
+_DECLARED_BY: dict[type, tuple[str, str]] = {}
+"""Classes loaded through an entry point -> the distribution that declares it, and its
+version."""
+
+
 def strategy_origin(strategy: Strategy) -> StrategyOrigin:
-    """The :class:`StrategyOrigin` of ``strategy`` (what a recording states of it)."""
+    """The :class:`StrategyOrigin` of ``strategy`` (what a recording states of it): for a
+    class loaded through an entry point, the distribution that declares it; else the one that
+    provides its top-level package."""
     cls = type(strategy)
     import_path = f"{cls.__module__}:{cls.__qualname__}"
+    declared = _DECLARED_BY.get(cls)
+    if declared is not None:
+        return StrategyOrigin(import_path, *declared)
     top = cls.__module__.partition(".")[0]
     if top == "rsstp_sim":  # ours: no scan of the installed distributions
         from rsstp_sim import __version__
@@ -149,6 +159,9 @@ def _plugin(name: str) -> Callable[..., Strategy]:
             raise StrategyError(
                 f"strategy {name!r}: cannot load {entries[0].value!r}: {type(exc).__name__}: {exc}"
             ) from None
+        dist = entries[0].dist
+        if dist is not None and isinstance(found, type):
+            _DECLARED_BY[found] = (dist.name, dist.version)
     if not callable(found):
         raise StrategyError(f"strategy {name!r}: {found!r} is not a class")
     factory: Callable[..., Strategy] = found
