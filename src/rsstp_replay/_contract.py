@@ -195,11 +195,14 @@ def rsstp_channels(container: Container) -> dict[str, int]:
     if not channels:
         found = sorted({c.topic for c in container.channels.values()})
         listed = ", ".join(found[:5]) + (", ..." if len(found) > 5 else "") if found else "none"
-        raise ForeignRecording(
-            f"{path}: an MCAP file, but not an rsstp recording: no /rsstp/* topic "
-            f"(its topics: {listed})"
+        what = (
+            "a scene file of rsstp-replay export --foxglove: open the recording it was made from"
+            if "/rsstp/scene" in found
+            else f"none of the topics {', '.join(TOPICS)} (its topics: {listed})"
         )
-    missing = [topic for topic in TOPICS if topic not in channels]
+        raise ForeignRecording(f"{path}: an MCAP file, but not an rsstp recording: {what}")
+    # A run whose agent keeps no model (a Gymnasium-driven one) has no model channel.
+    missing = [t for t in TOPICS if t not in channels and t != "/rsstp/model"]
     if missing:
         raise CorruptRecording(f"{path}: expected the topics {list(TOPICS)}, missing {missing}")
     return channels

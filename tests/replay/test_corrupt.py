@@ -178,8 +178,8 @@ CASES: dict[str, Case] = {
     "text": Case(NotARecording, r"text\.mcap: not an MCAP file \(it does not start with"),
     "foreign": Case(
         ForeignRecording,
-        r"foreign\.mcap: an MCAP file, but not an rsstp recording: no /rsstp/\* topic "
-        r"\(its topics: /camera\)",
+        r"foreign\.mcap: an MCAP file, but not an rsstp recording: none of the topics "
+        r"/rsstp/scenario, /rsstp/step, /rsstp/model, /rsstp/event \(its topics: /camera\)",
     ),
     "version1": Case(
         UnsupportedVersion,

@@ -25,7 +25,8 @@ from __future__ import annotations
 import json
 import os
 import platform
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
@@ -111,6 +112,7 @@ class Recorder:
         chunk_size: int = DEFAULT_CHUNK_SIZE,
         force: bool = False,
         versions: Mapping[str, str] | None = None,
+        model: bool = True,
     ) -> None:
         if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1024:
             raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
@@ -120,6 +122,7 @@ class Recorder:
         # since the runner also reports changes made during its own reset, before
         # ``self.runner`` exists.
         self._pending_models: list[tuple[int, tuple[Operation, ...]]] = []
+        self._topics = {t: name for t, name in TOPICS.items() if model or t != "/rsstp/model"}
         self.runner = Runner(
             scenario,
             strategy,
@@ -132,7 +135,7 @@ class Recorder:
             self._versions.update({k: v for k, v in versions.items() if k in _VERSION_KEYS})
         self._stop = False
         self._pose_parts: dict[int, tuple[bytes, bytes]] = {}
-        self._counts = dict.fromkeys(TOPICS, 0)
+        self._counts = dict.fromkeys(self._topics, 0)
         self.side_file = side_file(self.path)
         self._raw = open_side_file(self.path, force=force)
         self._file = WriteThrough(self._raw, lambda: self.runner.step_index)
@@ -162,6 +165,10 @@ class Recorder:
             self._pending_events.append(builders.note_event(event.step, event.text))
 
     def _on_model_change(self, step: int, operations: Sequence[Operation]) -> None:
+        if "/rsstp/model" not in self._topics:
+            raise RecordingError(
+                f"step {step}: the model changed in a run recorded without a model channel"
+            )
         self._pending_models.append((step, tuple(operations)))
         self._pending_events.extend(builders.operation_events(step, operations))
 
@@ -174,9 +181,11 @@ class Recorder:
         schema_ids = {
             name: writer.register_schema(name, "jsonschema", schema_bytes(name))
             for name in SCHEMA_NAMES
+            if name in self._topics.values()
         }
-        for topic, name in TOPICS.items():
+        for topic, name in self._topics.items():
             self._channels[topic] = writer.register_channel(topic, "json", schema_ids[name])
+        self._step_channel = self._channels["/rsstp/step"]
         params = dict(strategy.params())
         origin = strategy_origin(strategy)
         if origin.distribution == "rsstp":  # ours: the version the metadata names
@@ -204,8 +213,8 @@ class Recorder:
             strategy_origin=origin,
         )
         self._add("/rsstp/scenario", 0, records.encode(record))
-        if not self._pending_models:  # step 0 always has the initial model
-            self._pending_models.append((0, ()))
+        if not self._pending_models and "/rsstp/model" in self._topics:
+            self._pending_models.append((0, ()))  # step 0 always has the initial model
         self._write_step_zero()
 
     def _add(self, topic: str, step: int, data: bytes) -> None:
@@ -306,40 +315,56 @@ class Recorder:
         Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`.
         """
         _check_steps(steps)
-        runner = self.runner
-        world = runner.world
-        step = runner.step
-        add = self._writer.add_message
-        channel = self._channels["/rsstp/step"]
-        pending_models, pending_events = self._pending_models, self._pending_events
+        step, write = self.runner.step, self._write_step
         done = 0
         try:
-            while done < steps and not self._stop:
-                outcome = step()
-                t = outcome.step
-                pose = world.current
-                data = self._step_bytes(t, outcome, pose)
-                add(channel, t * STEP_NS, data, t * STEP_NS)
-                if outcome.blocker is not None or outcome.no_transition:
-                    self._lead_events(outcome)
-                if pending_models or pending_events:
-                    self._flush_pending(t)
-                done += 1
-                if progress is not None and not done & 4095:
-                    progress(done)
-        except OSError as exc:
+            with self._closed_on_failure():
+                while done < steps and not self._stop:
+                    write(step())
+                    done += 1
+                    if progress is not None and not done & 4095:
+                        progress(done)
+        finally:
             self._counts["/rsstp/step"] += done
-            if exc is self._file.error:  # the disk, not the run: the side file keeps its chunks
+        self.close()
+        return self.result()
+
+    def step(self) -> StepOutcome:
+        """Take and record one step; the file stays open until :meth:`close`."""
+        with self._closed_on_failure():
+            outcome = self.runner.step()
+            self._write_step(outcome)
+        self._counts["/rsstp/step"] += 1
+        return outcome
+
+    def result(self) -> RecordResult:
+        """What has been recorded so far."""
+        return RecordResult(self.path, self.runner.step_index, dict(self._counts), self._stop)
+
+    def _write_step(self, outcome: StepOutcome) -> None:
+        t = outcome.step
+        self._writer.add_message(
+            self._step_channel,
+            t * STEP_NS,
+            self._step_bytes(t, outcome, self.runner.world.current),
+            t * STEP_NS,
+        )
+        if outcome.blocker is not None or outcome.no_transition:
+            self._lead_events(outcome)
+        if self._pending_models or self._pending_events:
+            self._flush_pending(t)
+
+    @contextmanager
+    def _closed_on_failure(self) -> Iterator[None]:
+        """A write error of the disk leaves the side file with its chunks and says what is
+        safe; any other failure (a strategy's, a signal's) finishes the file first."""
+        try:
+            yield
+        except BaseException as exc:
+            if isinstance(exc, OSError) and exc is self._file.error:
                 raise self._write_failed(exc) from None
             self.close()
             raise
-        except BaseException:
-            self._counts["/rsstp/step"] += done
-            self.close()
-            raise
-        self._counts["/rsstp/step"] += done
-        self.close()
-        return RecordResult(self.path, runner.step_index, dict(self._counts), self._stop)
 
     def close(self) -> None:
         """Finish the file (summary and indexes) and rename it onto the output; idempotent.
