@@ -1,5 +1,5 @@
 """The viewers' own parser over the recordings: Foxglove Studio 1.48's ``parseChannel`` (the code
-Lichtblick forked), bundled unchanged in ``tests/lichtblick/dist/check_channels.mjs``, run with
+Lichtblick forked), bundled unchanged in ``tests/lichtblick/vendor/check_channels.mjs``, run with
 node over every channel of every reference recording. A channel it refuses is a topic Lichtblick
 or Foxglove skips; a field missing from its datatypes is a field no panel can plot."""
 

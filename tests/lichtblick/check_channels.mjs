@@ -3,7 +3,7 @@
 // definitions) that panels address fields by, and how many of the channel's messages the
 // returned deserializer read.
 //
-//   node dist/check_channels.mjs RECORDING.mcap
+//   node vendor/check_channels.mjs RECORDING.mcap
 //
 // Exit status: 0 when the JSON was printed (whatever it says), 2 when the file could not be read.
 import { readFileSync } from "node:fs";

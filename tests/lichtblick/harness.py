@@ -1,4 +1,4 @@
-"""Runs ``dist/check_channels.mjs`` (Foxglove Studio 1.48's ``parseChannel``, the parser
+"""Runs ``vendor/check_channels.mjs`` (Foxglove Studio 1.48's ``parseChannel``, the parser
 Lichtblick forked) with node, and writes small JSON recordings for it to read."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ from typing import Any
 import pytest
 from mcap.writer import Writer
 
-BUNDLE = Path(__file__).parent / "dist" / "check_channels.mjs"
+BUNDLE = Path(__file__).parent / "vendor" / "check_channels.mjs"
 
 NO_NODE = (
     "node is not on PATH: the viewer parser check runs Foxglove Studio 1.48's parseChannel "
