@@ -16,7 +16,7 @@ from collections.abc import Iterable, Sequence
 from rsstp_replay.errors import ViewerWarning
 from rsstp_sim.graph import plain_positions, run_graphviz
 from rsstp_sim.recording.records import ModelRecord, TransitionRecord
-from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.transition_system import TransitionSystem, snapshot_form
 
 __all__ = [
     "DOT_MAX_PAIRS",
@@ -41,14 +41,9 @@ def union_model(
     if not states:
         states.add(0)
     ordered = sorted(states)
+    every_action = sorted(actions | {t.action for t in transitions})
     return TransitionSystem.from_snapshot(
-        {
-            "states": ordered,
-            "next_id": ordered[-1] + 1,
-            "current": ordered[0],
-            "actions": sorted(actions | {a for _, a, _ in transitions}),
-            "transitions": [list(triple) for triple in sorted(transitions)],
-        }
+        snapshot_form(ordered, ordered[-1] + 1, ordered[0], every_action, sorted(transitions))
     )
 
 

@@ -59,7 +59,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any, SupportsIndex
 
@@ -281,18 +281,25 @@ class robot_arm:  # noqa: N801 - the thesis-era name, kept on purpose
         self, n: SupportsIndex, m: SupportsIndex, k: SupportsIndex
     ) -> Matrix:
         """Add the transition ``n -k-> m`` (no change if it exists)."""
-        s = self._state(n, "add_connection_between_nodes")
-        t = self._state(m, "add_connection_between_nodes")
-        self.model.add(s, t, self._model_action(k, "add_connection_between_nodes"))
-        return self.get_transition_matrix()
+        return self._edit(self.model.add, "add_connection_between_nodes", n, m, k)
 
     def delete_connection_between_nodes(
         self, n: SupportsIndex, m: SupportsIndex, k: SupportsIndex
     ) -> Matrix:
         """Delete the transition ``n -k-> m`` (no change if it does not exist)."""
-        s = self._state(n, "delete_connection_between_nodes")
-        t = self._state(m, "delete_connection_between_nodes")
-        self.model.delete(s, t, self._model_action(k, "delete_connection_between_nodes"))
+        return self._edit(self.model.delete, "delete_connection_between_nodes", n, m, k)
+
+    def _edit(
+        self,
+        operation: Callable[[int, int, int], bool],
+        method: str,
+        n: SupportsIndex,
+        m: SupportsIndex,
+        k: SupportsIndex,
+    ) -> Matrix:
+        """Apply ``operation`` (add or delete) to ``n -k-> m``, named ``method`` in errors."""
+        s, t = self._state(n, method), self._state(m, method)
+        operation(s, t, self._model_action(k, method))
         return self.get_transition_matrix()
 
     def delete_conection_between_nodes(

@@ -27,6 +27,8 @@ from typing import Literal, Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rsstp_sim._arrays import FloatArray, IntArray
+
 __all__ = [
     "ArmGeometry",
     "Blocker",
@@ -42,9 +44,6 @@ __all__ = [
     "pose_blockers",
     "segment_distance",
 ]
-
-FloatArray = NDArray[np.float64]
-IntArray = NDArray[np.int64]
 
 
 def _trig_tables() -> tuple[FloatArray, FloatArray]:

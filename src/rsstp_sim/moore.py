@@ -13,9 +13,9 @@ one class when no action sequence tells them apart by what they show.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
-IntArray = NDArray[np.int64]
+from rsstp_sim._arrays import IntArray
 
 __all__ = ["moore_classes"]
 

@@ -46,7 +46,7 @@ import numpy as np
 
 from rsstp_sim.errors import ModelError, RsstpError
 
-__all__ = ["DeterminismReport", "Operation", "TransitionSystem"]
+__all__ = ["DeterminismReport", "Operation", "TransitionSystem", "snapshot_form"]
 
 OperationKind = Literal["split", "merge", "add", "delete"]
 _ARITY: dict[str, int] = {"split": 1, "merge": 2, "add": 3, "delete": 3}
@@ -452,13 +452,9 @@ class TransitionSystem:
 
     def snapshot(self) -> dict[str, object]:
         """A JSON-ready sparse form; :meth:`from_snapshot` reads it back."""
-        return {
-            "states": list(self.states),
-            "next_id": self._next_id,
-            "current": self._current,
-            "actions": list(self.actions),
-            "transitions": [[s, a, t] for s, a, t in self.transitions()],
-        }
+        return snapshot_form(
+            self.states, self._next_id, self._current, self.actions, self.transitions()
+        )
 
     @classmethod
     def from_snapshot(cls, data: Mapping[str, object], *, version: int = 0) -> TransitionSystem:
@@ -557,3 +553,21 @@ def _as_list(value: object, what: str) -> list[object]:
     if isinstance(value, str | bytes | Mapping) or not isinstance(value, Iterable):
         raise ModelError(f"snapshot: {what} must be a list, got {value!r}")
     return list(value)
+
+
+def snapshot_form(
+    states: Iterable[int],
+    next_id: int,
+    current: int,
+    actions: Iterable[int],
+    transitions: Iterable[Iterable[int]],
+) -> dict[str, object]:
+    """The sparse form of a model that :meth:`TransitionSystem.from_snapshot` reads: its
+    states, the next id, the current state, the actions and ``[s, a, t]`` transitions."""
+    return {
+        "states": list(states),
+        "next_id": next_id,
+        "current": current,
+        "actions": list(actions),
+        "transitions": [list(t) for t in transitions],
+    }

@@ -35,8 +35,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rsstp_sim._arrays import BoolArray, IntArray
 from rsstp_sim.errors import ModelError, TruthError
-from rsstp_sim.geometry import IntArray
 from rsstp_sim.moore import moore_classes
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.transition_system import TransitionSystem
@@ -50,8 +50,6 @@ __all__ = [
     "format_truth",
     "pose_space_size",
 ]
-
-BoolArray = NDArray[np.bool_]
 
 
 @dataclass(frozen=True, eq=False)

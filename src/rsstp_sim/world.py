@@ -11,8 +11,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from rsstp_sim._arrays import FloatArray
 from rsstp_sim.errors import ActionError, UnknownPose
-from rsstp_sim.geometry import Blocker, FloatArray
+from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.world_table import WorldTable
 

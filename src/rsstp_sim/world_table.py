@@ -32,10 +32,10 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
 from rsstp_sim import geometry
-from rsstp_sim.geometry import ArmGeometry, FloatArray, IntArray
+from rsstp_sim._arrays import BoolArray, FloatArray, Int32Array, IntArray
+from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.scenario import Scenario
 
 __all__ = [
@@ -47,8 +47,6 @@ __all__ = [
     "unsensable",
 ]
 
-BoolArray = NDArray[np.bool_]
-Int32Array = NDArray[np.int32]
 
 DENSE_LIMIT = 4_000_000
 """Pose spaces of at most this many lattice poses index their rows in a dense array."""

@@ -131,26 +131,19 @@ def _check_output(output: str) -> None:
 
 def _cmd_report(args: argparse.Namespace) -> int:
     from rsstp_sim.commandline import UsageError
-    from rsstp_sweep.report import (
-        check_gate,
-        parse_gate,
-        plot_report,
-        read_runs,
-        summarize,
-        summary_text,
-    )
+    from rsstp_sweep import report
 
-    gates = [parse_gate(text) for text in args.fail_if]  # a bad gate before any work
+    gates = [report.parse_gate(text) for text in args.fail_if]  # a bad gate before any work
     if args.plot is not None and os.path.exists(args.plot) and not args.force:
         raise UsageError(f"{args.plot}: already exists (use --force to overwrite)")
-    runs = read_runs(args.directory)
+    runs = report.read_runs(args.directory)
     if args.strategy:
         unknown = sorted(set(args.strategy) - set(runs["strategy"]))
         if unknown:
             known = ", ".join(sorted(set(runs["strategy"])))
             raise UsageError(f"--strategy {unknown[0]}: not in this sweep ({known})")
         runs = runs[runs["strategy"].isin(args.strategy)]
-    summary = summarize(runs)
+    summary = report.summarize(runs)
     if args.json:
         records = [
             {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in row.items()}
@@ -158,15 +151,15 @@ def _cmd_report(args: argparse.Namespace) -> int:
         ]
         print(json.dumps(records, indent=2, default=_plain))
     else:
-        print(summary_text(summary))
+        print(report.summary_text(summary))
     if args.plot is not None:
         try:
-            plot_report(runs, args.plot)
+            report.plot_report(runs, args.plot)
         except (OSError, ValueError) as exc:
             raise UsageError(f"{args.plot}: cannot write the plot: {exc}") from None
         if not args.json:
             print(f"wrote {args.plot}")
-    failing = [(gate, line) for gate in gates for line in check_gate(summary, gate)]
+    failing = [(gate, line) for gate in gates for line in report.check_gate(summary, gate)]
     for gate, line in failing:
         print(f"rsstp-replay: report failed --fail-if '{gate}': {line}", file=sys.stderr)
     return 1 if failing else 0

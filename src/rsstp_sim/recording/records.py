@@ -39,7 +39,7 @@ import msgspec
 from rsstp_sim.errors import RecordFormatError
 from rsstp_sim.geometry import BlockerKind
 from rsstp_sim.scenario import CollisionMode, FeedbackMode
-from rsstp_sim.transition_system import Operation, OperationKind
+from rsstp_sim.transition_system import Operation, OperationKind, snapshot_form
 
 __all__ = [
     "AgentRecord",
@@ -280,13 +280,9 @@ class ModelRecord(_Record, frozen=True, kw_only=True):
 
     def snapshot(self) -> dict[str, object]:
         """The model in :meth:`TransitionSystem.snapshot` form (for ``from_snapshot``)."""
-        return {
-            "states": list(self.states),
-            "next_id": self.next_id,
-            "current": self.current,
-            "actions": list(self.actions),
-            "transitions": [list(t) for t in self.triples()],
-        }
+        return snapshot_form(
+            self.states, self.next_id, self.current, self.actions, self.transitions
+        )
 
 
 # ------------------------------------------------------------------- rsstp.Event

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 from rsstp_sim.errors import StrategyError
 from rsstp_sim.strategies._base import AgentView, StrategyBase
@@ -30,6 +30,33 @@ def _bit(sensation: bool) -> int:
 def _conflict(a: int, b: int) -> bool:
     """One mask saw a sensation the other saw the opposite of."""
     return bool((a & _FALSE and b & _TRUE) or (a & _TRUE and b & _FALSE))
+
+
+_Owner = TypeVar("_Owner", int, _Row)
+
+
+def _mark(
+    masks_by: dict[_Owner, dict[_Key, int]],
+    index: dict[tuple[_Key, int], set[_Owner]],
+    owner: _Owner,
+    key: _Key,
+    bit: int,
+) -> int | None:
+    """Set ``bit`` of ``key`` for ``owner`` (and index it): the mask before, or None when the
+    bit was already set."""
+    masks = masks_by.get(owner)
+    if masks is None:
+        masks = masks_by[owner] = {}
+    old = masks.get(key, 0)
+    if old & bit:
+        return None
+    masks[key] = old | bit
+    holders = index.get((key, bit))
+    if holders is None:
+        index[(key, bit)] = {owner}
+    else:
+        holders.add(owner)
+    return old
 
 
 @dataclass(slots=True)
@@ -80,18 +107,9 @@ class _Histories:
 
     def observe_own(self, state: int, key: _Key, bit: int) -> bool:
         """Record ``key -> bit`` for ``state``; True when that makes a contradiction."""
-        masks = self.own.get(state)
-        if masks is None:
-            masks = self.own[state] = {}
-        old = masks.get(key, 0)
-        if old & bit:
+        old = _mark(self.own, self.own_index, state, key, bit)
+        if old is None:
             return False
-        masks[key] = old | bit
-        holders = self.own_index.get((key, bit))
-        if holders is None:
-            self.own_index[(key, bit)] = {state}
-        else:
-            holders.add(state)
         for row in self.shifted_index.get((key, _BOTH - bit), ()):
             bar = self.inconsistent.get(row)
             if bar is None:
@@ -104,18 +122,8 @@ class _Histories:
 
     def observe_shifted(self, row: _Row, key: _Key, bit: int) -> None:
         """Record ``key -> bit`` for the continuation of ``row``."""
-        masks = self.shifted.get(row)
-        if masks is None:
-            masks = self.shifted[row] = {}
-        old = masks.get(key, 0)
-        if old & bit:
+        if _mark(self.shifted, self.shifted_index, row, key, bit) is None:
             return
-        masks[key] = old | bit
-        holders = self.shifted_index.get((key, bit))
-        if holders is None:
-            self.shifted_index[(key, bit)] = {row}
-        else:
-            holders.add(row)
         opposite = self.own_index.get((key, _BOTH - bit))
         if not opposite:
             return
