@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import copy
-import json
 import os
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 
 import pytest
+
+from scenarios import toml_text
 
 ScenarioText = Callable[[Mapping[str, object]], str]
 WriteScenario = Callable[..., Path]
@@ -36,36 +37,6 @@ collision = "{mode}"
 """
 """One link of length 2 at 0 degrees turning by 90; a thin disk on the diagonal in between.
 The end pose is free, the swept motion is not: ``.format(mode="swept"|"endpoint")``."""
-
-
-def _toml_value(value: object) -> str:
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, int | float):
-        return repr(value)  # nan and inf are valid TOML floats
-    if isinstance(value, str):
-        return json.dumps(value)
-    if isinstance(value, list | tuple):
-        return "[" + ", ".join(_toml_value(v) for v in value) + "]"
-    if isinstance(value, Mapping):  # an inline table
-        return "{" + ", ".join(f"{k} = {_toml_value(v)}" for k, v in value.items()) + "}"
-    raise TypeError(f"no TOML form for {value!r}")
-
-
-def toml_text(data: Mapping[str, object]) -> str:
-    """TOML for ``data``: top-level values, then ``[tables]`` and ``[[arrays of tables]]``."""
-    lines: list[str] = []
-    tables: list[tuple[str, Mapping[str, object]]] = []
-    for key, value in data.items():
-        if isinstance(value, Mapping):
-            tables.append((f"[{key}]", value))
-        elif isinstance(value, list) and value and all(isinstance(v, Mapping) for v in value):
-            tables.extend((f"[[{key}]]", v) for v in value)
-        else:
-            lines.append(f"{key} = {_toml_value(value)}")
-    for header, table in tables:
-        lines += ["", header, *(f"{k} = {_toml_value(v)}" for k, v in table.items())]
-    return "\n".join(lines) + "\n"
 
 
 @pytest.fixture(scope="session")

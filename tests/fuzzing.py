@@ -30,12 +30,13 @@ from typing import Any
 import pandas as pd
 from hypothesis import strategies as st
 
-from conftest import VALID_SCENARIO, toml_text
+from conftest import VALID_SCENARIO
 from rsstp_replay import ReplayError, UnfinishedRecordingWarning, open_recording
 from rsstp_replay import cli as replay_cli
 from rsstp_sim import RsstpError, load_scenario, make_strategy, parse_scenario
 from rsstp_sim import cli as sim_cli
 from rsstp_sim.recording import record
+from scenarios import toml_text
 
 SCENARIO_SECONDS = 10.0
 """Time bound of one scenario case: validate, then run and record a few steps."""

@@ -21,21 +21,14 @@ from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies import RandomStrategy, ScriptStrategy
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.world import World
+from scenarios import arm_toml
 
 
 def test_defect_01_link_inside_obstacle_is_a_collision() -> None:
     # The link from (0, 0) to (1, 0) lies inside the disk: it never meets the circle.
     disk = shapely.Point(0.5, 0.0).buffer(1.0, quad_segs=64)
     assert not shapely.LineString([(0, 0), (1, 0)]).intersects(disk.exterior)
-    text = """
-    [arm]
-    lengths = [1.0]
-    initial_deg = [0]
-    step_deg = 10
-    [[obstacles]]
-    center = [0.5, 0.0]
-    radius = 1.0
-    """
+    text = arm_toml([1.0], [0], 10, [((0.5, 0.0), 1.0)])
     with pytest.raises(
         ScenarioError, match=r"start pose \[0\] is invalid \(link 0 meets obstacle 0\)"
     ):

@@ -14,29 +14,17 @@ from rsstp_sim import palette
 from rsstp_sim.env import ENV_ID, MAX_EPISODE_STEPS, ArmEnv, register_envs
 from rsstp_sim.errors import ActionError, ScenarioError
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
+from scenarios import arm_toml
 
-FLOAT_TWO_LINKS = """
-name = "float-two-links"
-[arm]
-lengths = [2.0, 1.0]
-initial_deg = [0, 90]
-step_deg = 10
-[[obstacles]]
-center = [-2.0, -2.0]
-radius = 0.5
-[feedback]
-target_deg = [0, 90]
-mode = "float"
-"""
-
-SUBSET_ACTIONS = """
-name = "subset"
-[arm]
-lengths = [2.0, 1.0]
-initial_deg = [0, 90]
-step_deg = 10
-actions = [3, 1]
-"""
+FLOAT_TWO_LINKS = arm_toml(
+    [2.0, 1.0],
+    [0, 90],
+    10,
+    [((-2.0, -2.0), 0.5)],
+    name="float-two-links",
+    feedback={"target_deg": [0, 90], "mode": "float"},
+)
+SUBSET_ACTIONS = arm_toml([2.0, 1.0], [0, 90], 10, name="subset", actions=[3, 1])
 
 # thesis-obstacles: one link of length 2 from 95 degrees, 1-degree steps, an obstacle
 # at (1, 2) of radius 1 that the link touches at 90 degrees, feedback at 100 degrees.

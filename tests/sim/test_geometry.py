@@ -15,6 +15,7 @@ from conftest import THIN_OBSTACLE_TOML
 from rsstp_sim import geometry
 from rsstp_sim.geometry import ArmGeometry, Blocker
 from rsstp_sim.scenario import parse_scenario
+from scenarios import arm_toml
 
 SQRT3_2 = math.sqrt(3.0) / 2.0
 COS_27, SIN_27 = 0.8910065241883679, 0.45399049973954675  # cos and sin of 27 degrees
@@ -227,18 +228,7 @@ def test_obstacle_distances_are_to_the_surface() -> None:
 # -- blockers ---------------------------------------------------------------------------------
 
 
-THREE_LINKS = """
-[arm]
-lengths = [2.0, 1.0, 2.0]
-initial_deg = [0, 90, 90]
-step_deg = 30
-[[obstacles]]
-center = [5.0, 5.0]
-radius = 0.5
-[[obstacles]]
-center = [0.5, -1.5]
-radius = 0.5
-"""
+THREE_LINKS = arm_toml([2.0, 1.0, 2.0], [0, 90, 90], 30, [((5.0, 5.0), 0.5), ((0.5, -1.5), 0.5)])
 
 
 def test_blocker_codes_decode_to_what_they_name() -> None:

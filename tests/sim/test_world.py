@@ -17,6 +17,7 @@ from rsstp_sim.errors import ActionError
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 from rsstp_sim.world import World
+from scenarios import arm_toml
 
 SAMPLE_DEG = 0.25
 """Angular spacing of the intermediate poses checked along a move."""
@@ -202,20 +203,12 @@ def test_fixed_link_end_meeting_the_moving_link_blocks() -> None:
 def test_touching_counts_as_meeting(mode: str) -> None:
     # One link of length 2 turning from 0 to 90 degrees ends with its tip (0, 2) exactly on
     # the circle of the disk at (0, 3) of radius 1; a radius a hair smaller lets it through.
-    text = """
-    [arm]
-    lengths = [2.0]
-    initial_deg = [0]
-    step_deg = 90
-    [[obstacles]]
-    center = [0.0, 3.0]
-    radius = {radius}
-    [motion]
-    collision = "{mode}"
-    """
-    touching = World(parse_scenario(text.format(radius=1.0, mode=mode)))
+    def disk_above(radius: float) -> str:
+        return arm_toml([2.0], [0], 90, [((0.0, 3.0), radius)], motion={"collision": mode})
+
+    touching = World(parse_scenario(disk_above(1.0)))
     assert touching.move(0) == Blocker("obstacle", (0, 0))
-    clear = World(parse_scenario(text.format(radius=0.999, mode=mode)))
+    clear = World(parse_scenario(disk_above(0.999)))
     assert clear.move(0) is None
     # Four links: turning the last one down puts its tip exactly on link 0, at (1, 0).
     four = World(

@@ -13,16 +13,9 @@ import pytest
 from rsstp_sim.scenario import builtin_scenarios, load_scenario, parse_scenario
 from rsstp_sim.truth import compute_truth
 from rsstp_sim.world_table import unsensable
+from scenarios import arm_toml
 
-ARM = """
-[arm]
-lengths = [2.0, 1.0]
-initial_deg = [0, 0]
-step_deg = 30
-[[obstacles]]
-center = [0.0, 2.5]
-radius = 0.5
-"""
+ARM = arm_toml([2.0, 1.0], [0, 0], 30, [((0.0, 2.5), 0.5)])
 
 
 @pytest.mark.parametrize("name", sorted(builtin_scenarios()))

@@ -7,17 +7,9 @@ from pathlib import Path
 import pytest
 
 from rsstp_sweep import SweepError, load_sweep, parse_sweep
+from scenarios import sweep_toml
 
-BASE = """
-steps = 100
-seeds = 3
-scenarios = ["thesis-roulette", "one-joint-10"]
-[[strategy]]
-name = "learner"
-[[strategy]]
-name = "script"
-params = { actions = [0] }
-"""
+BASE = sweep_toml(steps=100, seeds=3)
 
 
 def test_runs_are_scenario_by_strategy_by_seed_in_file_order() -> None:

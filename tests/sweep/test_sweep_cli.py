@@ -22,6 +22,7 @@ from rsstp_replay import open_recording
 from rsstp_sim.recording.recorder import record
 from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import make_strategy
+from scenarios import sweep_toml
 
 FAULTY = """
 import os
@@ -48,18 +49,7 @@ class Dies(StrategyBase):
         return agent.actions[0]
 """
 
-SWEEP = """
-steps = 300
-seeds = 2
-scenarios = ["thesis-roulette", "one-joint-10"]
-[[strategy]]
-name = "learner"
-[[strategy]]
-name = "script"
-params = { actions = [0] }
-[[strategy]]
-name = "sweep_faulty:Breaks"
-"""
+SWEEP = sweep_toml(steps=300, seeds=2, more_strategies=["sweep_faulty:Breaks"])
 
 
 def sweep_cli(*args: str, path: Path, timeout: float = 240) -> subprocess.CompletedProcess[str]:
