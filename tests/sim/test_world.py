@@ -145,25 +145,37 @@ def walks(scenario: Scenario) -> st.SearchStrategy[list[int]]:
     return st.lists(st.sampled_from(scenario.actions), min_size=1, max_size=20)
 
 
-@settings(max_examples=150, deadline=None)
-@given(st.data())
-def test_swept_moves_against_shapely(data: st.DataObject) -> None:
-    """Every reached pose is valid; free moves are free all along; blockers are real."""
-    scenario = data.draw(small_scenarios(collision="swept"), label="scenario")
+def check_walk(data: st.DataObject, collision: str) -> None:
+    """A random walk in a random small scenario of ``collision`` mode, each move checked
+    against shapely on the poses that mode checks (the whole swept path, or the end pose
+    alone): a free move ends at its end pose, a blocked one stays where it was and its blocker
+    is real there; every reached pose is valid."""
+    scenario = data.draw(small_scenarios(collision=collision), label="scenario")
     world = World(scenario)
     for action in data.draw(walks(scenario), label="actions"):
         start = world.angles_deg
-        poses = path(scenario, start, action)
+        end = end_pose(scenario, start, action)
+        if collision == "swept":
+            poses = path(scenario, start, action)
+        else:
+            poses = np.array([end], dtype=np.float64)
         blocker = world.move(action)
         assert world.last_blocker == blocker
         if blocker is None:
-            assert world.angles_deg == end_pose(scenario, start, action)
+            assert world.angles_deg == end
             assert_free(scenario, poses)
         else:
             event(f"blocked: {blocker.kind}")
             assert world.angles_deg == start
             assert_blocked_by(scenario, poses, blocker)
         assert_free(scenario, np.array([world.angles_deg], dtype=np.float64))
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.data())
+def test_swept_moves_against_shapely(data: st.DataObject) -> None:
+    """Every reached pose is valid; free moves are free all along; blockers are real."""
+    check_walk(data, "swept")
 
 
 FIXED_END_ON_MOVING_LINK = """
@@ -224,18 +236,7 @@ def test_touching_counts_as_meeting(mode: str) -> None:
 @given(st.data())
 def test_endpoint_moves_against_shapely(data: st.DataObject) -> None:
     """In endpoint mode only the end pose counts, and every blocker is real there."""
-    scenario = data.draw(small_scenarios(collision="endpoint"), label="scenario")
-    world = World(scenario)
-    for action in data.draw(walks(scenario), label="actions"):
-        start = world.angles_deg
-        end = np.array([end_pose(scenario, start, action)], dtype=np.float64)
-        blocker = world.move(action)
-        if blocker is None:
-            assert world.angles_deg == end_pose(scenario, start, action)
-            assert_free(scenario, end)
-        else:
-            assert world.angles_deg == start
-            assert_blocked_by(scenario, end, blocker)
+    check_walk(data, "endpoint")
 
 
 @settings(max_examples=40, deadline=None)
