@@ -367,6 +367,19 @@ def test_equality_ignores_version_and_next_id_but_not_current() -> None:
 # --------------------------------------------------------- op log/apply
 
 
+def assert_replays_to(
+    start: TransitionSystem, ops: list[Operation], model: TransitionSystem
+) -> None:
+    """Applying ``ops`` to ``start`` gives ``model`` (its current state set by hand): equal,
+    with the same version and the same next id."""
+    for op in ops:
+        start.apply(op)
+    start.current = model.current  # setting current is not an operation
+    assert start == model
+    assert start.version == model.version
+    assert start.next_id == model.next_id
+
+
 def test_apply_replays_the_log_to_an_equal_model() -> None:
     model = TransitionSystem.universal([0, 1])
     start = model.copy()
@@ -379,12 +392,7 @@ def test_apply_replays_the_log_to_an_equal_model() -> None:
     ops = model.drain_operations()
     assert [op.kind for op in ops] == ["split", "delete", "add", "split", "merge"]
     assert model.version == 5
-    for op in ops:
-        start.apply(op)
-    start.current = model.current  # setting current is not an operation
-    assert start == model
-    assert start.version == model.version
-    assert start.next_id == model.next_id
+    assert_replays_to(start, ops, model)
     assert start.drain_operations() == ops
 
 
@@ -546,12 +554,7 @@ def test_replaying_drained_operations_rebuilds_the_model(
     logged = model.drain_operations()
     assert model.version == version + len(logged)
     assert all(op.changed for op in logged)
-    for op in logged:
-        before.apply(op)
-    before.current = model.current  # setting current is not an operation
-    assert before == model
-    assert before.version == model.version
-    assert before.next_id == model.next_id
+    assert_replays_to(before, logged, model)
     assert before.snapshot() == model.snapshot()
 
 
