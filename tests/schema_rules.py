@@ -80,45 +80,34 @@ def _check_object(schema: dict[str, Any], pointer: str, found: list[Problem]) ->
         _check_field(field, f"{pointer}/properties/{_escape(name)}", found)
 
 
-def _check_field(field: object, pointer: str, found: list[Problem]) -> None:
+def _check_field(field: object, pointer: str, found: list[Problem], *, items: bool = False) -> None:
+    """A property's schema, or (``items``) the ``items`` of an array property."""
     if not isinstance(field, dict):
-        found.append(Problem(pointer, NO_TYPE, _json(field)))
+        found.append(Problem(pointer, NO_ITEMS if items else NO_TYPE, _json(field)))
         return
     one_of = field.get("oneOf")
-    if isinstance(one_of, list):
+    if not items and isinstance(one_of, list):
         if not all(isinstance(a, dict) and _is_number(a.get("const")) for a in one_of):
             found.append(Problem(pointer, ONE_OF_NOT_NUMERIC, _json(one_of)))
         return
     kind = field.get("type")
     if kind in SCALARS:
         return
-    if kind == "string":
-        if "contentEncoding" in field and field["contentEncoding"] != "base64":
-            found.append(Problem(pointer, CONTENT_ENCODING, _json(field["contentEncoding"])))
+    encoding = field.get("contentEncoding")
+    if kind == "string" and items:
+        if encoding is not None:
+            found.append(Problem(pointer, ITEM_CONTENT_ENCODING, _json(encoding)))
+    elif kind == "string":
+        if "contentEncoding" in field and encoding != "base64":
+            found.append(Problem(pointer, CONTENT_ENCODING, _json(encoding)))
     elif kind == "object":
         _check_object(field, pointer, found)
+    elif kind == "array" and items:
+        found.append(Problem(pointer, ARRAY_OF_ARRAYS, _json(_outline(field))))
     elif kind == "array":
-        _check_items(field.get("items"), f"{pointer}/items", found)
+        _check_field(field.get("items"), f"{pointer}/items", found, items=True)
     else:
         found.append(_type_problem(pointer, field))
-
-
-def _check_items(items: object, pointer: str, found: list[Problem]) -> None:
-    if not isinstance(items, dict):
-        found.append(Problem(pointer, NO_ITEMS, _json(items)))
-        return
-    kind = items.get("type")
-    if kind in SCALARS:
-        return
-    if kind == "string":
-        if items.get("contentEncoding") is not None:
-            found.append(Problem(pointer, ITEM_CONTENT_ENCODING, _json(items["contentEncoding"])))
-    elif kind == "object":
-        _check_object(items, pointer, found)
-    elif kind == "array":
-        found.append(Problem(pointer, ARRAY_OF_ARRAYS, _json(_outline(items))))
-    else:
-        found.append(_type_problem(pointer, items))
 
 
 def _type_problem(pointer: str, schema: dict[str, Any]) -> Problem:
