@@ -12,33 +12,23 @@ Targets (2-core machine): about 5,000 poses <= 2 s, about 40,000 poses <= 20 s.
 
 from __future__ import annotations
 
-from rsstp_sim.scenario import Scenario, parse_scenario
-from rsstp_sim.truth import compute_truth
+import sys
+from pathlib import Path
 
-TWO_JOINT = """
-name = "bench-two-joint"
-[arm]
-lengths = [2.0, 1.0]
-initial_deg = [0, 0]
-step_deg = 5
-[[obstacles]]
-center = [0.0, 2.6]
-radius = 0.2
-"""
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-THREE_JOINT = """
-name = "bench-three-joint"
-[arm]
-lengths = [3.0, 2.0, 1.0]
-initial_deg = [330, 3, 357]
-step_deg = 10
-[[obstacles]]
-center = [0.0, 4.5]
-radius = 0.6
-[[obstacles]]
-center = [-4.5, -1.0]
-radius = 0.5
-"""
+from rsstp_sim.scenario import Scenario, parse_scenario  # noqa: E402
+from rsstp_sim.truth import compute_truth  # noqa: E402
+from scenarios import arm_toml  # noqa: E402 (the test suite's folder goes on the path first)
+
+TWO_JOINT = arm_toml([2.0, 1.0], [0, 0], 5, [((0.0, 2.6), 0.2)], name="bench-two-joint")
+THREE_JOINT = arm_toml(
+    [3.0, 2.0, 1.0],
+    [330, 3, 357],
+    10,
+    [((0.0, 4.5), 0.6), ((-4.5, -1.0), 0.5)],
+    name="bench-three-joint",
+)
 
 CASES: list[tuple[str, float]] = [(TWO_JOINT, 2.0), (THREE_JOINT, 20.0)]
 

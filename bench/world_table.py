@@ -19,38 +19,26 @@ import argparse
 import json
 import subprocess
 import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from scenarios import arm_toml  # noqa: E402 (the test suite's folder goes on the path first)
 
 _ARMS = {
-    "five-joint-30": """
-name = "five-joint-30"
-[arm]
-lengths = [2.0, 1.5, 1.0, 1.0, 0.5]
-initial_deg = [0, 30, 30, 30, 30]
-step_deg = 30
-[[obstacles]]
-center = [2.0, 3.0]
-radius = 0.6
-[[obstacles]]
-center = [-3.0, -1.0]
-radius = 0.8
-""",
+    "five-joint-30": arm_toml(
+        [2.0, 1.5, 1.0, 1.0, 0.5],
+        [0, 30, 30, 30, 30],
+        30,
+        [((2.0, 3.0), 0.6), ((-3.0, -1.0), 0.8)],
+        name="five-joint-30",
+    ),
 }
 
 
 def _links(n: int) -> str:
-    return f"""
-name = "links-{n}"
-[arm]
-lengths = [{", ".join(["1.0"] * n)}]
-initial_deg = [{", ".join(["0"] + ["30"] * (n - 1))}]
-step_deg = 5
-[[obstacles]]
-center = [1.5, 1.0]
-radius = 0.5
-[[obstacles]]
-center = [1.5, -1.5]
-radius = 0.5
-"""
+    disks = [((1.5, 1.0), 0.5), ((1.5, -1.5), 0.5)]
+    return arm_toml([1.0] * n, [0] + [30] * (n - 1), 5, disks, name=f"links-{n}")
 
 
 _TABLE = """
