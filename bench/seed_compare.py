@@ -32,6 +32,10 @@ import sys
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from scenarios import arm_toml  # noqa: E402 (the test suite's folder goes on the path first)
+
 BIN = Path(sys.executable).parent
 SETUP = {
     "lengths": [3, 2, 1],
@@ -41,72 +45,54 @@ SETUP = {
     "feedback": [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)],
 }
 
+_TIMED = """
+import contextlib, os, random, time
+actions = [random.Random(12345).randrange(6) for _ in range(N)]
+with open(os.devnull, "w") as sink, contextlib.redirect_stdout(sink):  # the original prints
+    began = time.perf_counter()
+    act = build()  # the world is built inside the cold figure
+    for a in actions:
+        act(a)
+    cold = warm = time.perf_counter() - began
+    if WARM:
+        began = time.perf_counter()
+        for a in actions:
+            act(a)
+        warm = time.perf_counter() - began
+print(cold, warm)
+"""
+"""The tail of every program but the yardstick: ``N`` actions, cold from a fresh ``build()``,
+then warm (when ``WARM``) on the same world."""
+
 _PROGRAMS = {
     "original-world": """
-import contextlib, os, random, sys, time
+import sys
 sys.path.insert(0, SRC)
 from external import External
-actions = [random.Random(12345).randrange(6) for _ in range(N)]
-with open(os.devnull, "w") as sink, contextlib.redirect_stdout(sink):  # it prints
-    began = time.perf_counter()
-    world = External(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
-                     [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)])
-    for a in actions:
-        world.update(a)
-    cold = time.perf_counter() - began
-    began = time.perf_counter()
-    for a in actions:
-        world.update(a)
-    warm = time.perf_counter() - began
-print(cold, warm)
+def build():
+    return External(*ARGS).update
 """,
     "ours-world": """
-import random, sys, time
 from rsstp_sim.scenario import parse_scenario
 from rsstp_sim.world import World
-actions = [random.Random(12345).randrange(6) for _ in range(N)]
 scenario = parse_scenario(TOML)
-began = time.perf_counter()
-world = World(scenario)  # builds the world's table: part of the cold figure
-move = world.move
-for a in actions:
-    move(a)
-cold = time.perf_counter() - began
-began = time.perf_counter()
-for a in actions:
-    move(a)
-print(cold, time.perf_counter() - began)
+def build():
+    return World(scenario).move  # builds the world's table
 """,
     "original-facade": """
-import contextlib, io, os, random, sys, time
+import sys
 sys.path.insert(0, SRC)
 import matplotlib
 matplotlib.use("Agg")
 from msrgym import robot_arm
-actions = [random.Random(12345).randrange(6) for _ in range(N)]
-with open(os.devnull, "w") as sink, contextlib.redirect_stdout(sink):
-    began = time.perf_counter()
-    arm = robot_arm(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
-                    [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)], list(range(6)))
-    for a in actions:
-        arm.update_position(a)
-    cold = time.perf_counter() - began
-print(cold, cold)
+def build():
+    return robot_arm(*ARGS, list(range(6))).update_position
+WARM = False
 """,
     "ours-facade": """
-import random, sys, time
 from rsstp_sim.compat import robot_arm
-actions = [random.Random(12345).randrange(6) for _ in range(N)]
-began = time.perf_counter()
-arm = robot_arm(3, [330, 3, 357], [3, 2, 1], [[1.5, 1], 0.5, [1.5, -1.5], 0.5], 5,
-                [(2.6, -1.5), (4.38, -2.41), (5.25, -2.91)], list(range(6)))
-for a in actions:
-    arm.update_position(a)
-cold = time.perf_counter() - began
-began = time.perf_counter()
-for a in actions:
-    arm.update_position(a)
-print(cold, time.perf_counter() - began)
+def build():
+    return robot_arm(*ARGS, list(range(6))).update_position
 """,
     "yardstick": """
 import random, time
@@ -127,23 +113,23 @@ print(seconds, seconds)
 """,
 }
 
-_TOML = """
-[arm]
-lengths = [3.0, 2.0, 1.0]
-initial_deg = [330, 3, 357]
-step_deg = 5
-[[obstacles]]
-center = [1.5, 1.0]
-radius = 0.5
-[[obstacles]]
-center = [1.5, -1.5]
-radius = 0.5
-"""
+_ARGS = (
+    len(SETUP["lengths"]),
+    SETUP["start"],
+    SETUP["lengths"],
+    [part for obstacle in SETUP["obstacles"] for part in obstacle],
+    SETUP["step"],
+    SETUP["feedback"],
+)
+"""The original's arguments (joints, start, lengths, obstacles flattened, step, feedback)."""
+
+_TOML = arm_toml([3.0, 2.0, 1.0], [330, 3, 357], 5, [((1.5, 1.0), 0.5), ((1.5, -1.5), 0.5)])
 
 
 def measure(name: str, n: int, src: Path) -> tuple[float, float]:
     """Cold and warm seconds for ``n`` actions of program ``name`` in a fresh process."""
-    code = f"N = {n}\nSRC = {str(src)!r}\nTOML = {_TOML!r}\n" + _PROGRAMS[name]
+    head = f"N = {n}\nSRC = {str(src)!r}\nTOML = {_TOML!r}\nARGS = {_ARGS!r}\nWARM = True\n"
+    code = head + _PROGRAMS[name] + ("" if name == "yardstick" else _TIMED)
     done = subprocess.run(
         [sys.executable, "-c", code],
         capture_output=True,
