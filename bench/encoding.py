@@ -71,19 +71,23 @@ def step_records(steps: int) -> list[StepRecord]:
     ]
     for _ in range(steps):
         out = runner.step()
-        records.append(
-            step_record(
-                out.step,
-                runner.world.current,
-                action=out.action,
-                state_before=out.state_before,
-                internal_state=out.state_after,
-                model_version=runner.model.version,
-                no_transition=out.no_transition,
-                blocker=out.blocker,
-            )
-        )
+        records.append(build((out, runner.world.current, runner.model.version)))
     return records
+
+
+def build(item: tuple[StepOutcome, Pose, int]) -> StepRecord:
+    """``step_record`` of a step: its outcome, the pose it ended in, the model's version."""
+    out, pose, version = item
+    return step_record(
+        out.step,
+        pose,
+        action=out.action,
+        state_before=out.state_before,
+        internal_state=out.state_after,
+        model_version=version,
+        no_transition=out.no_transition,
+        blocker=out.blocker,
+    )
 
 
 def best_us(function: Callable[[Any], object], items: Sequence[Any]) -> float:
@@ -104,20 +108,6 @@ def build_us(steps: int) -> float:
     for _ in range(steps):
         out = runner.step()
         walk.append((out, runner.world.current, runner.model.version))
-
-    def build(item: tuple[StepOutcome, Pose, int]) -> StepRecord:
-        out, pose, version = item
-        return step_record(
-            out.step,
-            pose,
-            action=out.action,
-            state_before=out.state_before,
-            internal_state=out.state_after,
-            model_version=version,
-            no_transition=out.no_transition,
-            blocker=out.blocker,
-        )
-
     return best_us(build, walk)
 
 
