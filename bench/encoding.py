@@ -8,24 +8,25 @@ links, two obstacles), one :class:`~rsstp_sim.recording.records.StepRecord` per 
 all records, in microseconds per record:
 
 - ``a ready dict -> bytes``: the serialiser alone, on ``record.to_json()`` output;
-- ``record -> bytes``: from the dataclass (json needs ``to_json()`` first, 2.4 us here,
-  itself msgspec-based; a hand-written stdlib-only ``to_json`` would cost about as much);
+- ``record -> bytes``: from the record, a msgspec struct (json needs ``to_json()`` first,
+  itself msgspec-based; orjson a ``default`` hook that turns each struct into a dict);
 - ``bytes -> record``: back to an equal record, with the field checks of ``from_json``
-  (msgspec checks them while decoding into the dataclasses);
+  (msgspec checks them while decoding into the structs);
 - ``pose -> record``: ``step_record`` from a world pose and a step outcome.
 
-On the 2-core development machine (Python 3.11.7, orjson 3.13.0, msgspec 0.22.0)::
+On the 2-core development machine (2026-11-25, schema 2.0 records of 565 bytes, Python 3.11.7,
+orjson 3.13.0, msgspec 0.22.0, the machine loaded by other work)::
 
-    a ready dict -> bytes: json.dumps            9.85 us/record
-    a ready dict -> bytes: orjson.dumps          0.65 us/record
-    a ready dict -> bytes: msgspec               0.86 us/record
-    record -> bytes: json.dumps(to_json())      12.48 us/record
-    record -> bytes: orjson.dumps(record)        2.23 us/record
-    record -> bytes: msgspec (= encode)          1.27 us/record
-    bytes -> record: json.loads + from_json      6.99 us/record
-    bytes -> record: orjson.loads + from_json    2.82 us/record
-    bytes -> record: msgspec typed (= decode)    1.60 us/record
-    pose -> record: step_record                  4.10 us/record
+    a ready dict -> bytes: json.dumps                 14.28 us/record
+    a ready dict -> bytes: orjson.dumps                1.00 us/record
+    a ready dict -> bytes: msgspec                     1.21 us/record
+    record -> bytes: json.dumps(to_json())            18.10 us/record
+    record -> bytes: orjson.dumps(record, default)     1.68 us/record
+    record -> bytes: msgspec (= encode)                1.04 us/record
+    bytes -> record: json.loads + from_json            9.82 us/record
+    bytes -> record: orjson.loads + from_json          3.88 us/record
+    bytes -> record: msgspec typed (= decode)          1.89 us/record
+    pose -> record: step_record                        3.71 us/record
 
 So ``records.encode`` and ``records.decode`` use msgspec. All three write shortest
 round-trip floats; orjson and msgspec differ only in positive exponents (``1e+16`` against
@@ -133,6 +134,9 @@ def main(argv: list[str]) -> None:
     def stdlib_loads(payload: bytes) -> StepRecord:
         return StepRecord.from_json(json.loads(payload))
 
+    def orjson_dumps(record: StepRecord) -> bytes:  # orjson does not know msgspec structs
+        return orjson.dumps(record, default=msgspec.structs.asdict)
+
     def orjson_loads(payload: bytes) -> StepRecord:
         return StepRecord.from_json(orjson.loads(payload))
 
@@ -144,7 +148,7 @@ def main(argv: list[str]) -> None:
         ("a ready dict -> bytes: orjson.dumps", best_us(orjson.dumps, dicts)),
         ("a ready dict -> bytes: msgspec", best_us(msgspec_encoder.encode, dicts)),
         ("record -> bytes: json.dumps(to_json())", best_us(stdlib_dumps, records)),
-        ("record -> bytes: orjson.dumps(record)", best_us(orjson.dumps, records)),
+        ("record -> bytes: orjson.dumps(record, default)", best_us(orjson_dumps, records)),
         ("record -> bytes: msgspec (= encode)", best_us(encode, records)),
         ("bytes -> record: json.loads + from_json", best_us(stdlib_loads, payloads)),
         ("bytes -> record: orjson.loads + from_json", best_us(orjson_loads, payloads)),
@@ -157,7 +161,7 @@ def main(argv: list[str]) -> None:
         f"python {sys.version.split()[0]})"
     )
     for label, micros in rows:
-        print(f"  {label:<42} {micros:7.2f} us/record")
+        print(f"  {label:<48} {micros:7.2f} us/record")
 
 
 if __name__ == "__main__":
