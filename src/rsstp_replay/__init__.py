@@ -4,6 +4,9 @@
 :class:`Recording` gives its steps table, the agent's memory, the model at any step and the
 events. Problems with a file raise a :class:`ReplayError` subclass; a file whose writer was
 killed is read up to its last complete chunk, with an :class:`UnfinishedRecordingWarning`.
+:mod:`rsstp_replay.tables` gives the tables of a recording for pandas; :func:`write_table`
+and :func:`read_table` (:mod:`rsstp_replay.table_files`) write one to Parquet or CSV and read
+it back with its index and dtypes.
 """
 
 from rsstp_replay.errors import (
@@ -12,10 +15,12 @@ from rsstp_replay.errors import (
     NotARecording,
     ReplayError,
     StepOutOfRange,
+    TableError,
     UnfinishedRecordingWarning,
     UnsupportedVersion,
 )
 from rsstp_replay.recording import EVENT_KINDS, Recording, open_recording
+from rsstp_replay.table_files import read_table, write_table
 
 __all__ = [
     "EVENT_KINDS",
@@ -25,7 +30,10 @@ __all__ = [
     "Recording",
     "ReplayError",
     "StepOutOfRange",
+    "TableError",
     "UnfinishedRecordingWarning",
     "UnsupportedVersion",
     "open_recording",
+    "read_table",
+    "write_table",
 ]

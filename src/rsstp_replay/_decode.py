@@ -29,7 +29,14 @@ import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 from rsstp_replay.errors import BadStep, ReplayError
 from rsstp_sim.geometry import ArmGeometry, joint_positions, obstacle_distances
 
-__all__ = ["StepColumns", "blocker_label", "pose_numbers"]
+__all__ = [
+    "BLOCKED_COLUMNS",
+    "BLOCKER_KINDS",
+    "StepColumns",
+    "blocker_label",
+    "blocker_texts",
+    "pose_numbers",
+]
 
 _Count = Annotated[int, msgspec.Meta(ge=0)]
 _Angle = Annotated[int, msgspec.Meta(ge=0, le=359)]
@@ -93,9 +100,25 @@ _DECODERS: dict[bool, tuple[msgspec.json.Decoder[Any], msgspec.json.Decoder[Any]
 }
 _ARITY = {"fold": 1, "obstacle": 2, "links": 2}
 
+BLOCKER_KINDS = ("fold", "obstacle", "links")
+"""The categories of the steps table's ``blocked_kind`` column, in this order in every
+recording (so tables of several recordings concatenate with the categorical kept)."""
+
+BLOCKED_COLUMNS: dict[str, tuple[str, ...]] = {
+    "fold": ("blocked_joint",),
+    "obstacle": ("blocked_link", "blocked_obstacle"),
+    "links": ("blocked_link_i", "blocked_link_j"),
+}
+"""The steps table's index columns of each blocker kind, in the order of the step message's
+``truth.blocked_by.indices``: a column holds a value exactly at the steps blocked by its kind
+(nullable ``Int64``, missing elsewhere)."""
+
+_KIND_DTYPE = pd.CategoricalDtype(list(BLOCKER_KINDS))
+
 
 def blocker_label(kind: str, indices: tuple[int, ...]) -> str:
-    """The ``blocked_by`` column's text: ``fold joint 1``, ``obstacle 1 link 2``, ``links 0 2``."""
+    """A blocker as text (the viewer's label): ``fold joint 1``, ``obstacle 1 link 2``,
+    ``links 0 2``."""
     if len(indices) != _ARITY[kind]:
         raise BadStep(
             f"truth.blocked_by: a {kind} blocker has {_ARITY[kind]} indices, found {list(indices)}"
@@ -274,16 +297,16 @@ class StepColumns:
                 raise BadStep("truth.blocked: expected false at step 0 (the reset)", step=0)
 
     def frame(self, *, geometry: bool = True, copy: bool = False) -> pd.DataFrame:
-        """The steps table (see :meth:`rsstp_replay.Recording.steps` for the columns);
-        ``geometry=False`` leaves out the joint positions and distances; ``copy=True`` gives a
-        table that shares no array with these columns."""
+        """The steps table, indexed by ``step`` (see :meth:`rsstp_replay.Recording.steps` for
+        the columns; :meth:`check` made the steps ``0 .. n_rows - 1``); ``geometry=False``
+        leaves out the joint positions and distances; ``copy=True`` gives a table that shares
+        no array with these columns."""
         n = self.n_rows
         action_mask = np.zeros(n, np.bool_)
         action_mask[self.action_nulls] = True
         before_mask = np.zeros(n, np.bool_)
         before_mask[self.state_before_nulls] = True
         columns: dict[str, Any] = {
-            "step": self.step,
             "action": pd.arrays.IntegerArray(self.action, action_mask),
             "state_before": pd.arrays.IntegerArray(self.state_before, before_mask),
             "internal_state": self.internal_state,
@@ -293,22 +316,71 @@ class StepColumns:
             "no_transition": self.no_transition,
         }
         if self.truth:
-            labels = [blocker_label(by.kind, by.indices) for by in self.blocker_labels]
             columns["blocked"] = self.blocked
-            columns["blocked_by"] = pd.Categorical.from_codes(
-                self.blocker, dtype=pd.CategoricalDtype(labels)
-            )
+            columns |= self._blocked_columns()
             for j in range(self.n_joints):
                 columns[f"angle_deg_{j}"] = self.angles_deg[j]
         if self.truth and geometry:
-            positions, distances = pose_numbers(self._geometry(), self.angles_deg.T)
-            for k in range(self.n_joints + 1):
-                columns[f"joint{k}_x"] = positions[:, k, 0]
-                columns[f"joint{k}_y"] = positions[:, k, 1]
-            for k in range(self.n_joints):
-                for j in range(self.n_obstacles):
-                    columns[f"dist_{k}_{j}"] = distances[:, k, j]
-        return pd.DataFrame(columns, copy=copy)
+            columns |= self._geometry_columns()
+        return pd.DataFrame(columns, index=pd.RangeIndex(n, name="step"), copy=copy)
+
+    def _geometry_columns(self) -> dict[str, npt.NDArray[np.float64]]:
+        """``joint{k}_x``, ``joint{k}_y`` and ``dist_{k}_{j}``: each distinct pose computed
+        once (a long run revisits its poses; found by hashing its code, ``sum_j angle_j *
+        360**j``), each column taken whole from those."""
+        places = 360 ** np.arange(self.n_joints, dtype=np.int64)
+        index, codes = pd.factorize(places @ self.angles_deg)
+        poses = codes[:, None] // places % 360
+        positions, distances = pose_numbers(self._geometry(), poses)
+        columns = {}
+        for k in range(self.n_joints + 1):
+            columns[f"joint{k}_x"] = positions[:, k, 0].take(index)
+            columns[f"joint{k}_y"] = positions[:, k, 1].take(index)
+        for k in range(self.n_joints):
+            for j in range(self.n_obstacles):
+                columns[f"dist_{k}_{j}"] = distances[:, k, j].take(index)
+        return columns
+
+    def _blocked_columns(self) -> dict[str, Any]:
+        """``blocked_kind`` and the index columns of :data:`BLOCKED_COLUMNS`, taken from the
+        per-row blocker codes through one small table per column (no object per row)."""
+        n_codes = len(self.blocker_labels)
+        # Code -1 (not blocked) takes the last entry: no kind, every index missing.
+        kinds = np.full(n_codes + 1, -1, np.int8)
+        values = {
+            name: np.full(n_codes + 1, -1, np.int64)
+            for names in BLOCKED_COLUMNS.values()
+            for name in names
+        }
+        for by, code in self.blocker_labels.items():
+            kinds[code] = BLOCKER_KINDS.index(by.kind)
+            for name, index in zip(BLOCKED_COLUMNS[by.kind], by.indices, strict=True):
+                values[name][code] = index
+        columns: dict[str, Any] = {
+            "blocked_kind": pd.Categorical.from_codes(kinds[self.blocker], dtype=_KIND_DTYPE)
+        }
+        for name, table in values.items():
+            column = table[self.blocker]
+            columns[name] = pd.arrays.IntegerArray(column, column < 0)
+        return columns
+
+
+def blocker_texts(steps: pd.DataFrame, rows: npt.NDArray[np.int64]) -> npt.NDArray[np.object_]:
+    """The :func:`blocker_label` of each of ``rows`` of a steps table, from its blocked
+    columns (``""`` where the move was not blocked); each distinct blocker is formatted once."""
+    kinds = steps["blocked_kind"].cat.codes.to_numpy()[rows].astype(np.int64)
+    names = [name for names in BLOCKED_COLUMNS.values() for name in names]
+    parts = [steps[name].to_numpy(np.int64, na_value=-1)[rows] for name in names]
+    keys, inverse = np.unique(np.stack([kinds, *parts], axis=1), axis=0, return_inverse=True)
+    texts = []
+    for key in keys.tolist():
+        if key[0] < 0:
+            texts.append("")
+            continue
+        kind = BLOCKER_KINDS[key[0]]
+        indices = tuple(key[1 + names.index(name)] for name in BLOCKED_COLUMNS[kind])
+        texts.append(blocker_label(kind, indices))
+    return np.array(texts, object)[inverse.reshape(-1)]
 
 
 def pose_numbers(
@@ -316,17 +388,6 @@ def pose_numbers(
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Joint positions ``(B, n + 1, 2)`` and obstacle distances ``(B, n, m)`` of poses
     ``(B, n)``, computed as the recorder computes them."""
-    if len(angles_deg) > 1024:  # a long run revisits its poses: each distinct pose once
-        codes = angles_deg @ (360 ** np.arange(angles_deg.shape[1], dtype=np.int64))
-        _, first, index = np.unique(codes, return_index=True, return_inverse=True)
-        positions, distances = _pose_numbers(geometry, angles_deg[first])
-        return positions[index], distances[index]
-    return _pose_numbers(geometry, angles_deg)
-
-
-def _pose_numbers(
-    geometry: ArmGeometry, angles_deg: npt.NDArray[np.int64]
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     positions = joint_positions(angles_deg, geometry.lengths)
     return positions, obstacle_distances(positions[:, 1:], geometry.centers, geometry.radii)
 

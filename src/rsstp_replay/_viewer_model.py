@@ -114,7 +114,7 @@ def state_places(
     for index, record in enumerate(versions):
         for state in record.states:
             last_version[state] = index
-    in_force = version_index(versions, steps["step"].to_numpy(np.int64))
+    in_force = version_index(versions, steps.index.to_numpy(np.int64))
     ids = np.unique(states)
     final = np.array([last_version.get(int(s), -1) for s in ids.tolist()], np.int64)
     own = in_force == final[np.searchsorted(ids, states)]

@@ -68,7 +68,7 @@ def log_series(
     step): exact, and small on long runs (a sensation that is false for a million steps is
     two rows). The distances are one entity with a series per tip and obstacle.
     """
-    times = steps["step"].to_numpy(np.int64)
+    times = steps.index.to_numpy(np.int64)
     series: list[tuple[str, list[str], npt.NDArray[np.float64]]] = [
         (SENSATION, ["sensation"], steps[["sensation"]].to_numpy(np.float64)),
         (FEEDBACK, ["feedback"], steps[["feedback"]].to_numpy(np.float64)),

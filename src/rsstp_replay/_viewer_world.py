@@ -15,6 +15,7 @@ import numpy.typing as npt
 import pandas as pd
 import rerun as rr
 
+from rsstp_replay._decode import blocker_texts
 from rsstp_replay._viewer_chunks import send_rows
 from rsstp_sim import palette
 from rsstp_sim.scenario import Scenario
@@ -140,7 +141,7 @@ def log_world(
     """The arm with its joints, the obstacle sensor and the blocked moves over the steps of
     ``steps``, a row only where something changed (the pose, or whether the move was
     blocked): Rerun shows the latest row at the time cursor. Returns rows per entity path."""
-    times = steps["step"].to_numpy(np.int64)
+    times = steps.index.to_numpy(np.int64)
     n = scenario.n_joints
     positions = joint_positions(steps, n)
     blocked = steps["blocked"].to_numpy(np.bool_)
@@ -174,14 +175,14 @@ def log_world(
             ),
         )
     if blocked.any():
-        labels = ("blocked: " + steps["blocked_by"].astype(str)).to_numpy(object)
         tips = positions[:, -1, :]
         rows_at = np.flatnonzero(blocked | np.r_[False, blocked[:-1]])
+        labels = "blocked: " + blocker_texts(steps, rows_at)
         logged[BLOCKED] = send_rows(
             stream,
             BLOCKED,
             times[rows_at],
-            lambda rows: _blocked(tips[rows_at], labels[rows_at], blocked[rows_at], rows),
+            lambda rows: _blocked(tips[rows_at], labels, blocked[rows_at], rows),
         )
     return logged
 

@@ -21,8 +21,10 @@ from typing import TYPE_CHECKING, Any
 
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
+from rsstp_replay.table_files import TABLE_FORMATS, sidecar_path, write_table
+from rsstp_replay.tables import TABLES, recording_table
 from rsstp_sim.commandline import Parser, UsageError, progress, run_command
-from rsstp_sim.files import irregular, written_whole
+from rsstp_sim.files import irregular
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -30,7 +32,6 @@ if TYPE_CHECKING:
 __all__ = ["main"]
 
 PROG = "rsstp-replay"
-_TABLE_FORMATS = (".parquet", ".csv")
 _FAIL_ON = (
     "contract",
     "contradiction",
@@ -109,39 +110,34 @@ def _cmd_info(args: argparse.Namespace) -> int:
 
 
 def _check_table_output(out: Path, *, force: bool) -> None:
-    """One line for a table path we cannot or must not write (before reading anything)."""
-    if out.suffix.lower() not in _TABLE_FORMATS:
+    """One line for a table path we cannot or must not write (before reading anything): a
+    CSV's dtype sidecar too."""
+    if out.suffix.lower() not in TABLE_FORMATS:
         raise UsageError(
             f"{out}: unknown table format {out.suffix or '(no suffix)'!r}: expected "
-            f"{' or '.join(_TABLE_FORMATS)}"
+            f"{' or '.join(TABLE_FORMATS)}"
         )
     _check_output(out, force=force)
+    if out.suffix.lower() == ".csv":
+        _check_output(sidecar_path(out), force=force)
 
 
 def _write_table(table: pd.DataFrame, out: Path) -> None:
-    """Write ``table`` (Parquet or CSV by the suffix) whole: a failed write leaves no partial
-    table and the old one untouched."""
-    with written_whole(out) as side:
-        if out.suffix.lower() == ".parquet":
-            import pyarrow as pa
-            import pyarrow.parquet as pq
-
-            pq.write_table(pa.Table.from_pandas(table, preserve_index=False), side)
-        else:
-            table.to_csv(side, index=False)
-    print(f"wrote {len(table):,} rows and {len(table.columns)} columns to {out}")
+    """Write ``table`` whole (:func:`rsstp_replay.table_files.write_table`): a failed write leaves
+    no partial table and the old one untouched."""
+    written = write_table(table, out)
+    index = f" (index {table.index.name})" if table.index.name is not None else ""
+    sidecar = f"; dtypes in {written[1]}" if len(written) > 1 else ""
+    print(f"wrote {len(table):,} rows and {len(table.columns)} columns{index} to {out}{sidecar}")
 
 
 def _cmd_table(args: argparse.Namespace) -> int:
     out = Path(args.output)
+    if args.truth and args.what != "steps":
+        raise UsageError(f"table: --truth adds to the steps table, not to --what {args.what}")
     _check_table_output(out, force=args.force)
     with _open(args.file) as recording:
-        if args.truth:
-            from rsstp_replay.audits import truth_table
-
-            table = truth_table(recording, truth=recording.ground_truth())
-        else:
-            table = recording.steps()
+        table = recording_table(recording, args.what, truth=args.truth)
     _write_table(table, out)
     return 0
 
@@ -376,7 +372,12 @@ def _table_parser(sub: Any, name: str, description: str) -> Parser:
     """A subcommand that writes a table: the recording, ``-o`` and ``--force``."""
     p: Parser = sub.add_parser(name, help=description)
     p.add_argument("file", help="the .mcap recording")
-    p.add_argument("-o", "--output", required=True, help="the table: .parquet or .csv")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="the table: .parquet, or .csv (with its dtypes in OUT.csv.dtypes.json)",
+    )
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     return p
 
@@ -392,7 +393,17 @@ def _build_parser() -> Parser:
     p.add_argument("file", help="the .mcap recording")
     p.set_defaults(func=_cmd_info)
 
-    p = _table_parser(sub, "table", "write the steps table (one row per step)")
+    p = _table_parser(
+        sub, "table", "write a table: the steps (one row per step), model, events or scenario"
+    )
+    p.add_argument(
+        "--what",
+        choices=TABLES,
+        default="steps",
+        help="which table: steps (one row per step, indexed by step; the default), model (one "
+        "row per transition of every model version), events (one row per event) or scenario "
+        "(one row)",
+    )
     p.add_argument(
         "--truth",
         action="store_true",

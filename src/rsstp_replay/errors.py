@@ -15,6 +15,7 @@ __all__ = [
     "NotARecording",
     "ReplayError",
     "StepOutOfRange",
+    "TableError",
     "UnfinishedRecordingWarning",
     "UnsupportedVersion",
 ]
@@ -42,6 +43,11 @@ class CorruptRecording(ReplayError):
 
 class StepOutOfRange(ReplayError):
     """A step index outside ``0 .. n_steps`` of the recording."""
+
+
+class TableError(ReplayError):
+    """A table that cannot be written or read back with its types (a CSV without its dtype
+    sidecar, a dtype CSV cannot keep, an unknown format)."""
 
 
 class UnfinishedRecordingWarning(UserWarning):

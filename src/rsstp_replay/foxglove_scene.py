@@ -232,12 +232,10 @@ class _ArmPoses:
 
 
 def _step_numbers(steps: pd.DataFrame, *, source: Path) -> npt.NDArray[np.int64]:
-    """The step of every row: the ``step`` column, or an index named ``step``."""
-    if "step" in steps.columns:
-        return steps["step"].to_numpy(np.int64)
-    if steps.index.name == "step":
-        return steps.index.to_numpy(np.int64)
-    raise ReplayError(f"{source}: the steps table has neither a step column nor a step index")
+    """The step of every row: the steps table's index, named ``step``."""
+    if steps.index.name != "step":
+        raise ReplayError(f"{source}: the steps table is not indexed by step")
+    return steps.index.to_numpy(np.int64)
 
 
 def _timestamp(step: int) -> Timestamp:

@@ -174,13 +174,20 @@ class Recording:
     # -- tables ----------------------------------------------------------------------------
 
     def steps(self, *, truth: bool = False, geometry: bool = True) -> pd.DataFrame:
-        """One row per step (``0 .. n_steps``), flat typed columns:
+        """One row per step, indexed by ``step`` (a ``RangeIndex`` ``0 .. n_steps`` named
+        ``step``; there is no ``step`` column, so ``groupby("step")`` and ``loc[a:b]`` read
+        the index), flat typed columns:
 
-        - ``step`` (int64); ``action`` and ``state_before`` (nullable Int64, ``<NA>`` at step 0);
+        - ``action`` and ``state_before`` (nullable Int64, ``<NA>`` at step 0);
           ``internal_state`` (int64); ``sensation`` (bool); ``feedback`` (float64, closeness in
           ``[0, 1]``); ``model_version`` (int64); ``no_transition`` (bool): the agent's view;
-        - ``blocked`` (bool) and ``blocked_by`` (categorical, missing when not blocked):
-          ``"fold joint J"``, ``"obstacle J link L"`` or ``"links I J"``;
+        - ``blocked`` (bool) and what blocked the move: ``blocked_kind`` (categorical, always
+          the categories ``fold``, ``obstacle``, ``links``; missing when not blocked) and
+          nullable Int64 indices, each present exactly at the steps of its kind:
+          ``blocked_joint`` (``fold``: the joint whose relative angle would reach 180),
+          ``blocked_link`` and ``blocked_obstacle`` (``obstacle``: the link that meets the
+          obstacle), ``blocked_link_i`` and ``blocked_link_j`` (``links``: two links that
+          meet, ``blocked_link_i < blocked_link_j - 1``);
         - ``angle_deg_{j}`` (int64, joint ``j``'s relative angle in degrees);
         - ``joint{k}_x``, ``joint{k}_y`` (float64, length units, world frame): point ``k`` of
           the arm, ``k = 0`` the base, ``k = n`` the tip of the last link;
@@ -191,6 +198,12 @@ class Recording:
 
         ``geometry=False`` leaves out the joint positions and the distances (what the audits
         do not read: a tenth of the memory per step).
+
+        Every name is the same in every scenario (joints, points and obstacles are numbered
+        from 0), so the tables of several recordings concatenate by name:
+        ``pd.concat([a, b], keys=["a", "b"], names=["recording"])`` has the union of their
+        columns (a joint or obstacle that one scenario lacks is missing in its rows, and
+        such an int64 column becomes float64 there); the other columns keep their dtypes.
         """
         self._check_open()
         columns = self._step_columns(truth=True)

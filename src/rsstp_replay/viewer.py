@@ -369,7 +369,7 @@ def _log(
     rows |= plots_part.log_model_size(stream, shown, times, last)
     rows[model_part.CURRENT] = model_part.log_current_state(
         stream,
-        window["step"].to_numpy(np.int64),
+        window.index.to_numpy(np.int64),
         window["internal_state"].to_numpy(np.int64),
         loaded.places,
     )

@@ -90,18 +90,22 @@ class FakeRecording:
                     "blocked": outcome.blocker is not None,
                 }
             )
-        self._steps = pd.DataFrame(rows).astype(
-            {
-                "step": "int64",
-                "action": "Int64",
-                "state_before": "Int64",
-                "internal_state": "int64",
-                "sensation": bool,
-                "feedback": "float64",
-                "model_version": "int64",
-                "no_transition": bool,
-                "blocked": bool,
-            }
+        self._steps = (
+            pd.DataFrame(rows)
+            .astype({"step": "int64"})
+            .set_index("step")
+            .astype(
+                {
+                    "action": "Int64",
+                    "state_before": "Int64",
+                    "internal_state": "int64",
+                    "sensation": bool,
+                    "feedback": "float64",
+                    "model_version": "int64",
+                    "no_transition": bool,
+                    "blocked": bool,
+                }
+            )
         )
 
     @property
@@ -149,7 +153,7 @@ class FakeRecording:
         return list(self._models)
 
     def step_log_times(self) -> npt.NDArray[np.int64]:
-        return self._steps["step"].to_numpy(np.int64) * STEP_NS
+        return self._steps.index.to_numpy(np.int64) * STEP_NS
 
     def model_at(self, step: int) -> TransitionSystem:
         record = [model for model in self._models if model.step <= step][-1]

@@ -18,7 +18,7 @@ from typing import ClassVar
 import pandas as pd
 import pytest
 
-from rsstp_replay import open_recording
+from rsstp_replay import open_recording, read_table
 from rsstp_replay.audits import audit_truth, compare, run_audits
 from rsstp_replay.cli import main
 from rsstp_sim import AgentView, StrategyBase, load_scenario, make_strategy
@@ -115,9 +115,10 @@ def test_table_writes_parquet(
     out = tmp_path / "steps.parquet"
     code, printed, err = run_cli(capsys, "table", str(run), "-o", str(out))
     assert (code, err) == (0, "")
-    assert printed == f"wrote 1,501 rows and 27 columns to {out}\n"
+    assert printed == f"wrote 1,501 rows and 31 columns (index step) to {out}\n"
     expected = open_recording(run).steps()
-    pd.testing.assert_frame_equal(pd.read_parquet(out), expected)
+    pd.testing.assert_frame_equal(pd.read_parquet(out), expected)  # the index as written
+    assert read_table(out).equals(expected)
 
 
 def test_table_truth_adds_class_pose_and_aliasing(
@@ -126,12 +127,12 @@ def test_table_truth_adds_class_pose_and_aliasing(
     out = tmp_path / "truth.parquet"
     code, printed, err = run_cli(capsys, "table", str(run), "--truth", "-o", str(out))
     assert (code, err) == (0, "")
-    assert printed == f"wrote 1,501 rows and 30 columns to {out}\n"
-    table = pd.read_parquet(out)
+    assert printed == f"wrote 1,501 rows and 34 columns (index step) to {out}\n"
+    table = read_table(out)
     with open_recording(run) as recording:
         truth = recording.ground_truth()
         findings = audit_truth(recording, truth=truth)
-        pd.testing.assert_frame_equal(table.iloc[:, :27], recording.steps())
+        pd.testing.assert_frame_equal(table.iloc[:, :31], recording.steps())
     assert table["true_class"].tolist() == findings.true_class.tolist()
     assert table["aliased"].tolist() == findings.aliased_step.tolist()
     angles = table[[f"angle_deg_{j}" for j in range(truth.n_joints)]].to_numpy()
@@ -140,19 +141,17 @@ def test_table_truth_adds_class_pose_and_aliasing(
 
 def test_table_writes_csv(run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     out = tmp_path / "steps.csv"
-    code, _, err = run_cli(capsys, "table", str(run), "-o", str(out))
+    code, printed, err = run_cli(capsys, "table", str(run), "-o", str(out))
     assert (code, err) == (0, "")
-    exact = {"float_precision": "round_trip"} if pd.__version__.startswith("2.") else {}
-    table = pd.read_csv(out, **exact)  # pandas 3 reads floats exactly by default
+    assert printed.endswith(f"to {out}; dtypes in {out}.dtypes.json\n")
     expected = open_recording(run).steps()
-    assert list(table.columns) == list(expected.columns)
-    assert table["step"].tolist() == expected["step"].tolist()
+    assert read_table(out).equals(expected)  # every dtype and the index, through the sidecar
+    exact = {"float_precision": "round_trip"} if pd.__version__.startswith("2.") else {}
+    table = pd.read_csv(out, **exact)  # plain pandas: pandas 3 reads floats exactly
+    assert list(table.columns) == ["step", *expected.columns]
+    assert table["step"].tolist() == expected.index.tolist()
     assert table["feedback"].tolist() == expected["feedback"].tolist()  # exact round trip
     assert table["joint3_x"].tolist() == expected["joint3_x"].tolist()
-    assert (
-        table["blocked_by"].fillna("").tolist()
-        == expected["blocked_by"].astype(object).fillna("").tolist()
-    )
 
 
 def test_table_refuses_to_overwrite_without_force(

@@ -123,7 +123,7 @@ def scene(recorded: Recorded) -> Scene:
 
 
 def _step_numbers(table: pd.DataFrame) -> np.ndarray:
-    return (table["step"] if "step" in table.columns else table.index).to_numpy(np.int64)
+    return table.index.to_numpy(np.int64)
 
 
 # ------------------------------------------------------------------------------ the arm

@@ -40,6 +40,13 @@ SRC = Path(__file__).resolve().parents[2] / "src"
 STEPS = 2000
 SEED = 7
 CHUNK_SIZE = 16 * 1024  # about 20 steps per chunk: many chunks in a small file
+BLOCKED_INDEX_COLUMNS = [
+    "blocked_joint",
+    "blocked_link",
+    "blocked_obstacle",
+    "blocked_link_i",
+    "blocked_link_j",
+]
 
 
 class Refiner(StrategyBase):
@@ -186,9 +193,10 @@ def test_steps_table_has_flat_typed_columns(random_run: tuple[Path, Any]) -> Non
     path, _ = random_run
     table = open_recording(path).steps()
     assert len(table) == STEPS + 1
+    assert isinstance(table.index, pd.RangeIndex)
+    assert (table.index.name, table.index.start, table.index.stop) == ("step", 0, STEPS + 1)
     dtypes = {name: str(dtype) for name, dtype in table.dtypes.items()}
     assert dtypes == {
-        "step": "int64",
         "action": "Int64",
         "state_before": "Int64",
         "internal_state": "int64",
@@ -197,7 +205,8 @@ def test_steps_table_has_flat_typed_columns(random_run: tuple[Path, Any]) -> Non
         "model_version": "int64",
         "no_transition": "bool",
         "blocked": "bool",
-        "blocked_by": "category",
+        "blocked_kind": "category",
+        **dict.fromkeys(BLOCKED_INDEX_COLUMNS, "Int64"),
         **{f"angle_deg_{j}": "int64" for j in range(3)},
         **{f"joint{k}_{axis}": "float64" for k in range(4) for axis in "xy"},
         **{f"dist_{k}_{j}": "float64" for k in range(3) for j in range(2)},
@@ -205,6 +214,8 @@ def test_steps_table_has_flat_typed_columns(random_run: tuple[Path, Any]) -> Non
     assert table["action"].isna().tolist() == [True] + [False] * STEPS
     assert table["state_before"].isna().sum() == 1
     assert table["blocked"].any()  # the random walk meets the obstacles
+    assert list(table["blocked_kind"].cat.categories) == ["fold", "obstacle", "links"]
+    assert table.groupby("step")["action"].first().equals(table["action"])  # no ambiguity
 
 
 def test_steps_table_equals_the_step_messages(random_run: tuple[Path, Any]) -> None:
@@ -212,9 +223,9 @@ def test_steps_table_equals_the_step_messages(random_run: tuple[Path, Any]) -> N
     table = open_recording(path).steps()
     messages = steps_of(path)
     assert len(messages) == len(table)
-    for row, message in zip(table.itertuples(index=False), messages, strict=True):
+    for row, message in zip(table.itertuples(), messages, strict=True):
         agent, truth = message.agent, message.truth
-        assert row.step == message.step
+        assert row.Index == message.step
         assert (None if pd.isna(row.action) else row.action) == agent.action
         assert (None if pd.isna(row.state_before) else row.state_before) == agent.state_before
         assert (row.internal_state, row.sensation, row.feedback) == (
@@ -224,22 +235,25 @@ def test_steps_table_equals_the_step_messages(random_run: tuple[Path, Any]) -> N
         )
         assert (row.model_version, row.no_transition) == (agent.model_version, agent.no_transition)
         assert row.blocked == truth.blocked
-        by = truth.blocked_by
-        if by is None:
-            assert pd.isna(row.blocked_by)
-        else:
-            expected = {
-                "fold": lambda i: f"fold joint {i[0]}",
-                "obstacle": lambda i: f"obstacle {i[1]} link {i[0]}",
-                "links": lambda i: f"links {i[0]} {i[1]}",
-            }[by.kind](by.indices)
-            assert row.blocked_by == expected
         values = row._asdict()
+        by = truth.blocked_by
+        expected: dict[str, Any] = dict.fromkeys(BLOCKED_INDEX_COLUMNS)
+        if by is not None:
+            names = {
+                "fold": ["blocked_joint"],
+                "obstacle": ["blocked_link", "blocked_obstacle"],
+                "links": ["blocked_link_i", "blocked_link_j"],
+            }[by.kind]
+            expected |= dict(zip(names, by.indices, strict=True))
+        assert (None if pd.isna(row.blocked_kind) else row.blocked_kind) == (by and by.kind)
+        assert {name: None if pd.isna(values[name]) else values[name] for name in expected} == (
+            expected
+        )
         assert [values[f"angle_deg_{j}"] for j in range(3)] == list(truth.angles_deg)
-        for k, (x, y) in enumerate(truth.joint_positions):
-            assert (values[f"joint{k}_x"], values[f"joint{k}_y"]) == (x, y)  # exactly
+        for k, point in enumerate(truth.joint_positions):
+            assert (values[f"joint{k}_x"], values[f"joint{k}_y"]) == (point.x, point.y)  # exactly
         for k, tip in enumerate(truth.distances):
-            assert [values[f"dist_{k}_{j}"] for j in range(2)] == list(tip)
+            assert [values[f"dist_{k}_{j}"] for j in range(2)] == list(tip.obstacles)
 
 
 def test_events_table_equals_the_event_messages(refined_run: LiveRun) -> None:
@@ -355,7 +369,7 @@ def test_a_truncated_recording_is_read_up_to_its_last_complete_chunk(
     assert STEPS // 4 < n < STEPS
     assert recording.memory() == refined_run.memory_until(n)
     table = recording.steps()
-    assert table["step"].tolist() == list(range(n + 1))
+    assert table.index.tolist() == list(range(n + 1))
     for step in (0, n // 2, n - 1, n):
         assert _same_model(recording.model_at(step), live[step]), f"step {step}"
     assert recording.events()["step"].max() <= n

@@ -274,5 +274,5 @@ def test_the_truth_table_gives_class_pose_and_aliasing_per_step() -> None:
     # After the learner's last version came into force, no step is aliased.
     learned = findings.learned_at_step
     assert learned is not None
-    assert not table.loc[table["step"] >= learned, "aliased"].any()
-    assert table.loc[table["step"] < learned, "aliased"].any()
+    assert not table.loc[learned:, "aliased"].any()
+    assert table.loc[: learned - 1, "aliased"].any()

@@ -216,9 +216,13 @@ def test_blocked_moves_are_marked(reference: tuple[Recording, Rrd]) -> None:
     assert len(blocked) > 100
     red = None
     for step in blocked[:20].tolist():
-        assert rrd.at("world/blocked", "Points2D:labels", step) == [
-            f"blocked: {table.at[step, 'blocked_by']}"
-        ]
+        kind = table.at[step, "blocked_kind"]
+        label = {
+            "fold": "fold joint {blocked_joint}",
+            "obstacle": "obstacle {blocked_obstacle} link {blocked_link}",
+            "links": "links {blocked_link_i} {blocked_link_j}",
+        }[kind].format(**table.loc[step].to_dict())
+        assert rrd.at("world/blocked", "Points2D:labels", step) == [f"blocked: {label}"]
         np.testing.assert_allclose(
             rrd.at("world/blocked", "Points2D:positions", step),
             [[table.at[step, "joint3_x"], table.at[step, "joint3_y"]]],
@@ -252,7 +256,7 @@ def test_states_sit_where_the_arm_was_in_their_last_version(refined: tuple[Recor
     recording, rrd = refined
     table = recording.steps()
     versions = recording.model_versions()
-    in_force = version_index(versions, table["step"].to_numpy())
+    in_force = version_index(versions, table.index.to_numpy())
     last = {s: i for i, record in enumerate(versions) for s in record.states}
     tips = table[["joint3_x", "joint3_y"]].to_numpy()
     states = table["internal_state"].to_numpy()
@@ -368,7 +372,7 @@ def test_a_learned_model_looks_like_the_world() -> None:
         versions = recording.model_versions()
         places = state_places(table, versions, n_joints=2, reach=3.0)
     final = versions[-1]
-    last_steps = table.loc[table["step"] >= final.step]
+    last_steps = table.loc[final.step :]
     for state in final.states:
         seen = last_steps.loc[last_steps["internal_state"] == state]
         if len(seen):

@@ -108,7 +108,7 @@ def check_contract(source: ContractSource) -> ContractFindings:
     """Check every step against the model messages (see the module docstring)."""
     table = source.steps(geometry=False)
     versions = list(source.model_versions())
-    step = table["step"].to_numpy(np.int64)
+    step = table.index.to_numpy(np.int64)
     state = table["internal_state"].to_numpy(np.int64)
     named = table["model_version"].to_numpy(np.int64)
     before = table["state_before"].to_numpy(np.int64, na_value=-1)
