@@ -377,12 +377,12 @@ def _not_written(path: Path, written: Written) -> str | None:
         except ReplayError:
             return None
     steps = _plain(steps)
-    original = _plain(written.steps).set_index("step", drop=False)
-    if len(steps) and not steps.step.isin(original.index).all():
-        return f"steps {sorted(set(steps.step) - set(original.index))[:5]} were never written"
-    expected = original.loc[steps["step"].to_numpy()].reset_index(drop=True)
-    if not steps.reset_index(drop=True).equals(expected):
-        changed = steps.reset_index(drop=True).compare(expected)
+    original = _plain(written.steps)
+    if len(steps) and not steps.index.isin(original.index).all():
+        return f"steps {sorted(set(steps.index) - set(original.index))[:5]} were never written"
+    expected = original.loc[steps.index.to_numpy()]
+    if not steps.equals(expected):
+        changed = steps.compare(expected)
         return f"steps read back differ from those written: {changed.head(3).to_dict()}"
     for model in models:
         if written.models.get(model.version) != model:
