@@ -43,9 +43,9 @@ _Angle = Annotated[int, msgspec.Meta(ge=0, le=359)]
 _Closeness = Annotated[float, msgspec.Meta(ge=0.0, le=1.0)]
 
 
-class _Agent(msgspec.Struct, gc=False):
-    action: _Count | None
-    state_before: _Count | None
+class _Agent(msgspec.Struct, gc=False, kw_only=True):
+    action: _Count | None = None  # absent at step 0
+    state_before: _Count | None = None
     internal_state: _Count
     sensation: bool
     feedback: _Closeness
@@ -58,12 +58,21 @@ class _BlockedBy(msgspec.Struct, gc=False, frozen=True):
     indices: Annotated[tuple[_Count, ...], msgspec.Meta(min_length=1, max_length=2)]
 
 
-class _Truth(msgspec.Struct, gc=False):
+class _Point(msgspec.Struct, gc=False):
+    x: float
+    y: float
+
+
+class _Distances(msgspec.Struct, gc=False):
+    obstacles: list[float]
+
+
+class _Truth(msgspec.Struct, gc=False, kw_only=True):
     angles_deg: list[_Angle]
-    joint_positions: list[tuple[float, float]]
+    joint_positions: list[_Point]
     blocked: bool
-    blocked_by: _BlockedBy | None
-    distances: list[list[float]]
+    blocked_by: _BlockedBy | None = None  # absent when the arm moved
+    distances: list[_Distances]
 
 
 class _Step(msgspec.Struct, gc=False):
@@ -78,7 +87,7 @@ class _PoseTruth(msgspec.Struct, gc=False):
 
     angles_deg: list[_Angle]
     blocked: bool
-    blocked_by: _BlockedBy | None
+    blocked_by: _BlockedBy | None = None
 
 
 class _PoseStep(msgspec.Struct, gc=False):
@@ -221,17 +230,19 @@ class StepColumns:
         positions, distances = pose_numbers(self._geometry(), angles[None, :])
         n, m = self.n_joints, self.n_obstacles
         _check_lengths([truth.joint_positions], n + 1, "truth.joint_positions", "points")
-        _check_lengths([truth.distances], n, "truth.distances", "rows (one per tip)")
-        if any(len(row) != m for row in truth.distances):
-            raise BadStep(f"truth.distances: expected rows of {m} values", index=0)
-        found = np.array(truth.joint_positions, np.float64).reshape(n + 1, 2)
+        _check_lengths([truth.distances], n, "truth.distances", "entries (one per tip)")
+        rows = [tip.obstacles for tip in truth.distances]
+        if any(len(row) != m for row in rows):
+            raise BadStep(f"truth.distances: expected {m} obstacles per tip", index=0)
+        points = [(point.x, point.y) for point in truth.joint_positions]
+        found = np.array(points, np.float64).reshape(n + 1, 2)
         if not np.array_equal(found, positions[0]):
             raise BadStep(
                 "truth.joint_positions are not the positions of its angles "
                 f"{angles.tolist()}: {found.tolist()}",
                 index=0,
             )
-        if m and not np.array_equal(np.array(truth.distances, np.float64), distances[0]):
+        if m and not np.array_equal(np.array(rows, np.float64), distances[0]):
             raise BadStep(
                 f"truth.distances are not the distances of its angles {angles.tolist()}",
                 index=0,
@@ -278,9 +289,9 @@ class StepColumns:
         nullable = (("action", self.action_nulls), ("state_before", self.state_before_nulls))
         for name, nulls in nullable:
             if self.n_rows and nulls[:1] != [0]:
-                raise BadStep(f"agent.{name}: expected null at step 0 (the reset)", step=0)
+                raise BadStep(f"agent.{name}: expected none at step 0 (the reset)", step=0)
             if len(nulls) > 1:
-                raise BadStep(f"agent.{name}: null after step 0", step=nulls[1])
+                raise BadStep(f"agent.{name}: missing after step 0", step=nulls[1])
         unknown = np.flatnonzero(~np.isin(self.action[1:], np.array(actions, np.int64)))
         if unknown.size:
             t = int(unknown[0]) + 1

@@ -78,8 +78,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
             f"deg; step {record.step_deg} deg; actions {list(record.actions)})"
         )
         obstacles = "; ".join(
-            f"centre ({o.center[0]:g}, {o.center[1]:g}) radius {o.radius:g}"
-            for o in record.obstacles
+            f"centre ({o.center.x:g}, {o.center.y:g}) radius {o.radius:g}" for o in record.obstacles
         )
         print(f"  obstacles: {len(record.obstacles)}" + (f": {obstacles}" if obstacles else ""))
         print(
@@ -87,7 +86,12 @@ def _cmd_info(args: argparse.Namespace) -> int:
             f"collision: {record.collision}"
         )
         params = json.dumps(recording.strategy_params, sort_keys=True)
-        print(f"strategy: {recording.strategy} {params}; seed: {recording.seed}")
+        strategy = record.strategy
+        origin = " ".join(filter(None, (strategy.distribution, strategy.version)))
+        print(
+            f"strategy: {recording.strategy} {params}; seed: {recording.seed}\n"
+            f"  class: {strategy.import_path}" + (f" (from {origin})" if origin else "")
+        )
         print(f"steps: 0 to {recording.n_steps} (the reset, then {recording.n_steps:,} steps)")
         print("topics:")
         width = max(map(len, recording.topic_counts))

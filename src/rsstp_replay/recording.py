@@ -16,7 +16,6 @@ file and where. A file whose writer was killed is read up to its last complete c
 from __future__ import annotations
 
 import bisect
-import dataclasses
 import gc
 import operator
 import os
@@ -47,7 +46,7 @@ from rsstp_replay.errors import (
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
-from rsstp_sim.recording.records import EventRecord, ModelRecord
+from rsstp_sim.recording.records import EventRecord, ModelRecord, TransitionRecord
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, compute_truth
@@ -146,7 +145,7 @@ class Recording:
 
     @property
     def strategy_params(self) -> dict[str, Any]:
-        return dict(self.scenario_record.strategy.params)
+        return self.scenario_record.strategy.param_values()
 
     def __repr__(self) -> str:
         state = "finished" if self.finished else "unfinished"
@@ -428,12 +427,12 @@ class _SharedTransitions:
     distinct ones (300 MB as separate tuples, 30 MB shared)."""
 
     def __init__(self) -> None:
-        self._shared: dict[tuple[int, int, int], tuple[int, int, int]] = {}
+        self._shared: dict[TransitionRecord, TransitionRecord] = {}
 
     def __call__(self, record: ModelRecord) -> ModelRecord:
         keep = self._shared.setdefault
         transitions = tuple(map(keep, record.transitions, record.transitions))
-        return dataclasses.replace(record, transitions=transitions)
+        return msgspec.structs.replace(record, transitions=transitions)
 
 
 class _AgentRow(NamedTuple):
