@@ -9,6 +9,7 @@ import pytest
 pytest_plugins = ["pytester"]
 
 CONFTEST = (Path(__file__).parent / "conftest.py").read_text()
+SCENARIOS = (Path(__file__).parent / "scenarios.py").read_text()  # what the conftest imports
 
 
 @pytest.mark.parametrize(("in_ci", "code"), [("1", 1), (None, 0)])
@@ -20,6 +21,7 @@ def test_a_skip_fails_ci_and_only_ci(
     else:
         monkeypatch.setenv("RSSTP_FAIL_ON_SKIP", in_ci)
     pytester.makeconftest(CONFTEST)
+    pytester.makepyfile(scenarios=SCENARIOS)
     pytester.makepyfile(
         test_one="import pytest\n\ndef test_gone():\n    pytest.skip('no tool here')\n"
     )

@@ -99,10 +99,13 @@ def _cmd_info(args: argparse.Namespace) -> int:
             print(f"  {topic:<{width}}  {count:>12,}")
         model = recording.model_at(recording.n_steps)
         kind = "deterministic" if model.is_deterministic() else "nondeterministic"
-        print(
-            f"model at the end: version {model.version}, {len(model)} states, "
-            f"{len(model.transitions())} transitions, {kind}"
-        )
+        if not recording.has_model:
+            print(f"model: {_NO_MODEL}")
+        else:
+            print(
+                f"model at the end: version {model.version}, {len(model)} states, "
+                f"{len(model.transitions())} transitions, {kind}"
+            )
         schemas = ", ".join(f"{name} {v}" for name, v in recording.schema_versions.items())
         print(f"schemas: {schemas}")
         meta = recording.metadata
@@ -164,6 +167,9 @@ def _cmd_events(args: argparse.Namespace) -> int:
     return 0
 
 
+_NO_MODEL = "none recorded (the agent kept no model; read as the one-state model)"
+
+
 def _cmd_audit(args: argparse.Namespace) -> int:
     from rsstp_replay.audits import audit_truth, run_audits
     from rsstp_replay.audits.loaded import load
@@ -188,13 +194,15 @@ def _cmd_audit(args: argparse.Namespace) -> int:
             truth = audit_truth(loaded, within_versions=report.within_versions)
             bar.to(3)
     if args.json:
-        document = report.to_json()
+        document = {"model_recorded": recording.has_model, **report.to_json()}
         if truth is not None:
             document = {"verdict": truth.verdict.to_json(), **document, "truth": truth.to_json()}
         print(json.dumps(document, indent=2))
     else:
         if truth is not None:
             print(f"{truth.verdict.to_text()}\n")
+        if not recording.has_model:
+            print(f"model: {_NO_MODEL}\n")
         text = report.to_text()
         print(text, end="" if text.endswith("\n") else "\n")
         if truth is not None:

@@ -46,6 +46,7 @@ from rsstp_replay.errors import (
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
+from rsstp_sim.recording.builders import model_record
 from rsstp_sim.recording.records import EventRecord, ModelRecord, TransitionRecord
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
@@ -264,10 +265,22 @@ class Recording:
 
     # -- the model ---------------------------------------------------------------------------
 
+    @property
+    def has_model(self) -> bool:
+        """Whether the run recorded its agent's model. An agent that keeps none (a
+        Gymnasium-driven run) leaves no ``/rsstp/model`` channel; its steps are all in state
+        0, and the recording is read as having the one-state model (a self-loop per action)."""
+        return "/rsstp/model" in self._file.channels
+
     def model_versions(self) -> tuple[ModelRecord, ...]:
-        """The ``/rsstp/model`` messages in order, the chain between them checked."""
+        """The ``/rsstp/model`` messages in order, the chain between them checked (without a
+        model channel, the one-state model at step 0: :attr:`has_model`)."""
         self._check_open()
         if self._models is None:
+            if not self.has_model:
+                one_state = TransitionSystem.universal(self.scenario_record.actions)
+                self._models = (model_record(one_state, step=0, operations=()),)
+                return self._models
             models = self._records("/rsstp/model", keep=_SharedTransitions())
             verify_chain(self.path, models)
             self._models = tuple(models)

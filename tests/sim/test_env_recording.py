@@ -113,15 +113,15 @@ def test_an_agent_with_a_model_is_recorded_with_it(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     "command",
     [
-        ["info"],
-        ["check"],
-        ["audit"],
-        ["audit", "--truth"],
-        ["compare", "10", "20"],
-        ["table", "-o", "{out}.parquet"],
-        ["view", "--save", "{out}.rrd"],
-        ["graph", "-o", "{out}.svg"],
-        ["export", "--foxglove", "-o", "{out}.scene.mcap"],
+        ["info", "{file}"],
+        ["check", "{file}"],
+        ["audit", "{file}"],
+        ["audit", "--truth", "{file}"],
+        ["compare", "{file}", "10", "20"],
+        ["table", "{file}", "-o", "{out}.parquet"],
+        ["view", "{file}", "--save", "{out}.rrd"],
+        ["graph", "{file}", "--step", "60", "-o", "{out}.svg"],
+        ["export", "--foxglove", "{file}", "-o", "{out}.scene.mcap"],
     ],
     ids=lambda c: "-".join(w for w in c if not w.startswith("{"))[:30],
 )
@@ -129,17 +129,16 @@ def test_every_replay_command_reads_a_recording_without_a_model(
     tmp_path: Path, command: list[str]
 ) -> None:
     env = random_episodes(tmp_path, episodes=1, steps=120)
-    path = env.recordings[0]
-    words = [w.format(out=tmp_path / "out") for w in command]
+    words = [w.format(file=env.recordings[0], out=tmp_path / "out") for w in command]
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", words[0], str(path), *words[1:]],
+        [sys.executable, "-m", "rsstp_replay", *words],
         capture_output=True,
         text=True,
         timeout=300,
     )
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr
-    if command == ["info"]:
+    if command[0] in ("info", "audit"):
         assert "model: none recorded (the agent kept no model; read as the one-state model)" in (
             done.stdout
         )
