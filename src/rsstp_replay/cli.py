@@ -224,7 +224,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
             "aliasing": (bool(truth.aliased), "an internal state stood for several true classes"),
             "redundancy": (bool(truth.redundant), "a true class was split over several states"),
             "not-equivalent": (
-                not truth.final_equivalent,
+                not truth.verdict.learned,
                 "the final model is not equivalent to the truth",
             ),
         }

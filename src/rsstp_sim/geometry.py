@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal, Protocol
 
 import numpy as np
@@ -223,6 +223,14 @@ class ArmGeometry:
     radii: FloatArray
     swept: bool
     eps: float
+    n: int = field(init=False)
+    """Links (one per joint): ``len(lengths)``."""
+    m: int = field(init=False)
+    """Obstacles: ``len(radii)``."""
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "n", int(self.lengths.shape[0]))
+        object.__setattr__(self, "m", int(self.radii.shape[0]))
 
     @classmethod
     def from_scenario(cls, scenario: _ScenarioLike) -> ArmGeometry:
@@ -242,14 +250,6 @@ class ArmGeometry:
             scenario.collision == "swept",
             CONTACT_EPS * float(lengths.sum()),
         )
-
-    @property
-    def n(self) -> int:
-        return int(self.lengths.shape[0])
-
-    @property
-    def m(self) -> int:
-        return int(self.radii.shape[0])
 
     def decode(self, code: int) -> Blocker | None:
         n, m = self.n, self.m

@@ -302,22 +302,35 @@ class Memory:
     # -- conversion ----------------------------------------------------------------------------
 
     def to_dataframe(self) -> pd.DataFrame:
+        """One row per entry, indexed by ``step`` (as :meth:`rsstp_replay.Recording.steps`):
+        ``action`` (nullable Int64, ``<NA>`` at step 0), ``internal_state`` (int64),
+        ``sensation`` (bool), ``feedback`` (float64)."""
         import pandas as pd  # a simulation never needs it: imported on first use (~0.2 s)
 
-        """One row per entry: ``step`` (int64), ``action`` (nullable Int64, ``<NA>`` at step 0),
-        ``internal_state`` (int64), ``sensation`` (bool), ``feedback`` (float64)."""
         size = self._length
         mask = np.zeros(size, dtype=np.bool_)
         mask[:1] = True
         action = pd.arrays.IntegerArray(self._actions[:size].astype(np.int64), mask)
         return pd.DataFrame(
             {
-                "step": np.arange(size, dtype=np.int64),
                 "action": action,
                 "internal_state": self._states[:size].copy(),
                 "sensation": self._sensations[:size].copy(),
                 "feedback": self._feedback[:size].copy(),
-            }
+            },
+            index=pd.RangeIndex(size, name="step"),
+        )
+
+    def until(self, step: int) -> Memory:
+        """The memory as it was at the end of step ``step`` (entries ``0 .. step``), a copy."""
+        end = operator.index(step) + 1
+        if not 0 < end <= self._length:
+            raise MemoryRangeError(f"until: step {step} is not in 0..{self._length - 1}")
+        return Memory.from_arrays(
+            self.actions[:end],
+            self.internal_states[:end],
+            self.sensations[:end],
+            self.feedback[:end],
         )
 
     @classmethod

@@ -23,16 +23,7 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
-from rsstp_replay import (
-    CorruptRecording,
-    ForeignRecording,
-    NotARecording,
-    Recording,
-    ReplayError,
-    StepOutOfRange,
-    UnsupportedVersion,
-    open_recording,
-)
+from rsstp_replay import Recording, errors, open_recording
 from rsstp_sim import AgentView, StrategyBase, load_scenario
 from rsstp_sim.recording.recorder import record
 
@@ -164,7 +155,7 @@ def edit_json(topic: str, step: int, change: Callable[[dict[str, Any]], None]) -
 class Case:
     """A damaged file, what the API raises (and how it is reached), what the CLI runs."""
 
-    error: type[ReplayError]
+    error: type[errors.ReplayError]
     match: str
     reach: Callable[[Recording], object] | None = None
     """``None``: open_recording raises; else this raises on the opened recording."""
@@ -172,76 +163,78 @@ class Case:
 
 
 CASES: dict[str, Case] = {
-    "missing": Case(NotARecording, r"missing\.mcap: no such file"),
-    "directory": Case(NotARecording, r"directory\.mcap: is a directory, not a recording"),
-    "empty": Case(NotARecording, r"empty\.mcap: the file is empty, not an MCAP recording"),
-    "text": Case(NotARecording, r"text\.mcap: not an MCAP file \(it does not start with"),
+    "missing": Case(errors.NotARecording, r"missing\.mcap: no such file"),
+    "directory": Case(errors.NotARecording, r"directory\.mcap: is a directory, not a recording"),
+    "empty": Case(errors.NotARecording, r"empty\.mcap: the file is empty, not an MCAP recording"),
+    "text": Case(errors.NotARecording, r"text\.mcap: not an MCAP file \(it does not start with"),
     "foreign": Case(
-        ForeignRecording,
+        errors.ForeignRecording,
         r"foreign\.mcap: an MCAP file, but not an rsstp recording: none of the topics "
         r"/rsstp/scenario, /rsstp/step, /rsstp/model, /rsstp/event \(its topics: /camera\)",
     ),
     "version1": Case(
-        UnsupportedVersion,
+        errors.UnsupportedVersion,
         r"version1\.mcap: channel /rsstp/step: schema rsstp\.Step version 1\.0 is not "
         r"supported \(this reader understands 2\.x; re-record the run with rsstp-sim record: "
         r"its scenario\.toml is attached\)",
     ),
-    "in-magic": Case(CorruptRecording, r"in-magic\.mcap: truncated: the file ends at byte 5"),
+    "in-magic": Case(
+        errors.CorruptRecording, r"in-magic\.mcap: truncated: the file ends at byte 5"
+    ),
     "in-header": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"in-header\.mcap: the file was not finished and holds no complete chunk "
         r"\(read \d+ of 40 bytes\): nothing to recover",
     ),
     "chunk-flip": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"chunk-flip\.mcap: the chunk at byte \d+ (fails its CRC check|does not decompress)",
         reach=Recording.steps,
         command=("table", "-o", "{tmp}/chunk-flip.parquet"),
     ),
     "first-chunk-flip": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"first-chunk-flip\.mcap: the chunk at byte \d+ (fails its CRC check|does not decompress)",
     ),
     "summary-flip": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"summary-flip\.mcap: the summary section \(bytes \d+ to \d+\) fails its CRC check: "
         r"expected 0x[0-9a-f]{8}, computed 0x[0-9a-f]{8}",
     ),
     "bad-step": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"bad-step\.mcap: the step message at step 17 \(chunk at byte \d+\) is invalid: "
         r"agent\.action: expected `int \| null`, got `float`",
         reach=Recording.memory,
         command=("compare", "1", "2"),
     ),
     "moved-joint": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"moved-joint\.mcap: the step message at step 0 \(chunk at byte \d+\) is invalid: "
         r"truth\.joint_positions are not the positions of its angles \[330, 3, 357\]",
         reach=Recording.steps,
         command=("table", "-o", "{tmp}/moved-joint.parquet"),
     ),
     "step-gap": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"step-gap\.mcap: step 50: expected step 50 in this place, found step 51",
         reach=Recording.steps,
         command=("table", "-o", "{tmp}/step-gap.csv"),
     ),
     "broken-chain": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"broken-chain\.mcap: model version \d+ \(step \d+\): its operations applied to "
         r"version \d+ do not give its snapshot \(transitions differ",
         reach=Recording.model_versions,
         command=("audit",),
     ),
     "other-scenario": Case(
-        CorruptRecording,
+        errors.CorruptRecording,
         r"other-scenario\.mcap: the /rsstp/scenario message's sha256 is [0-9a-f]{64}, but the "
         r"scenario\.toml attachment hashes to [0-9a-f]{64}",
     ),
     "step-out-of-range": Case(
-        StepOutOfRange,
+        errors.StepOutOfRange,
         r"step-out-of-range\.mcap: (step|compare M =) 401 is out of range: the recording "
         r"has steps 0 to 400",
         reach=lambda recording: recording.model_at(STEPS + 1),
@@ -363,7 +356,7 @@ def test_a_later_minor_version_with_new_fields_is_read(original: Path, tmp_path:
 def test_a_bit_flip_in_a_chunk_spares_the_chunks_before_it(damaged: dict[str, Path]) -> None:
     recording = open_recording(damaged["chunk-flip"])
     assert recording.model_at(0).version >= 0  # the first chunks read fine
-    with pytest.raises(CorruptRecording, match="chunk at byte"):
+    with pytest.raises(errors.CorruptRecording, match="chunk at byte"):
         recording.memory()
 
 
@@ -379,7 +372,7 @@ def test_an_event_of_an_unknown_kind_is_refused(original: Path, tmp_path: Path) 
     )
     with open_recording(bad) as recording:
         with pytest.raises(
-            CorruptRecording,
+            errors.CorruptRecording,
             match=rf"bad-event\.mcap: the /rsstp/event message at step {step} \(chunk at byte "
             r"\d+\) is invalid: rsstp\.Event: kind: invalid enum value 'explosion'",
         ):
@@ -443,7 +436,7 @@ def test_a_message_index_that_points_elsewhere_is_refused(original: Path, tmp_pa
     raw[entry : entry + 8] = (offset + 1).to_bytes(8, "little")
     bad = tmp_path / "moved-index.mcap"
     bad.write_bytes(bytes(raw))
-    with open_recording(bad) as recording, pytest.raises(CorruptRecording) as caught:
+    with open_recording(bad) as recording, pytest.raises(errors.CorruptRecording) as caught:
         recording.steps()
     assert re.fullmatch(
         rf"{re.escape(str(bad))}: the message index of the chunk at byte {ref.offset} does "

@@ -24,13 +24,8 @@ import pandas as pd
 import pytest
 from mcap.reader import make_reader
 
-from rsstp_replay import (
-    EVENT_KINDS,
-    ReplayError,
-    StepOutOfRange,
-    UnfinishedRecordingWarning,
-    open_recording,
-)
+from rsstp_replay import EVENT_KINDS, open_recording
+from rsstp_replay.errors import ReplayError, StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording import records
 from rsstp_sim.recording.recorder import record
@@ -123,16 +118,6 @@ class LiveRun:
     path: Path
     memory: Memory
     models: list[TransitionSystem]
-
-    def memory_until(self, step: int) -> Memory:
-        live = self.memory
-        end = step + 1
-        return Memory.from_arrays(
-            live.actions[:end],
-            live.internal_states[:end],
-            live.sensations[:end],
-            live.feedback[:end],
-        )
 
 
 @pytest.fixture(scope="module")
@@ -367,7 +352,7 @@ def test_a_truncated_recording_is_read_up_to_its_last_complete_chunk(
     n = recording.n_steps
     assert recording.recovered_steps == n
     assert STEPS // 4 < n < STEPS
-    assert recording.memory() == refined_run.memory_until(n)
+    assert recording.memory() == refined_run.memory.until(n)
     table = recording.steps()
     assert table.index.tolist() == list(range(n + 1))
     for step in (0, n // 2, n - 1, n):

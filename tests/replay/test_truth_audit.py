@@ -53,7 +53,7 @@ def test_the_true_model_matches_the_truth_at_every_step(tmp_path: Path) -> None:
     assert (steps["internal_state"] == steps["true_class"]).all()
     assert findings.aliased == {} and findings.redundant == {}
     assert findings.first_mismatch_step is None
-    assert findings.final_equivalent and findings.counterexample is None
+    assert findings.verdict.learned and findings.counterexample is None
     # The one version is right from the reset: learned at step 0, every figure zero.
     assert findings.learned_at_step == 0
     assert findings.to_text().startswith(
@@ -74,7 +74,7 @@ def test_a_one_state_model_aliases_every_class(tmp_path: Path) -> None:
     assert findings.aliased == {0: (0, 1, 2, 3)}
     assert findings.first_aliasing_step == 1
     assert findings.redundant == {}
-    assert not findings.final_equivalent
+    assert not findings.verdict.learned
     # One move already tells the 4-cycle from one state: the model stays in state 0, which it
     # labels with the sensation last seen there (true at step 20), the world senses false.
     example = findings.counterexample
@@ -97,7 +97,7 @@ def test_roulette_is_redundant(tmp_path: Path) -> None:
         findings = audit_truth(rec)
     assert set(findings.redundant) == {0, 1, 2, 3}
     assert all(len(states) > 30 for states in findings.redundant.values())
-    assert findings.final_model_states == 152
+    assert findings.verdict.final_states == 152
     report = findings.to_json()
     assert json.loads(json.dumps(report)) == report
     assert report["history"]["redundant_classes"]["0"] == list(findings.redundant[0])

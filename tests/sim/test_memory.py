@@ -257,9 +257,9 @@ def test_compare_matches_reference(steps: list[tuple[int, int, bool]], data: st.
 
 def test_to_dataframe() -> None:
     frame = figure_11().to_dataframe()
-    assert list(frame.columns) == ["step", "action", "internal_state", "sensation", "feedback"]
-    assert frame.dtypes.astype(str).tolist() == ["int64", "Int64", "int64", "bool", "float64"]
-    assert frame["step"].tolist() == list(range(6))
+    assert list(frame.columns) == ["action", "internal_state", "sensation", "feedback"]
+    assert frame.dtypes.astype(str).tolist() == ["Int64", "int64", "bool", "float64"]
+    assert frame.index.name == "step" and frame.index.tolist() == list(range(6))
     assert frame["action"].isna().tolist() == [True] + [False] * 5
     assert frame["action"].iloc[1:].tolist() == [1, 0, 1, 0, 1]
     assert frame["sensation"].tolist() == [False, True, False, True, True, True]
@@ -277,7 +277,19 @@ def test_to_dataframe_is_a_copy() -> None:
 def test_to_dataframe_of_empty_memory() -> None:
     frame = Memory().to_dataframe()
     assert len(frame) == 0
-    assert frame.dtypes.astype(str).tolist() == ["int64", "Int64", "int64", "bool", "float64"]
+    assert frame.dtypes.astype(str).tolist() == ["Int64", "int64", "bool", "float64"]
+
+
+def test_until_is_the_memory_at_the_end_of_a_step() -> None:
+    memory = figure_11()
+    earlier = memory.until(2)
+    assert len(earlier) == 3 and list(earlier) == list(memory)[:3]
+    assert memory.until(len(memory) - 1) == memory
+    earlier.append(0, 7, False, 0.0)  # a copy: the memory it came from does not change
+    assert len(memory) == 6
+    for step in (-1, 6):
+        with pytest.raises(MemoryRangeError, match=rf"until: step {step} is not in 0\.\.5"):
+            memory.until(step)
 
 
 @settings(max_examples=100, deadline=None)

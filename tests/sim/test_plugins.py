@@ -82,7 +82,11 @@ def mine(tmp_path: Path) -> Path:
     return tmp_path
 
 
-def test_a_class_by_its_import_path_records_and_audits(mine: Path) -> None:
+@pytest.mark.parametrize("provided", [True, False], ids=["installed", "on-the-path"])
+def test_a_class_by_its_import_path_records_and_audits(mine: Path, provided: bool) -> None:
+    """The recording names the class, and the distribution providing its package if any."""
+    if not provided:
+        (mine / "my_strategies-1.2.dist-info" / "top_level.txt").unlink()
     out = mine / "run.mcap"
     done = cli(
         "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Clockwise",
@@ -94,26 +98,10 @@ def test_a_class_by_its_import_path_records_and_audits(mine: Path) -> None:
         assert recording.n_steps == 20
         strategy = recording.scenario_record.strategy
         assert strategy.import_path == "my_strategies:Clockwise"
-        assert (strategy.distribution, strategy.version) == ("my-strategies", "1.2")
+        found = (strategy.distribution, strategy.version)
+        assert found == (("my-strategies", "1.2") if provided else (None, None))
+        assert recording.metadata["strategy_distribution"] == ("my-strategies" if provided else "")
     assert cli("rsstp_replay", "audit", str(out), path=mine).returncode == 0
-
-
-def test_a_module_no_distribution_provides_is_recorded_without_one(mine: Path) -> None:
-    (mine / "my_strategies-1.2.dist-info" / "top_level.txt").unlink()
-    out = mine / "run.mcap"
-    done = cli(
-        "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Clockwise",
-        "--steps", "3", "-o", str(out), path=mine,
-    )  # fmt: skip
-    assert done.returncode == 0, done.stderr
-    with open_recording(out) as recording:
-        strategy = recording.scenario_record.strategy
-        assert (strategy.import_path, strategy.distribution, strategy.version) == (
-            "my_strategies:Clockwise",
-            None,
-            None,
-        )
-        assert recording.metadata["strategy_distribution"] == ""
 
 
 def test_an_entry_point_is_listed_and_runs_by_name(mine: Path) -> None:
@@ -132,34 +120,34 @@ def test_an_entry_point_is_listed_and_runs_by_name(mine: Path) -> None:
     assert "  class: my_strategies:Clockwise (from my-strategies 1.2)" in info.stdout
 
 
-def test_a_failing_strategy_stops_in_one_line_and_keeps_a_valid_file(mine: Path) -> None:
+@pytest.mark.parametrize(
+    ("strategy", "message", "kept"),
+    [
+        (  # its own code raises
+            "Breaks",
+            "strategy 'breaks' failed in choose_action at step 7: RuntimeError: boom",
+            6,
+        ),
+        (  # a model operation that would break the model's invariants
+            "Corrupts",
+            "strategy 'corrupts' failed in refine at step 5: "
+            "ModelError: merge: unknown state 99 (states: [0])",
+            4,
+        ),
+    ],
+)
+def test_a_failing_strategy_stops_in_one_line_and_keeps_a_valid_file(
+    mine: Path, strategy: str, message: str, kept: int
+) -> None:
     out = mine / "broken.mcap"
     done = cli(
-        "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Breaks",
+        "rsstp_sim", "record", "thesis-roulette", "--strategy", f"my_strategies:{strategy}",
         "--steps", "50", "-o", str(out), path=mine,
     )  # fmt: skip
     assert done.returncode == 2
-    assert done.stderr.strip() == (
-        "rsstp-sim: error: strategy 'breaks' failed in choose_action at step 7: RuntimeError: boom"
-    )
+    assert done.stderr.strip() == f"rsstp-sim: error: {message}"
     with open_recording(out) as recording:
-        assert recording.finished and recording.n_steps == 6
-    assert cli("rsstp_replay", "check", str(out), path=mine).returncode == 0
-
-
-def test_a_strategy_breaking_the_models_invariants_stops_in_one_line(mine: Path) -> None:
-    out = mine / "corrupt.mcap"
-    done = cli(
-        "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Corrupts",
-        "--steps", "50", "-o", str(out), path=mine,
-    )  # fmt: skip
-    assert done.returncode == 2
-    assert done.stderr.strip() == (
-        "rsstp-sim: error: strategy 'corrupts' failed in refine at step 5: "
-        "ModelError: merge: unknown state 99 (states: [0])"
-    )
-    with open_recording(out) as recording:
-        assert recording.finished and recording.n_steps == 4
+        assert recording.finished and recording.n_steps == kept
     assert cli("rsstp_replay", "check", str(out), path=mine).returncode == 0
 
 

@@ -42,12 +42,8 @@ from rsstp_sim import (
     make_strategy,
 )
 from rsstp_sim.recording import builders, records, schemas
-from rsstp_sim.recording.recorder import (
-    DEFAULT_CHUNK_SIZE,
-    Recorder,
-    environment_versions,
-    record,
-)
+from rsstp_sim.recording import recorder as recorder_module
+from rsstp_sim.recording.recorder import Recorder, record
 from rsstp_sim.recording.records import EventRecord, ModelRecord, StepRecord
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.strategies import Strategy
@@ -215,7 +211,7 @@ def test_metadata_record_rsstp(recording: Path, three_joint: Scenario) -> None:
     assert values["strategy_distribution"] == "rsstp"
     assert values["strategy_version"] == values["package_version"]
     assert values["scenario_sha256"] == three_joint.sha256
-    for key, version in environment_versions().items():
+    for key, version in recorder_module.environment_versions().items():
         assert values[key] == version
 
 
@@ -281,7 +277,7 @@ def test_no_wall_clock_time_anywhere(recording: Path) -> None:
     with recording.open("rb") as stream:
         header = make_reader(stream).get_header()
     assert header.profile == ""
-    assert header.library == f"rsstp {environment_versions()['package_version']}"
+    assert header.library == f"rsstp {recorder_module.environment_versions()['package_version']}"
 
 
 # ------------------------------------------------- 2. every message, against a live run
@@ -530,7 +526,7 @@ def test_smallest_chunk_size_makes_many_chunks(tmp_path: Path) -> None:
     summary = read_summary(path)
     assert len(summary.chunk_indexes) > 10
     assert topic_counts(summary)["/rsstp/step"] == 201
-    assert DEFAULT_CHUNK_SIZE == 1024 * 1024
+    assert recorder_module.DEFAULT_CHUNK_SIZE == 1024 * 1024
 
 
 @pytest.mark.parametrize("steps", [-1, 1.5, True, "10"])

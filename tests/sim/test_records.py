@@ -29,44 +29,8 @@ from hypothesis import strategies as st
 from jsonschema import Draft202012Validator
 
 import rsstp_sim
-from rsstp_sim.coupling import Event, Runner
+from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.recording import builders, records, schemas
-from rsstp_sim.recording.builders import (
-    blocked_event,
-    contradiction_event,
-    event_record,
-    model_record,
-    note_event,
-    operation_events,
-    scenario_record,
-    step_record,
-)
-from rsstp_sim.recording.records import (
-    RECORD_TYPES,
-    AgentRecord,
-    BlockedByRecord,
-    DistancesRecord,
-    EventRecord,
-    MessageRecord,
-    ModelRecord,
-    PointRecord,
-    RecordFormatError,
-    ScenarioRecord,
-    StepRecord,
-    TruthRecord,
-    decode,
-    encode,
-)
-from rsstp_sim.recording.schemas import (
-    SCHEMA_NAMES,
-    SCHEMA_VERSION,
-    TOPICS,
-    check_schema_version,
-    parse_version,
-    schema_bytes,
-    schema_json,
-    validate,
-)
 from rsstp_sim.scenario import builtin_scenarios, load_scenario
 from rsstp_sim.strategies import RandomStrategy, strategy_origin
 from rsstp_sim.transition_system import TransitionSystem
@@ -79,28 +43,28 @@ HAND_EDIT_AT = 150
 # ------------------------------------------------------------------ the schemas
 
 
-@pytest.mark.parametrize("name", SCHEMA_NAMES)
+@pytest.mark.parametrize("name", schemas.SCHEMA_NAMES)
 def test_schema_is_a_valid_draft_2020_12_schema(name: str) -> None:
-    schema = schema_json(name)
+    schema = schemas.schema_json(name)
     Draft202012Validator.check_schema(schema)
     assert schema["$schema"] == "https://json-schema.org/draft/2020-12/schema"
     assert schema["title"] == name
-    assert schema["version"] == SCHEMA_VERSION
+    assert schema["version"] == schemas.SCHEMA_VERSION
     assert schema["additionalProperties"] is True
     assert schema["required"] == list(schema["properties"])
 
 
-@pytest.mark.parametrize("name", SCHEMA_NAMES)
+@pytest.mark.parametrize("name", schemas.SCHEMA_NAMES)
 def test_packaged_schema_bytes_are_the_repository_files(name: str) -> None:
     on_disk = (SCHEMA_DIR / f"{name}.json").read_bytes()
-    assert schema_bytes(name) == on_disk
+    assert schemas.schema_bytes(name) == on_disk
     packaged = resources.files("rsstp_sim").joinpath(f"schemas/{name}.json").read_bytes()
     assert packaged == on_disk
 
 
-@pytest.mark.parametrize("name", SCHEMA_NAMES)
+@pytest.mark.parametrize("name", schemas.SCHEMA_NAMES)
 def test_schema_files_are_formatted_deterministically(name: str) -> None:
-    text = schema_bytes(name).decode("utf-8")
+    text = schemas.schema_bytes(name).decode("utf-8")
     assert text == json.dumps(json.loads(text), indent=2, ensure_ascii=False) + "\n"
 
 
@@ -116,9 +80,9 @@ def _object_schemas(schema: Mapping[str, Any], where: str) -> Iterator[tuple[str
         yield from _object_schemas(branch["then"], f"{where}.allOf[{i}]")
 
 
-@pytest.mark.parametrize("name", SCHEMA_NAMES)
+@pytest.mark.parametrize("name", schemas.SCHEMA_NAMES)
 def test_every_property_has_a_description_and_objects_are_open(name: str) -> None:
-    for where, schema in _object_schemas(schema_json(name), name):
+    for where, schema in _object_schemas(schemas.schema_json(name), name):
         for key, sub in schema["properties"].items():
             assert sub.get("description"), f"{where}.{key} has no description"
         if "type" in schema:  # the allOf branches only add requirements
@@ -128,9 +92,10 @@ def test_every_property_has_a_description_and_objects_are_open(name: str) -> Non
 
 
 def test_topics_schemas_and_record_types_agree() -> None:
-    assert list(TOPICS.values()) == list(SCHEMA_NAMES)
-    assert list(RECORD_TYPES) == list(SCHEMA_NAMES)
-    assert all(topic == "/rsstp/" + name.split(".")[1].lower() for topic, name in TOPICS.items())
+    assert list(schemas.TOPICS.values()) == list(schemas.SCHEMA_NAMES)
+    assert list(records.RECORD_TYPES) == list(schemas.SCHEMA_NAMES)
+    for topic, name in schemas.TOPICS.items():
+        assert topic == "/rsstp/" + name.split(".")[1].lower()
     assert schemas.log_time_ns(7) == 7_000_000
 
 
@@ -157,9 +122,9 @@ def _mirror(cls: type, schema: Mapping[str, Any], where: str) -> None:
             _mirror(typing.cast(type, inner[0]), target, f"{where}.{name}")
 
 
-@pytest.mark.parametrize("name", SCHEMA_NAMES)
+@pytest.mark.parametrize("name", schemas.SCHEMA_NAMES)
 def test_record_classes_mirror_their_schema(name: str) -> None:
-    _mirror(RECORD_TYPES[name], schema_json(name), name)
+    _mirror(records.RECORD_TYPES[name], schemas.schema_json(name), name)
 
 
 # ------------------------------------------------------------------ versions
@@ -169,51 +134,53 @@ def test_record_classes_mirror_their_schema(name: str) -> None:
     ("text", "expected"), [("1.0", (1, 0)), ("1.12", (1, 12)), ("2.3", (2, 3)), ("0.1", (0, 1))]
 )
 def test_parse_version(text: str, expected: tuple[int, int]) -> None:
-    assert parse_version(text) == expected
+    assert schemas.parse_version(text) == expected
 
 
 @pytest.mark.parametrize("text", ["1", "1.0.0", "v1.0", "01.0", "1.x", "", " 1.0", 1.0, None])
 def test_parse_version_refuses_anything_else(text: object) -> None:
-    with pytest.raises(RecordFormatError, match=r'schema version: expected "major.minor"'):
-        parse_version(text)
+    with pytest.raises(records.RecordFormatError, match=r'schema version: expected "major.minor"'):
+        schemas.parse_version(text)
 
 
 def _with_version(name: str, version: str) -> bytes:
-    schema = schema_json(name)
+    schema = schemas.schema_json(name)
     schema["version"] = version
     return json.dumps(schema).encode()
 
 
-@pytest.mark.parametrize("name", SCHEMA_NAMES)
+@pytest.mark.parametrize("name", schemas.SCHEMA_NAMES)
 def test_a_reader_accepts_any_2_x(name: str) -> None:
-    assert check_schema_version(name, schema_bytes(name)) == (2, 0)
-    assert check_schema_version(name, _with_version(name, "2.7")) == (2, 7)
+    assert schemas.check_schema_version(name, schemas.schema_bytes(name)) == (2, 0)
+    assert schemas.check_schema_version(name, _with_version(name, "2.7")) == (2, 7)
 
 
 def test_a_reader_refuses_another_major_version_or_a_foreign_schema() -> None:
     for other in ("1.0", "3.0"):
         with pytest.raises(
-            RecordFormatError,
+            records.RecordFormatError,
             match=rf"rsstp.Step: schema version {other} is not supported .*re-record",
         ):
-            check_schema_version("rsstp.Step", _with_version("rsstp.Step", other))
+            schemas.check_schema_version("rsstp.Step", _with_version("rsstp.Step", other))
     with pytest.raises(
-        RecordFormatError, match=r"title: expected 'rsstp.Step', found 'rsstp.Model'"
+        records.RecordFormatError, match=r"title: expected 'rsstp.Step', found 'rsstp.Model'"
     ):
-        check_schema_version("rsstp.Step", schema_bytes("rsstp.Model"))
-    with pytest.raises(RecordFormatError, match=r"rsstp.Step: the schema is not JSON"):
-        check_schema_version("rsstp.Step", b"{")
-    no_version = schema_json("rsstp.Step")
+        schemas.check_schema_version("rsstp.Step", schemas.schema_bytes("rsstp.Model"))
+    with pytest.raises(records.RecordFormatError, match=r"rsstp.Step: the schema is not JSON"):
+        schemas.check_schema_version("rsstp.Step", b"{")
+    no_version = schemas.schema_json("rsstp.Step")
     del no_version["version"]
-    with pytest.raises(RecordFormatError, match=r"rsstp.Step: schema version: .* found None"):
-        check_schema_version("rsstp.Step", json.dumps(no_version).encode())
+    with pytest.raises(
+        records.RecordFormatError, match=r"rsstp.Step: schema version: .* found None"
+    ):
+        schemas.check_schema_version("rsstp.Step", json.dumps(no_version).encode())
 
 
 def test_unknown_schema_names_are_refused() -> None:
-    with pytest.raises(RecordFormatError, match=r"unknown schema 'rsstp.Pose'"):
-        schema_bytes("rsstp.Pose")
-    with pytest.raises(RecordFormatError, match=r"unknown schema 'rsstp.Pose'"):
-        decode("rsstp.Pose", b"{}")
+    with pytest.raises(records.RecordFormatError, match=r"unknown schema 'rsstp.Pose'"):
+        schemas.schema_bytes("rsstp.Pose")
+    with pytest.raises(records.RecordFormatError, match=r"unknown schema 'rsstp.Pose'"):
+        records.decode("rsstp.Pose", b"{}")
 
 
 # ------------------------------------------------------------- a corpus of real messages
@@ -222,10 +189,10 @@ def test_unknown_schema_names_are_refused() -> None:
 @dataclasses.dataclass
 class Corpus:
     scenario: str
-    messages: list[MessageRecord]
-    models: list[tuple[ModelRecord, TransitionSystem]]  # with the model as it was
+    messages: list[records.MessageRecord]
+    models: list[tuple[records.ModelRecord, TransitionSystem]]  # with the model as it was
 
-    def of(self, cls: type[MessageRecord]) -> list[Any]:
+    def of(self, cls: type[records.MessageRecord]) -> list[Any]:
         return [m for m in self.messages if isinstance(m, cls)]
 
 
@@ -243,19 +210,19 @@ def _edit_by_hand(model: TransitionSystem, actions: Sequence[int]) -> None:
 def record_run(name: str) -> Corpus:
     """Run RandomStrategy for STEPS steps, recording as a recorder would (in memory)."""
     pending: list[Event] = []
-    messages: list[MessageRecord] = []
-    models: list[tuple[ModelRecord, TransitionSystem]] = []
+    messages: list[records.MessageRecord] = []
+    models: list[tuple[records.ModelRecord, TransitionSystem]] = []
     runner: Runner | None = None
 
     def on_model_change(step: int, operations: Sequence[Any]) -> None:
         assert runner is not None
-        record = model_record(runner.model, step=step, operations=operations)
+        record = builders.model_record(runner.model, step=step, operations=operations)
         report = runner.model.determinism_report()
         assert record.nondeterministic_pairs == len(report.nondeterministic)
         assert record.deterministic == runner.model.is_deterministic()
         models.append((record, runner.model.copy()))
         messages.append(record)
-        messages.extend(operation_events(step, operations))
+        messages.extend(builders.operation_events(step, operations))
 
     scenario = load_scenario(name)
     runner = Runner(
@@ -263,7 +230,7 @@ def record_run(name: str) -> Corpus:
     )
     messages.insert(
         0,
-        scenario_record(
+        builders.scenario_record(
             scenario,
             seed=1,
             strategy_name="random",
@@ -271,45 +238,39 @@ def record_run(name: str) -> Corpus:
             strategy_origin=strategy_origin(RandomStrategy()),
         ),
     )
-    first = model_record(runner.model, step=0, operations=())
+    first = builders.model_record(runner.model, step=0, operations=())
     models.insert(0, (first, runner.model.copy()))
     messages.append(first)
     world, model = runner.world, runner.model
-    messages.append(
-        step_record(
-            0,
+
+    def step_message(out: StepOutcome | None) -> records.StepRecord:
+        """The step record after ``out`` (None: the reset), as the recorder builds it."""
+        return builders.step_record(
+            0 if out is None else out.step,
             world.current,
-            action=None,
-            state_before=None,
-            internal_state=model.current,
+            action=None if out is None else out.action,
+            state_before=None if out is None else out.state_before,
+            internal_state=model.current if out is None else out.state_after,
             model_version=model.version,
-            no_transition=False,
-            blocker=None,
+            no_transition=out is not None and out.no_transition,
+            blocker=None if out is None else out.blocker,
         )
-    )
+
+    messages.append(step_message(None))
     for _ in range(STEPS):
         if runner.step_index == HAND_EDIT_AT:
             _edit_by_hand(model, scenario.actions)
             runner.agent.note("the model was edited by hand\nbefore this step")
         out = runner.step()
-        messages.append(
-            step_record(
-                out.step,
-                world.current,
-                action=out.action,
-                state_before=out.state_before,
-                internal_state=out.state_after,
-                model_version=model.version,
-                no_transition=out.no_transition,
-                blocker=out.blocker,
-            )
-        )
+        messages.append(step_message(out))
         if out.blocker is not None:
-            messages.append(blocked_event(out.step, action=out.action, blocker=out.blocker))
+            messages.append(
+                builders.blocked_event(out.step, action=out.action, blocker=out.blocker)
+            )
         for event in pending:
-            messages.append(event_record(event, state=out.state_before, action=out.action))
+            messages.append(builders.event_record(event, state=out.state_before, action=out.action))
         pending.clear()
-    messages.append(contradiction_event(STEPS, state=0, i=3, j=17, actions=[1, 0]))
+    messages.append(builders.contradiction_event(STEPS, state=0, i=3, j=17, actions=[1, 0]))
     return Corpus(name, messages, models)
 
 
@@ -318,22 +279,22 @@ def corpus(request: pytest.FixtureRequest) -> Corpus:
     return record_run(request.param)
 
 
-def _round_trip(record: MessageRecord) -> None:
+def _round_trip(record: records.MessageRecord) -> None:
     name = record.schema_name
     data = record.to_json()
-    schema = schema_json(name)
+    schema = schemas.schema_json(name)
     assert list(data) == [key for key in schema["properties"] if key in data]
     assert set(schema["required"]) <= set(data)
-    validate(name, data)
+    schemas.validate(name, data)
     again = type(record).from_json(data)
     assert again == record
-    payload = encode(record)
-    assert encode(again) == payload
+    payload = records.encode(record)
+    assert records.encode(again) == payload
     assert json.loads(payload) == data == orjson.loads(payload)
     assert msgspec.json.encode(data) == payload
-    decoded = decode(name, payload)
+    decoded = records.decode(name, payload)
     assert decoded == record
-    assert encode(decoded) == payload
+    assert records.encode(decoded) == payload
 
 
 def test_every_message_round_trips(corpus: Corpus) -> None:
@@ -342,10 +303,10 @@ def test_every_message_round_trips(corpus: Corpus) -> None:
 
 
 def test_the_corpus_has_every_kind_of_message(corpus: Corpus) -> None:
-    kinds = {event.kind for event in corpus.of(EventRecord)}
+    kinds = {event.kind for event in corpus.of(records.EventRecord)}
     expected = {"split", "merge", "add", "delete", "note", "no_transition", "contradiction"}
     assert expected <= kinds
-    steps = corpus.of(StepRecord)
+    steps = corpus.of(records.StepRecord)
     assert [s.step for s in steps] == list(range(STEPS + 1))
     assert any(s.agent.no_transition for s in steps)
     assert not corpus.models[-1][0].deterministic
@@ -357,17 +318,17 @@ def test_the_corpus_has_every_kind_of_message(corpus: Corpus) -> None:
 def test_step_records_carry_the_pose_and_the_outcome(corpus: Corpus) -> None:
     scenario = load_scenario(corpus.scenario)
     n, m = scenario.n_joints, len(scenario.obstacles)
-    for step in corpus.of(StepRecord):
+    for step in corpus.of(records.StepRecord):
         truth, agent = step.truth, step.agent
         assert len(truth.angles_deg) == n
         assert len(truth.joint_positions) == n + 1
-        assert truth.joint_positions[0] == PointRecord(x=0.0, y=0.0)
+        assert truth.joint_positions[0] == records.PointRecord(x=0.0, y=0.0)
         assert len(truth.distances) == n
         assert all(len(tip.obstacles) == m for tip in truth.distances)
         assert truth.blocked == (truth.blocked_by is not None)
         assert (agent.action is None) == (agent.state_before is None) == (step.step == 0)
         assert agent.sensation == (agent.feedback == 1.0) or not agent.sensation
-    scenario_message = corpus.of(ScenarioRecord)[0]
+    scenario_message = corpus.of(records.ScenarioRecord)[0]
     assert scenario_message.n_joints == n and scenario_message.origin == corpus.scenario
     assert scenario_message.sha256 == scenario.sha256
     strategy = scenario_message.strategy
@@ -393,7 +354,7 @@ def test_the_model_is_rebuilt_from_the_model_messages(corpus: Corpus) -> None:
 def test_ground_truth_floats_survive_json_exactly(corpus: Corpus) -> None:
     floats = [
         value
-        for step in corpus.of(StepRecord)
+        for step in corpus.of(records.StepRecord)
         for value in (
             step.agent.feedback,
             *(c for point in step.truth.joint_positions for c in (point.x, point.y)),
@@ -401,14 +362,14 @@ def test_ground_truth_floats_survive_json_exactly(corpus: Corpus) -> None:
         )
     ]
     bits = [struct.pack("<d", v) for v in floats]
-    for text in (encode, orjson.dumps, lambda v: json.dumps(v).encode()):
+    for text in (records.encode, orjson.dumps, lambda v: json.dumps(v).encode()):
         for load in (json.loads, orjson.loads):
             assert [struct.pack("<d", load(text(v))) for v in floats] == bits
 
 
 def test_the_same_run_gives_the_same_bytes() -> None:
     one, two = record_run("three-joint"), record_run("three-joint")
-    assert [encode(m) for m in one.messages] == [encode(m) for m in two.messages]
+    assert [records.encode(m) for m in one.messages] == [records.encode(m) for m in two.messages]
 
 
 def test_origin_is_the_file_base_name_never_a_directory(tmp_path: Path, corpus: Corpus) -> None:
@@ -417,7 +378,7 @@ def test_origin_is_the_file_base_name_never_a_directory(tmp_path: Path, corpus: 
     path = tmp_path / "deep" / "my arm.toml"
     path.parent.mkdir()
     path.write_text(text, encoding="utf-8")
-    record = scenario_record(
+    record = builders.scenario_record(
         load_scenario(path),
         seed=3,
         strategy_name="random",
@@ -425,7 +386,7 @@ def test_origin_is_the_file_base_name_never_a_directory(tmp_path: Path, corpus: 
         strategy_origin=strategy_origin(RandomStrategy()),
     )
     assert record.origin == "my arm.toml"
-    assert str(tmp_path) not in encode(record).decode()
+    assert str(tmp_path) not in records.encode(record).decode()
     assert record.sha256 == hashlib.sha256(text.encode()).hexdigest()
 
 
@@ -442,17 +403,17 @@ def _sample(name: str) -> dict[str, Any]:
     for record in _three_joint().messages:
         if record.schema_name != name:
             continue
-        if isinstance(record, StepRecord) and record.truth.blocked_by is None:
+        if isinstance(record, records.StepRecord) and record.truth.blocked_by is None:
             continue
-        if isinstance(record, EventRecord) and record.kind != "blocked":
+        if isinstance(record, records.EventRecord) and record.kind != "blocked":
             continue
-        if isinstance(record, ModelRecord) and not record.operations:
+        if isinstance(record, records.ModelRecord) and not record.operations:
             continue
         return record.to_json()
     raise AssertionError(f"no sample of {name}")
 
 
-SAMPLES = {name: _sample(name) for name in SCHEMA_NAMES}
+SAMPLES = {name: _sample(name) for name in schemas.SCHEMA_NAMES}
 
 
 def _required_paths(
@@ -473,8 +434,8 @@ def _dotted(path: Sequence[Any]) -> str:
 
 MISSING_CASES = [
     (name, path)
-    for name in SCHEMA_NAMES
-    for path in _required_paths(SAMPLES[name], schema_json(name), ())
+    for name in schemas.SCHEMA_NAMES
+    for path in _required_paths(SAMPLES[name], schemas.schema_json(name), ())
 ]
 
 
@@ -487,14 +448,14 @@ def test_a_missing_field_fails_validation_and_from_json(name: str, path: tuple[A
     for key in path[:-1]:
         parent = parent[key]
     del parent[path[-1]]
-    with pytest.raises(RecordFormatError, match=f"^{name}: .*'{path[-1]}' is a required"):
-        validate(name, data)
+    with pytest.raises(records.RecordFormatError, match=f"^{name}: .*'{path[-1]}' is a required"):
+        schemas.validate(name, data)
     expected = f"{name}: {_dotted(path)}: missing"
-    with pytest.raises(RecordFormatError) as raised:
-        RECORD_TYPES[name].from_json(data)
+    with pytest.raises(records.RecordFormatError) as raised:
+        records.RECORD_TYPES[name].from_json(data)
     assert str(raised.value).startswith(expected)
-    with pytest.raises(RecordFormatError, match=f"^{re.escape(expected)}"):
-        decode(name, orjson.dumps(data))
+    with pytest.raises(records.RecordFormatError, match=f"^{re.escape(expected)}"):
+        records.decode(name, orjson.dumps(data))
 
 
 @pytest.mark.parametrize(
@@ -546,12 +507,12 @@ def test_a_mistyped_field_is_refused_with_its_path(
     for key in path[:-1]:
         parent = parent[key]
     parent[path[-1]] = value
-    with pytest.raises(RecordFormatError, match=f"^{name}: {message}"):
-        RECORD_TYPES[name].from_json(data)
-    with pytest.raises(RecordFormatError, match=f"^{name}: {message}"):
-        decode(name, orjson.dumps(data))
-    with pytest.raises(RecordFormatError, match=f"^{name}: "):
-        validate(name, data)
+    with pytest.raises(records.RecordFormatError, match=f"^{name}: {message}"):
+        records.RECORD_TYPES[name].from_json(data)
+    with pytest.raises(records.RecordFormatError, match=f"^{name}: {message}"):
+        records.decode(name, orjson.dumps(data))
+    with pytest.raises(records.RecordFormatError, match=f"^{name}: "):
+        schemas.validate(name, data)
 
 
 @pytest.mark.parametrize(
@@ -569,36 +530,46 @@ def test_a_mistyped_field_is_refused_with_its_path(
 )
 def test_event_data_is_checked_by_kind(kind: str, data: dict[str, Any], message: str) -> None:
     event = {"step": 4, "kind": kind, "text": "t", "data": data}
-    with pytest.raises(RecordFormatError, match=f"^rsstp.Event: {message}"):
-        EventRecord.from_json(event)
-    with pytest.raises(RecordFormatError, match=r"^rsstp.Event: data[.:\[]"):
-        validate("rsstp.Event", event)
+    with pytest.raises(records.RecordFormatError, match=f"^rsstp.Event: {message}"):
+        records.EventRecord.from_json(event)
+    with pytest.raises(records.RecordFormatError, match=r"^rsstp.Event: data[.:\[]"):
+        schemas.validate("rsstp.Event", event)
 
 
-@pytest.mark.parametrize("name", SCHEMA_NAMES)
+@pytest.mark.parametrize("name", schemas.SCHEMA_NAMES)
 def test_unknown_fields_are_ignored(name: str) -> None:
     data = copy.deepcopy(SAMPLES[name])
-    expected = RECORD_TYPES[name].from_json(data)
+    expected = records.RECORD_TYPES[name].from_json(data)
     data["added_in_2_1"] = {"anything": [1, 2]}
     for key, value in data.items():
         if isinstance(value, dict) and key != "data":  # an event's data keeps every key
             value["also_new"] = None
-    validate(name, data)
-    assert RECORD_TYPES[name].from_json(data) == expected
-    assert decode(name, orjson.dumps(data)) == expected
+    schemas.validate(name, data)
+    assert records.RECORD_TYPES[name].from_json(data) == expected
+    assert records.decode(name, orjson.dumps(data)) == expected
 
 
 def test_bad_bytes_and_bad_shapes_are_refused() -> None:
-    with pytest.raises(RecordFormatError, match=r"^rsstp.Step: invalid JSON: "):
-        decode("rsstp.Step", encode(StepRecord.from_json(SAMPLES["rsstp.Step"]))[:-3])
-    with pytest.raises(RecordFormatError, match=r"^rsstp.Step: expected `object`, got `array`"):
-        decode("rsstp.Step", b"[1, 2]")
-    with pytest.raises(RecordFormatError, match=r"^rsstp.Model: expected `object`, got `str`"):
-        ModelRecord.from_json("model")  # type: ignore[arg-type]
-    with pytest.raises(RecordFormatError, match=r"^AgentRecord: feedback: expected `float`"):
-        AgentRecord.from_json({**SAMPLES["rsstp.Step"]["agent"], "feedback": "high"})
-    with pytest.raises(RecordFormatError, match=r"^rsstp.Step: agent.feedback: .* less than"):
-        validate(
+    with pytest.raises(records.RecordFormatError, match=r"^rsstp.Step: invalid JSON: "):
+        records.decode(
+            "rsstp.Step", records.encode(records.StepRecord.from_json(SAMPLES["rsstp.Step"]))[:-3]
+        )
+    with pytest.raises(
+        records.RecordFormatError, match=r"^rsstp.Step: expected `object`, got `array`"
+    ):
+        records.decode("rsstp.Step", b"[1, 2]")
+    with pytest.raises(
+        records.RecordFormatError, match=r"^rsstp.Model: expected `object`, got `str`"
+    ):
+        records.ModelRecord.from_json("model")  # type: ignore[arg-type]
+    with pytest.raises(
+        records.RecordFormatError, match=r"^AgentRecord: feedback: expected `float`"
+    ):
+        records.AgentRecord.from_json({**SAMPLES["rsstp.Step"]["agent"], "feedback": "high"})
+    with pytest.raises(
+        records.RecordFormatError, match=r"^rsstp.Step: agent.feedback: .* less than"
+    ):
+        schemas.validate(
             "rsstp.Step",
             {
                 **SAMPLES["rsstp.Step"],
@@ -609,18 +580,24 @@ def test_bad_bytes_and_bad_shapes_are_refused() -> None:
 
 def test_builders_refuse_what_cannot_be_recorded() -> None:
     scenario = load_scenario("three-joint")
-    with pytest.raises(RecordFormatError, match=r"^rsstp.Scenario: strategy.params: expected"):
-        scenario_record(
+    with pytest.raises(
+        records.RecordFormatError, match=r"^rsstp.Scenario: strategy.params: expected"
+    ):
+        builders.scenario_record(
             scenario,
             seed=0,
             strategy_name="x",
             strategy_params={"f": object()},
             strategy_origin=strategy_origin(RandomStrategy()),
         )
-    with pytest.raises(RecordFormatError, match=r"no_transition event needs state and action"):
-        event_record(Event(3, "no_transition", "no transition"))
-    assert note_event(2, "two\nlines").text == "two lines"
-    assert contradiction_event(5, state=1, i=0, j=2, actions=[3], text="a\r\nb").text == "a b"
+    with pytest.raises(
+        records.RecordFormatError, match=r"no_transition event needs state and action"
+    ):
+        builders.event_record(Event(3, "no_transition", "no transition"))
+    assert builders.note_event(2, "two\nlines").text == "two lines"
+    assert (
+        builders.contradiction_event(5, state=1, i=0, j=2, actions=[3], text="a\r\nb").text == "a b"
+    )
 
 
 def test_docstring_examples_run() -> None:
@@ -636,7 +613,7 @@ ids = st.integers(min_value=0, max_value=2**40)
 
 
 @st.composite
-def step_records(draw: st.DrawFn) -> StepRecord:
+def step_records(draw: st.DrawFn) -> records.StepRecord:
     n = draw(st.integers(min_value=1, max_value=4))
     m = draw(st.integers(min_value=0, max_value=3))
     step = draw(st.integers(min_value=0, max_value=10**9))
@@ -647,13 +624,13 @@ def step_records(draw: st.DrawFn) -> StepRecord:
         else draw(
             st.none()
             | st.builds(
-                BlockedByRecord,
+                records.BlockedByRecord,
                 kind=st.sampled_from(["fold", "obstacle", "links"]),
                 indices=st.lists(st.integers(0, 50), min_size=1, max_size=2).map(tuple),
             )
         )
     )
-    agent = AgentRecord(
+    agent = records.AgentRecord(
         action=None if first else draw(st.integers(min_value=0, max_value=7)),
         state_before=None if first else draw(ids),
         internal_state=draw(ids),
@@ -663,27 +640,27 @@ def step_records(draw: st.DrawFn) -> StepRecord:
         no_transition=False if first else draw(st.booleans()),
     )
     points = draw(st.lists(st.tuples(finite, finite), min_size=n + 1, max_size=n + 1))
-    truth = TruthRecord(
+    truth = records.TruthRecord(
         angles_deg=tuple(draw(st.lists(st.integers(0, 359), min_size=n, max_size=n))),
-        joint_positions=tuple(PointRecord(x=x, y=y) for x, y in points),
+        joint_positions=tuple(records.PointRecord(x=x, y=y) for x, y in points),
         blocked=blocker is not None,
         blocked_by=blocker,
         distances=tuple(
-            DistancesRecord(obstacles=tuple(draw(st.lists(finite, min_size=m, max_size=m))))
+            records.DistancesRecord(obstacles=tuple(draw(st.lists(finite, min_size=m, max_size=m))))
             for _ in range(n)
         ),
     )
-    return StepRecord(step=step, agent=agent, truth=truth)
+    return records.StepRecord(step=step, agent=agent, truth=truth)
 
 
 @settings(max_examples=300, deadline=None)
 @given(step_records())
-def test_random_step_records_round_trip(record: StepRecord) -> None:
+def test_random_step_records_round_trip(record: records.StepRecord) -> None:
     _round_trip(record)
-    payload = encode(record)
-    assert StepRecord.from_json(json.loads(payload)) == record
+    payload = records.encode(record)
+    assert records.StepRecord.from_json(json.loads(payload)) == record
     floats = [c for p in record.truth.joint_positions for c in (p.x, p.y)]
-    decoded = decode("rsstp.Step", payload)
-    assert isinstance(decoded, StepRecord)
+    decoded = records.decode("rsstp.Step", payload)
+    assert isinstance(decoded, records.StepRecord)
     back = [c for p in decoded.truth.joint_positions for c in (p.x, p.y)]
     assert [struct.pack("<d", v) for v in back] == [struct.pack("<d", v) for v in floats]

@@ -63,17 +63,6 @@ def start(scenario: str, strategy: Strategy, *, seed: int = 0) -> Run:
     return Run(runner, ops, notes)
 
 
-def prefix(memory: Memory, step: int) -> Memory:
-    """The memory as it was right after ``step``."""
-    end = step + 1
-    return Memory.from_arrays(
-        memory.actions[:end],
-        memory.internal_states[:end],
-        memory.sensations[:end],
-        memory.feedback[:end],
-    )
-
-
 def replay_follows_model(run: Run) -> None:
     """Every memory entry's internal state is a successor, in the model of that moment, of the
     previous entry's state by the entry's action (the model rebuilt from the op log)."""
@@ -147,7 +136,7 @@ def test_roulette_splits_are_justified_by_the_memory() -> None:
         pair = note.text.split("compare(", 1)[1].split(")", 1)[0]
         t, earlier = (int(x) for x in pair.split(", "))
         assert earlier == t - 1 and t <= note.step
-        result = prefix(memory, note.step).compare(t, earlier)
+        result = memory.until(note.step).compare(t, earlier)
         assert result.kind is CompareKind.DIFFERENT_SENSATION
     replay_follows_model(run)
 

@@ -23,7 +23,7 @@ with numpy (no per-step Python), and reports each broken rule once, at its first
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Protocol
 
@@ -129,18 +129,15 @@ def check_contract(source: ContractSource) -> ContractFindings:
 
     index = version_index(versions, step)
     in_force = np.where(index >= 0, numbers[np.maximum(index, 0)], -1)
-    wrong = np.flatnonzero(named != in_force)
-    if len(wrong):
-        t = int(wrong[0])
-        found.append(
-            Violation(
-                "model-version",
-                int(step[t]),
-                len(wrong),
-                f"step {step[t]} names model version {named[t]}, but the version in force is "
-                f"{in_force[t]}",
-            )
-        )
+    found += _first_of(
+        "model-version",
+        np.flatnonzero(named != in_force),
+        step,
+        lambda t: (
+            f"step {step[t]} names model version {named[t]}, but the version in force "
+            f"is {in_force[t]}"
+        ),
+    )
 
     sizes = np.fromiter((len(record.states) for record in versions), np.int64, len(versions))
     members = np.fromiter(
@@ -150,50 +147,44 @@ def check_contract(source: ContractSource) -> ContractFindings:
     keys = np.sort(np.repeat(np.arange(len(versions), dtype=np.int64), sizes) * base + members)
     wanted = np.maximum(index, 0) * base + state
     where = np.minimum(np.searchsorted(keys, wanted), max(len(keys) - 1, 0))
-    outside = np.flatnonzero((index < 0) | (state < 0) | (keys[where] != wanted))
-    if len(outside):
-        t = int(outside[0])
-        found.append(
-            Violation(
-                "state-in-model",
-                int(step[t]),
-                len(outside),
-                f"step {step[t]} is in internal state {state[t]}, which is not a state of model "
-                f"version {in_force[t]}",
-            )
-        )
+    found += _first_of(
+        "state-in-model",
+        np.flatnonzero((index < 0) | (state < 0) | (keys[where] != wanted)),
+        step,
+        lambda t: (
+            f"step {step[t]} is in internal state {state[t]}, which is not a state of "
+            f"model version {in_force[t]}"
+        ),
+    )
 
-    broken = np.flatnonzero(before[1:] != state[:-1]) + 1
-    if len(broken):
-        t = int(broken[0])
-        found.append(
-            Violation(
-                "state-chain",
-                int(step[t]),
-                len(broken),
-                f"step {step[t]} starts in state {before[t]}, but step {step[t - 1]} ended in "
-                f"state {state[t - 1]}",
-            )
-        )
-    found += _log_times(step, source.step_log_times())
+    found += _first_of(
+        "state-chain",
+        np.flatnonzero(before[1:] != state[:-1]) + 1,
+        step,
+        lambda t: (
+            f"step {step[t]} starts in state {before[t]}, but step {step[t - 1]} ended "
+            f"in state {state[t - 1]}"
+        ),
+    )
+    log_time = source.step_log_times()
+    found += _first_of(
+        "log-time",
+        np.flatnonzero(log_time != step * STEP_NS),
+        step,
+        lambda t: f"step {step[t]} is logged at {log_time[t]:,} ns, not {step[t] * STEP_NS:,}",
+    )
     found += _event_steps(source.events(), int(step[-1]) if len(step) else 0)
     found.sort(key=lambda v: v.step)
     return ContractFindings(int(step[-1]) if len(step) else 0, tuple(found))
 
 
-def _log_times(step: _Ints, log_time: _Ints) -> list[Violation]:
-    off = np.flatnonzero(log_time != step * STEP_NS)
-    if not len(off):
+def _first_of(rule: str, bad: _Ints, step: _Ints, text: Callable[[int], str]) -> list[Violation]:
+    """One violation of ``rule`` for the steps at the rows ``bad``: the first, described by
+    ``text(row)``, and how many there are."""
+    if not len(bad):
         return []
-    t = int(off[0])
-    return [
-        Violation(
-            "log-time",
-            int(step[t]),
-            len(off),
-            f"step {step[t]} is logged at {log_time[t]:,} ns, not {step[t] * STEP_NS:,}",
-        )
-    ]
+    t = int(bad[0])
+    return [Violation(rule, int(step[t]), len(bad), text(t))]
 
 
 def _event_steps(events: pd.DataFrame, last_step: int) -> list[Violation]:

@@ -166,14 +166,6 @@ class TruthFindings:
         return self.verdict.learned_at_step
 
     @property
-    def final_equivalent(self) -> bool:
-        return self.verdict.learned
-
-    @property
-    def final_model_states(self) -> int:
-        return self.verdict.final_states
-
-    @property
     def counterexample(self) -> Counterexample | None:
         return self.verdict.counterexample
 
@@ -258,8 +250,8 @@ class TruthFindings:
             "reachable_poses": self.reachable_poses,
             "minimal_states": self.minimal_states,
             "steps": self.steps,
-            "final_model_states": self.final_model_states,
-            "final_equivalent": self.final_equivalent,
+            "final_model_states": self.verdict.final_states,
+            "final_equivalent": self.verdict.learned,
             "final_version": {
                 "aliased_states": {str(s): list(c) for s, c in sorted(self.final_aliased.items())},
                 "redundant_classes": {
