@@ -12,10 +12,13 @@ import shutil
 import subprocess
 import warnings
 from collections.abc import Iterable, Sequence
+from itertools import chain
+
+import numpy as np
 
 from rsstp_replay.errors import ViewerWarning
 from rsstp_sim.graph import plain_positions, run_graphviz
-from rsstp_sim.recording.records import ModelRecord, TransitionRecord
+from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem, snapshot_form
 
 __all__ = [
@@ -33,17 +36,23 @@ def union_model(
     ``extra_states``): the one graph whose layout fixes every node's place."""
     states: set[int] = set(extra_states)
     actions: set[int] = set()
-    transitions: set[TransitionRecord] = set()
     for record in versions:
         states.update(record.states)
         actions.update(record.actions)
-        transitions.update(record.transitions)
+    columns = [
+        np.fromiter(chain.from_iterable(getattr(r.transitions, name) for r in versions), np.int64)
+        for name in ("source", "action", "target")
+    ]
+    # Every version's transitions at once, as one int64 key each: the distinct ones, sorted.
+    base = int(max((c.max(initial=0) for c in columns), default=0)) + 1
+    keys = np.unique((columns[0] * base + columns[1]) * base + columns[2])
+    transitions = np.stack([keys // (base * base), keys // base % base, keys % base], axis=1)
     if not states:
         states.add(0)
     ordered = sorted(states)
-    every_action = sorted(actions | {t.action for t in transitions})
+    every_action = sorted(actions | set(transitions[:, 1].tolist()))
     return TransitionSystem.from_snapshot(
-        snapshot_form(ordered, ordered[-1] + 1, ordered[0], every_action, sorted(transitions))
+        snapshot_form(ordered, ordered[-1] + 1, ordered[0], every_action, transitions.tolist())
     )
 
 

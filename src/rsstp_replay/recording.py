@@ -47,7 +47,7 @@ from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
-from rsstp_sim.recording.records import EventRecord, ModelRecord, TransitionRecord
+from rsstp_sim.recording.records import EventRecord, ModelRecord, TransitionsRecord
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, compute_truth
@@ -281,7 +281,7 @@ class Recording:
                 one_state = TransitionSystem.universal(self.scenario_record.actions)
                 self._models = (model_record(one_state, step=0, operations=()),)
                 return self._models
-            models = self._records("/rsstp/model", keep=_SharedTransitions())
+            models = self._records("/rsstp/model", keep=_SharedIds())
             verify_chain(self.path, models)
             self._models = tuple(models)
         return self._models
@@ -433,19 +433,27 @@ class Recording:
         raise CorruptRecording(f"{self.path}: the message of step {step} is missing")
 
 
-class _SharedTransitions:
-    """A model record with one object per distinct ``(source, action, target)`` triple across
-    every record it was given: consecutive snapshots repeat most of their transitions, and a
-    run of the splitter with 1,695 versions holds 3.8 million triples of a few thousand
-    distinct ones (300 MB as separate tuples, 30 MB shared)."""
+class _SharedIds:
+    """A model record whose transitions hold one int object per distinct state id across
+    every record it was given. Consecutive snapshots repeat most of their transitions (a run
+    of the splitter with 1,695 versions holds 4.7 million); CPython shares the ints up to 256
+    by itself, and this shares the larger ids, which would otherwise be an object (28 bytes)
+    per transition end."""
 
     def __init__(self) -> None:
-        self._shared: dict[TransitionRecord, TransitionRecord] = {}
+        self._shared: dict[int, int] = {}
 
     def __call__(self, record: ModelRecord) -> ModelRecord:
+        t = record.transitions
+        if not t.source or max(max(t.source), max(t.target)) <= 256:
+            return record
         keep = self._shared.setdefault
-        transitions = tuple(map(keep, record.transitions, record.transitions))
-        return msgspec.structs.replace(record, transitions=transitions)
+        shared = TransitionsRecord(
+            source=tuple(map(keep, t.source, t.source)),
+            action=t.action,
+            target=tuple(map(keep, t.target, t.target)),
+        )
+        return msgspec.structs.replace(record, transitions=shared)
 
 
 class _AgentRow(NamedTuple):

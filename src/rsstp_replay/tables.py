@@ -58,14 +58,12 @@ def model_table(source: _Models) -> pd.DataFrame:
     counts = np.fromiter((len(r.transitions) for r in versions), np.int64, n)
     rows = np.maximum(counts, 1)
     total = int(counts.sum())
-    triples = np.fromiter(
-        chain.from_iterable(chain.from_iterable(r.transitions for r in versions)),
-        np.int64,
-        3 * total,
-    ).reshape(total, 3)
     has = np.repeat(counts > 0, rows)
     values = np.full((int(rows.sum()), 3), -1, np.int64)
-    values[has] = triples
+    for k, name in enumerate(("source", "action", "target")):
+        values[has, k] = np.fromiter(
+            chain.from_iterable(getattr(r.transitions, name) for r in versions), np.int64, total
+        )
     columns: dict[str, Any] = {
         name: np.repeat(np.fromiter(map(get, versions), np.int64, n), rows)
         for name, get in (

@@ -294,7 +294,7 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
         changed = recording.model_versions()[2]
 
     def drop_transition(model: dict[str, Any]) -> None:
-        model["transitions"] = model["transitions"][1:]
+        model["transitions"] = {k: v[1:] for k, v in model["transitions"].items()}
         model["deterministic"], model["nondeterministic_pairs"] = _determinism(model)
 
     rewrite(
@@ -309,8 +309,8 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
 
 def _determinism(model: dict[str, Any]) -> tuple[bool, int]:
     pairs: dict[tuple[int, int], int] = {}
-    for transition in model["transitions"]:
-        pair = (transition["source"], transition["action"])
+    transitions = model["transitions"]
+    for pair in zip(transitions["source"], transitions["action"], strict=True):
         pairs[pair] = pairs.get(pair, 0) + 1
     count = sum(1 for n in pairs.values() if n > 1)
     return count == 0, count

@@ -483,9 +483,9 @@ def test_a_missing_field_fails_validation_and_from_json(name: str, path: tuple[A
         ),
         (
             "rsstp.Model",
-            ("transitions", 0),
-            [0, 1, 2],
-            r"transitions\[0\]: expected `object`, got `array`",
+            ("transitions", "target", 0),
+            "x",
+            r"transitions.target\[0\]: expected `int`, got `str`",
         ),
         ("rsstp.Model", ("operations", 0, "kind"), "swap", r"operations\[0\].kind: invalid enum"),
         ("rsstp.Scenario", ("feedback", "mode"), "int", r"feedback.mode: invalid enum value"),
@@ -513,6 +513,16 @@ def test_a_mistyped_field_is_refused_with_its_path(
         records.decode(name, orjson.dumps(data))
     with pytest.raises(records.RecordFormatError, match=f"^{name}: "):
         schemas.validate(name, data)
+
+
+def test_transitions_of_unequal_lengths_are_refused() -> None:
+    data = copy.deepcopy(SAMPLES["rsstp.Model"])
+    data["transitions"]["target"] = data["transitions"]["target"][:-1]
+    message = r"^rsstp.Model: transitions: source, action and target differ in length"
+    with pytest.raises(records.RecordFormatError, match=message):
+        records.ModelRecord.from_json(data)
+    with pytest.raises(records.RecordFormatError, match=message):
+        records.decode("rsstp.Model", orjson.dumps(data))
 
 
 @pytest.mark.parametrize(

@@ -31,7 +31,7 @@ from rsstp_sim.recording.records import (
     ScenarioRecord,
     StepRecord,
     StrategyRecord,
-    TransitionRecord,
+    TransitionsRecord,
     TruthRecord,
     encode_json,
 )
@@ -208,8 +208,10 @@ def model_record(
         next_id=int(model.next_id),
         current=int(model.current),
         actions=model.actions,
-        transitions=tuple(
-            TransitionRecord(source=s, action=a, target=t) for s, a, t in transitions
+        transitions=TransitionsRecord(
+            source=tuple(s for s, _, _ in transitions),
+            action=tuple(a for _, a, _ in transitions),
+            target=tuple(t for _, _, t in transitions),
         ),
         operations=tuple(operation_record(op) for op in operations),
         deterministic=pairs == 0,

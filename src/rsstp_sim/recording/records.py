@@ -3,9 +3,10 @@
 Each message schema (``rsstp.Scenario``, ``rsstp.Step``, ``rsstp.Model``, ``rsstp.Event``)
 has a record class, and each nested object of a schema has one too. Field names, order and
 types are those of the schema: JSON arrays are tuples, points are :class:`PointRecord`
-``{x, y}``, transitions are :class:`TransitionRecord` ``{source, action, target}``. A field the
-schema makes optional is ``None`` in Python and left out of the JSON (schema 2.0 writes no
-``null``: see ``schemas/README.md``); an event's ``data`` is a dict of the fields its kind has.
+``{x, y}``, a model's transitions a :class:`TransitionsRecord` of three parallel arrays. A
+field the schema makes optional is ``None`` in Python and left out of the JSON (schema 2.0
+writes no ``null``: see ``schemas/README.md``); an event's ``data`` is a dict of the fields
+its kind has.
 
 - ``record.to_json()`` gives the JSON-ready dict (keys in schema order, arrays as lists);
 - ``Record.from_json(data)`` reads one back, ignoring keys it does not know (a later 2.x may
@@ -31,7 +32,7 @@ b'{"internal_state":0,"sensation":false,"feedback":0.5,"model_version":0,"no_tra
 from __future__ import annotations
 
 import re
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from typing import Any, ClassVar, Literal, Self, TypeVar
 
 import msgspec
@@ -58,7 +59,7 @@ __all__ = [
     "ScenarioRecord",
     "StepRecord",
     "StrategyRecord",
-    "TransitionRecord",
+    "TransitionsRecord",
     "TruthRecord",
     "decode",
     "encode",
@@ -227,20 +228,30 @@ class StepRecord(_Record, frozen=True, kw_only=True):
 # ------------------------------------------------------------------- rsstp.Model
 
 
-class TransitionRecord(_Record, frozen=True, kw_only=True, order=True, gc=False):
-    """One transition ``source -action-> target`` (state ids and an action id). It unpacks
-    like the ``(source, action, target)`` triples of
-    :meth:`~rsstp_sim.transition_system.TransitionSystem.transitions`."""
+class TransitionsRecord(_Record, frozen=True, kw_only=True, gc=False):
+    """Every transition of a model as three parallel arrays, sorted by source, action and
+    target: transition ``i`` is ``source[i] -action[i]-> target[i]`` (state ids and action
+    ids). Parallel arrays keep a model message as compact as a list of triples, in a shape
+    every JSON-Schema viewer can address."""
 
-    source: int
-    action: int
-    target: int
+    source: tuple[int, ...]
+    action: tuple[int, ...]
+    target: tuple[int, ...]
 
-    def __iter__(self) -> Iterator[int]:
-        return iter((self.source, self.action, self.target))
+    def __len__(self) -> int:
+        return len(self.source)
 
-    def triple(self) -> tuple[int, int, int]:
-        return (self.source, self.action, self.target)
+    def triples(self) -> tuple[tuple[int, int, int], ...]:
+        """The ``(source, action, target)`` triples, as
+        :meth:`~rsstp_sim.transition_system.TransitionSystem.transitions` gives them."""
+        return tuple(zip(self.source, self.action, self.target, strict=True))
+
+    def _check(self) -> None:
+        if not len(self.source) == len(self.action) == len(self.target):
+            raise RecordFormatError(
+                f"transitions: source, action and target differ in length "
+                f"({len(self.source)}, {len(self.action)}, {len(self.target)})"
+            )
 
 
 class OperationRecord(_Record, frozen=True, kw_only=True):
@@ -269,20 +280,24 @@ class ModelRecord(_Record, frozen=True, kw_only=True):
     next_id: int
     current: int
     actions: tuple[int, ...]
-    transitions: tuple[TransitionRecord, ...]
+    transitions: TransitionsRecord
     operations: tuple[OperationRecord, ...]
     deterministic: bool
     nondeterministic_pairs: int
 
     def triples(self) -> tuple[tuple[int, int, int], ...]:
         """The transitions as ``(source, action, target)`` triples, sorted as written."""
-        return tuple(t.triple() for t in self.transitions)
+        return self.transitions.triples()
 
     def snapshot(self) -> dict[str, object]:
         """The model in :meth:`TransitionSystem.snapshot` form (for ``from_snapshot``)."""
-        return snapshot_form(
-            self.states, self.next_id, self.current, self.actions, self.transitions
-        )
+        return snapshot_form(self.states, self.next_id, self.current, self.actions, self.triples())
+
+    def _check(self) -> None:
+        try:
+            self.transitions._check()
+        except RecordFormatError as exc:
+            raise RecordFormatError(f"{self.schema_name}: {exc}") from None
 
 
 # ------------------------------------------------------------------- rsstp.Event
