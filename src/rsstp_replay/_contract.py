@@ -29,7 +29,7 @@ from rsstp_replay._chunks import log_times_at, messages_at, split_messages
 from rsstp_replay._container import ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
 from rsstp_sim.errors import ScenarioError
-from rsstp_sim.recording.records import RecordFormatError, ScenarioRecord, decode
+from rsstp_sim.recording.records import RecordFormatError, ScenarioRecord, decode, decode_many
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_NAME,
     MESSAGE_ENCODING,
@@ -77,6 +77,12 @@ class CheckedFile:
     def decode_one(self, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
         """The record of one message of ``topic``."""
         return _decode_one(self.container.path, topic, part, log_time, ref)
+
+    def decode_many(
+        self, topic: str, parts: list[memoryview], log_times: _Ints, ref: ChunkRef
+    ) -> list[Any]:
+        """The records of a chunk's messages of ``topic``, decoded at once."""
+        return _decode_many(self.container.path, topic, parts, log_times, ref)
 
 
 def check_file(container: Container) -> CheckedFile:
@@ -171,6 +177,18 @@ def _topic_chunks(
             times: dict[int, list[int]] = {channel: []}
             split_messages(path, data, parts, where=ref.offset, limit_ns=cut, times=times)
             yield ref, data, parts[channel], np.array(times[channel], np.int64)
+
+
+def _decode_many(
+    path: Path, topic: str, parts: list[memoryview], log_times: _Ints, ref: ChunkRef
+) -> list[Any]:
+    try:
+        return decode_many(TOPICS[topic], parts)
+    except (RecordFormatError, msgspec.DecodeError):
+        pass
+    for part, log_time in zip(parts, log_times, strict=True):  # which one, and why
+        _decode_one(path, topic, part, int(log_time), ref)
+    raise CorruptRecording(f"{path}: the {topic} messages of the chunk at byte {ref.offset}")
 
 
 def _decode_one(path: Path, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:

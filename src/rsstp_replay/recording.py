@@ -346,8 +346,8 @@ class Recording:
         decoded), checked against its log time."""
         found: list[Any] = []
         for ref, _, parts, times in self._chunks(topic):
-            for part, log_time in zip(parts, times, strict=True):
-                record = self._file.decode_one(topic, part, log_time, ref)
+            records = self._file.decode_many(topic, parts, times, ref)
+            for record, log_time in zip(records, times, strict=True):
                 assert isinstance(record, EventRecord | ModelRecord)
                 if record.step * STEP_NS != log_time:
                     raise CorruptRecording(

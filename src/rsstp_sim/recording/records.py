@@ -32,7 +32,7 @@ b'{"internal_state":0,"sensation":false,"feedback":0.5,"model_version":0,"no_tra
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any, ClassVar, Literal, Self, TypeVar
 
 import msgspec
@@ -62,6 +62,7 @@ __all__ = [
     "TransitionsRecord",
     "TruthRecord",
     "decode",
+    "decode_many",
     "encode",
 ]
 
@@ -339,6 +340,7 @@ RECORD_TYPES: dict[str, type[MessageRecord]] = {
 """Schema name -> record class."""
 
 _DECODERS = {name: msgspec.json.Decoder(cls) for name, cls in RECORD_TYPES.items()}
+_MANY = {name: msgspec.json.Decoder(list[cls]) for name, cls in RECORD_TYPES.items()}  # type: ignore[valid-type]
 
 
 # ----------------------------------------------------------------------- bytes
@@ -372,6 +374,25 @@ def decode(schema_name: str, data: bytes) -> MessageRecord:
         raise RecordFormatError(f"{schema_name}: invalid JSON: {exc}") from None
     record._check()
     return record
+
+
+def decode_many(schema_name: str, parts: Sequence[bytes | memoryview]) -> list[MessageRecord]:
+    """:func:`decode` of many messages of one schema at once (one parser call for them all:
+    a chunk's events, say). A bad message raises what :func:`decode` of it raises."""
+    decoder = _MANY.get(schema_name)
+    if decoder is None:
+        raise RecordFormatError(
+            f"unknown schema {schema_name!r} (known: {', '.join(RECORD_TYPES)})"
+        )
+    try:
+        found: list[MessageRecord] = decoder.decode(b"[" + b",".join(parts) + b"]")
+    except msgspec.DecodeError:
+        found = []
+    if len(found) != len(parts):  # the culprit, one message at a time
+        return [decode(schema_name, bytes(part)) for part in parts]
+    for record in found:
+        record._check()
+    return found
 
 
 # ------------------------------------------------------------- msgspec plumbing
