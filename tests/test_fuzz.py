@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 
 from fuzzing import (
     Mutation,
@@ -39,8 +39,18 @@ def reference(tmp_path_factory: pytest.TempPathFactory) -> Written:
     return splitter_run(tmp_path_factory.mktemp("fuzz"))
 
 
+# Found by bench/fuzz.py (2026-11-25): an attachment record whose data length no read() can
+# take (OverflowError) ended in a traceback.
+_HUGE_ATTACHMENT = [
+    Mutation(kind="truncate", where=0.3127605217994334, size=414, data=b"d\x83\xc4y"),
+    Mutation(kind="overwrite", where=0.6314287784805704, size=190, data=b"["),
+    Mutation(kind="flip", where=0.02339802904654054, size=4095, data=b"5\xc1"),
+]
+
+
 @SHORT
 @given(mutations=recording_mutations())
+@example(mutations=_HUGE_ATTACHMENT)
 def test_damage_to_a_recording_never_returns_what_was_not_written(
     mutations: list[Mutation], reference: Written, tmp_path: Path
 ) -> None:

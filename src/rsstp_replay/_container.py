@@ -34,7 +34,15 @@ __all__ = ["ChunkRef", "Container", "open_container"]
 
 MAGIC = b"\x89MCAP0\r\n"
 _FOOTER = struct.Struct("<BQQQI")  # opcode, length, summary start, summary offset start, crc
-_PARSE_ERRORS = (McapError, struct.error, ValueError, UnicodeDecodeError, KeyError, EOFError)
+_PARSE_ERRORS = (
+    McapError,
+    struct.error,
+    ValueError,
+    OverflowError,
+    UnicodeDecodeError,
+    KeyError,
+    EOFError,
+)
 
 
 @dataclass(frozen=True, slots=True)
