@@ -72,7 +72,10 @@ class Tally:
 def explore(
     tally: Tally, strategy: st.SearchStrategy[object], check: Callable[[object], str | None]
 ) -> None:
-    """Run ``check`` on ``tally``'s budget of random cases, noting each outcome."""
+    """Run ``check`` on ``tally``'s budget of random cases (none for a budget of 0), noting
+    each outcome."""
+    if tally.budget == 0:
+        return
 
     @settings(
         max_examples=tally.budget,
@@ -95,9 +98,11 @@ def reference_recordings(folder: Path) -> list[fuzzing.Written]:
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--scenarios", type=int, default=5_000, help="scenario cases")
-    parser.add_argument("--recordings", type=int, default=5_000, help="recording cases")
+    parser.add_argument("--scenarios", type=int, default=5_000, help="scenario cases (0: none)")
+    parser.add_argument("--recordings", type=int, default=5_000, help="recording cases (0: none)")
     args = parser.parse_args()
+    if min(args.scenarios, args.recordings) < 0:
+        parser.error("--scenarios and --recordings take a number of cases >= 0")
     with tempfile.TemporaryDirectory() as name:
         folder = Path(name)
         scenarios = Tally("scenario files", args.scenarios)
