@@ -188,7 +188,10 @@ def _decode_many(
         pass
     for part, log_time in zip(parts, log_times, strict=True):  # which one, and why
         _decode_one(path, topic, part, int(log_time), ref)
-    raise CorruptRecording(f"{path}: the {topic} messages of the chunk at byte {ref.offset}")
+    raise CorruptRecording(
+        f"{path}: the {topic} messages of the chunk at byte {ref.offset} decode one by one but "
+        f"not together (a message holding more than one JSON value)"
+    )
 
 
 def _decode_one(path: Path, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:

@@ -378,7 +378,8 @@ def decode(schema_name: str, data: bytes) -> MessageRecord:
 
 def decode_many(schema_name: str, parts: Sequence[bytes | memoryview]) -> list[MessageRecord]:
     """:func:`decode` of many messages of one schema at once (one parser call for them all:
-    a chunk's events, say). A bad message raises what :func:`decode` of it raises."""
+    a chunk's events, say). Raises :class:`RecordFormatError` when any of them is bad; which
+    one, and why, is what :func:`decode` of each says."""
     decoder = _MANY.get(schema_name)
     if decoder is None:
         raise RecordFormatError(
@@ -386,10 +387,10 @@ def decode_many(schema_name: str, parts: Sequence[bytes | memoryview]) -> list[M
         )
     try:
         found: list[MessageRecord] = decoder.decode(b"[" + b",".join(parts) + b"]")
-    except msgspec.DecodeError:
-        found = []
-    if len(found) != len(parts):  # the culprit, one message at a time
-        return [decode(schema_name, bytes(part)) for part in parts]
+    except msgspec.DecodeError as exc:
+        raise RecordFormatError(f"{schema_name}: a message of the batch: {exc}") from None
+    if len(found) != len(parts):  # a part that is several JSON values, or none
+        raise RecordFormatError(f"{schema_name}: {len(parts)} messages decode as {len(found)}")
     for record in found:
         record._check()
     return found
