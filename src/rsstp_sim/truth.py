@@ -185,6 +185,16 @@ class GroundTruth:
         model.drain_operations()
         return model
 
+    def classes_reached_from(self, c: int) -> BoolArray:
+        """Which classes some action sequence leads to from class ``c`` (``c`` included)."""
+        sources = np.repeat(np.arange(self.n_classes, dtype=np.int64), len(self.actions))
+        return _reached(sources, self.class_next.ravel(), c, self.n_classes)
+
+    def classes_returning_to(self, c: int) -> BoolArray:
+        """From which classes some action sequence leads to class ``c`` (``c`` included)."""
+        sources = np.repeat(np.arange(self.n_classes, dtype=np.int64), len(self.actions))
+        return _reached(self.class_next.ravel(), sources, c, self.n_classes)
+
     def class_labels(self) -> dict[int, bool]:
         """The sensation of every class, as :func:`check_equivalence` takes labels."""
         return dict(enumerate(self.class_sensation.tolist()))
@@ -213,6 +223,25 @@ def format_truth(truth: GroundTruth) -> str:
             f"seconds: {truth.seconds:.3f}",
         ]
     )
+
+
+def _reached(tail: IntArray, head: IntArray, start: int, n: int) -> BoolArray:
+    """The nodes ``0 .. n-1`` reached from ``start`` along the edges ``tail[i] -> head[i]``,
+    breadth first, a whole frontier per numpy call."""
+    order = np.argsort(tail, kind="stable")
+    heads = head[order]
+    bounds = np.searchsorted(tail[order], np.arange(n + 1, dtype=np.int64))
+    seen = np.zeros(n, np.bool_)
+    seen[start] = True
+    frontier = np.array([start], np.int64)
+    while len(frontier):
+        lo, hi = bounds[frontier], bounds[frontier + 1]
+        sizes = hi - lo
+        offsets = np.repeat(lo - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))
+        following = np.unique(heads[offsets])
+        frontier = following[~seen[following]]
+        seen[frontier] = True
+    return seen
 
 
 # --------------------------------------------------------------- enumeration

@@ -26,6 +26,11 @@ from rsstp_sim.strategies import AgentView, StrategyBase
 from rsstp_sim.transition_system import Operation, TransitionSystem
 
 
+def _angles(angles_deg: Sequence[int]) -> dict[str, int]:
+    """A step row's ground-truth joint angles, named as the steps table names them."""
+    return {f"angle_deg_{j}": int(a) for j, a in enumerate(angles_deg)}
+
+
 class FakeRecording:
     """A run of ``strategy`` in ``scenario`` for ``steps`` steps, kept as a recording keeps it.
 
@@ -66,6 +71,7 @@ class FakeRecording:
                 "model_version": runner.model.version,
                 "no_transition": False,
                 "blocked": False,
+                **_angles(runner.world.current.angles_deg),
             }
         ]
         for _ in range(steps):
@@ -88,6 +94,7 @@ class FakeRecording:
                     "model_version": runner.model.version,
                     "no_transition": outcome.no_transition,
                     "blocked": outcome.blocker is not None,
+                    **_angles(pose.angles_deg),
                 }
             )
         self._steps = (

@@ -310,12 +310,15 @@ def audit_truth(
     states = np.asarray(memory.internal_states, dtype=np.int64)
     step_numbers = np.arange(len(states), dtype=np.int64)
     index = version_index(versions, step_numbers)
+    columns = [f"angle_deg_{j}" for j in range(truth.n_joints)]
     verdict, equivalent = judge_versions(
         versions,
         truth=truth,
         states=states,
         sensations=np.asarray(memory.sensations, np.bool_),
         true_class=true_class,
+        actions=steps["action"].to_numpy(np.int64, na_value=-1),
+        angles=steps[columns].to_numpy(np.int64),
     )
 
     # Within each version: keys (version index, state) and (version index, class).

@@ -1,20 +1,29 @@
 """The verdict of a learning run: did it learn the world, from which step, and if not, why not.
 
-Every model version is judged against the ground truth (:func:`rsstp_sim.truth.check_equivalence`)
-where it came into force: from its current state, which by the recording contract is the
-internal state of the step it was written at, and from the true class of that step's pose.
-Each state is labelled with the sensation last seen in it up to the last step the version was
-in force (a transition system has no labels of its own; the memory gives them).
+A model state *behaves as* a true class when no action sequence tells them apart: after every
+sequence the model has a single successor and predicts the sensation the world gives (each
+state labelled with the sensation last seen in it, up to the last step its version was in
+force: a transition system has no labels of its own; the memory gives them).
 
-- **learned**: the final model is equivalent to the truth; ``learned_at_step`` is the step from
-  which every version in force, to the end, was (the first step of the run's final stretch of
-  equivalent versions).
-- **not learned**: the final model is not equivalent. The verdict gives the model's size
-  against the true classes, how fast it was still growing (states a step over the last half of
-  the run), and the shortest action sequence that tells the final model from the truth, from
-  the final state: the states the model goes through, the sensation it predicts after each
-  action and the sensation the world gives, and the last step at which any transition on that
-  path changed (where to look in the recording).
+- **learned** means two things: the final model has a state that behaves as the start pose,
+  and its current state behaves as the arm's pose at the end. In a world the arm can always
+  return through, the second gives the first; in a one-way world it does not, and a model
+  that knows only the part the arm ended in is *not* learned.
+- **equivalent** (one model version, the ``equivalent`` column of the truth audit): some state
+  of the version behaves as the start pose, and at every step the version was in force, the
+  step's internal state behaves as the step's true class. ``learned_at_step`` is the first step
+  from which every version in force is equivalent, so it agrees with that column by
+  construction; a run is learned exactly when its final version is equivalent.
+- **not learned**: the verdict gives the model's size against the true classes, how fast it
+  was still growing (states a step over the last half of the run), and the shortest action
+  sequence that tells the final model from the truth, from the last step whose internal state
+  does not behave as its true class: the states the model goes through, the sensation it
+  predicts after each action and the sensation the world gives, and the last step at which any
+  transition on that path changed (where to look in the recording).
+- **confined**: when the arm ends where no action sequence leads back to the start pose's
+  class, the verdict names the step (and the move) that left the start's part of the world for
+  good, how many classes the arm can still reach, and whether the model is equivalent on that
+  part (``learned_reachable``).
 """
 
 from __future__ import annotations
@@ -26,11 +35,12 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from rsstp_replay.audits._equivalence import ModelTable, closure, equivalent_classes
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence
 
-__all__ = ["Counterexample", "Verdict", "judge_versions"]
+__all__ = ["Confinement", "Counterexample", "Verdict", "judge_versions"]
 
 _Ints = npt.NDArray[np.int64]
 
@@ -99,8 +109,41 @@ class Counterexample:
 
 
 @dataclass(frozen=True, slots=True)
+class Confinement:
+    """The run left the start's part of the world for good: from ``step`` on, no action
+    sequence leads back to the start pose's class. The move of that step was ``action``, from
+    ``pose_before`` to ``pose_after`` (joint angles in degrees; None when the recording gives
+    no angles). At the end the arm can still reach ``reachable_classes`` of the world's
+    classes."""
+
+    step: int
+    action: int | None
+    pose_before: tuple[int, ...] | None
+    pose_after: tuple[int, ...] | None
+    reachable_classes: int
+
+    def move(self) -> str:
+        """``step 120 (action 0, from pose [350, 10] to [0, 10])``."""
+        if self.action is None:
+            return f"step {self.step:,}"
+        if self.pose_before is None or self.pose_after is None:
+            return f"step {self.step:,} (action {self.action})"
+        return (
+            f"step {self.step:,} (action {self.action}, from pose {list(self.pose_before)} to "
+            f"{list(self.pose_after)})"
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class Verdict:
-    """Whether the run learned the world (see the module docstring)."""
+    """Whether the run learned the world (see the module docstring).
+
+    ``learned``: the final model has a state equivalent to the start pose, and its current
+    state is equivalent to the arm's pose at the end. ``learned_reachable``: the second
+    alone (the model is right about the part of the world the arm can still reach);
+    ``has_start_state``: the first alone. ``confinement``: where the run left the start's part
+    of the world for good (None when it can still return).
+    """
 
     learned: bool
     learned_at_step: int | None
@@ -110,19 +153,36 @@ class Verdict:
     growth_per_step: float
     last_change_step: int
     counterexample: Counterexample | None
+    learned_reachable: bool
+    has_start_state: bool
+    confinement: Confinement | None
+    reachable_classes: int
 
     def line(self) -> str:
         """One line, the first a researcher reads."""
         if self.learned:
             assert self.learned_at_step is not None
             if self.final_states == self.minimal_states:
-                what = f"equivalent to the minimal model ({self.minimal_states} states)"
+                what = f"equivalent to the minimal model ({self.minimal_states:,} states)"
             else:
                 what = (
-                    f"equivalent to the truth with {self.final_states} states (the minimal "
-                    f"model has {self.minimal_states})"
+                    f"equivalent to the truth with {self.final_states:,} states (the minimal "
+                    f"model has {self.minimal_states:,})"
                 )
             return f"learned: {what} from step {self.learned_at_step:,} to the end"
+        if self.confinement is not None:
+            part = (
+                "the model is equivalent to the truth on that part"
+                if self.learned_reachable
+                else "the model is not equivalent to the truth even there"
+            )
+            return (
+                f"not learned: since {self.confinement.move()} the arm cannot return to where "
+                f"it started; the run is confined to {self.reachable_classes:,} of the "
+                f"{_count(self.minimal_states, 'true class', 'true classes')}, {part} "
+                f"({_count(self.final_states, 'state')}), and no state of the final model is "
+                f"equivalent to the start pose"
+            )
         head = (
             f"not learned: {_count(self.final_states, 'state')} for "
             f"{_count(self.minimal_states, 'true class', 'true classes')} after "
@@ -141,10 +201,26 @@ class Verdict:
         return "\n".join(lines)
 
     def to_json(self) -> dict[str, Any]:
+        confinement = self.confinement
         return {
             "learned": self.learned,
             "text": self.line(),
             "learned_at_step": self.learned_at_step,
+            "learned_reachable": self.learned_reachable,
+            "has_start_state": self.has_start_state,
+            "confined_since_step": None if confinement is None else confinement.step,
+            "confining_move": None
+            if confinement is None
+            else {
+                "action": confinement.action,
+                "pose_before": None
+                if confinement.pose_before is None
+                else list(confinement.pose_before),
+                "pose_after": None
+                if confinement.pose_after is None
+                else list(confinement.pose_after),
+            },
+            "reachable_classes": self.reachable_classes,
             "steps": self.steps,
             "final_states": self.final_states,
             "minimal_states": self.minimal_states,
@@ -181,6 +257,49 @@ class _Labels:
         )
 
 
+@dataclass(frozen=True, slots=True)
+class _Visits:
+    """The distinct (internal state, true class) pairs of the steps each version was in
+    force, sorted by version, state and class."""
+
+    state: _Ints
+    true_class: _Ints
+    bounds: _Ints
+
+    @classmethod
+    def of(cls, index: _Ints, states: _Ints, true_class: _Ints, n_versions: int) -> _Visits:
+        keep = index >= 0
+        order = np.lexsort((true_class[keep], states[keep], index[keep]))
+        v, s, c = index[keep][order], states[keep][order], true_class[keep][order]
+        first = np.ones(len(v), np.bool_)
+        first[1:] = (v[1:] != v[:-1]) | (s[1:] != s[:-1]) | (c[1:] != c[:-1])
+        v, s, c = v[first], s[first], c[first]
+        return cls(s, c, np.searchsorted(v, np.arange(n_versions + 1, dtype=np.int64)))
+
+    def of_version(self, k: int) -> tuple[_Ints, _Ints]:
+        lo, hi = self.bounds[k], self.bounds[k + 1]
+        return self.state[lo:hi], self.true_class[lo:hi]
+
+
+def _judge(
+    model: TransitionSystem,
+    labels: dict[int, bool],
+    truth: GroundTruth,
+    states: _Ints,
+    classes: _Ints,
+) -> tuple[bool, bool]:
+    """(the model's state at every pair behaves as the pair's class, some state of the model
+    behaves as the start pose's class 0)."""
+    table = ModelTable.of(model, labels, truth.actions)
+    rows = np.minimum(table.rows(states), len(table.states) - 1)
+    if (table.states[rows] != states).any():
+        return False, False  # the contract is broken: a step's state is not in its version
+    phi = closure(table, truth, rows, classes)
+    if phi is not None and (phi == 0).any():
+        return True, True
+    return phi is not None, bool((equivalent_classes(table, truth) == 0).any())
+
+
 def judge_versions(
     versions: Sequence[ModelRecord],
     *,
@@ -188,90 +307,158 @@ def judge_versions(
     states: _Ints,
     sensations: npt.NDArray[np.bool_],
     true_class: _Ints,
+    actions: npt.NDArray[np.int64] | None = None,
+    angles: _Ints | None = None,
 ) -> tuple[Verdict, npt.NDArray[np.bool_]]:
-    """The verdict, and whether each version was equivalent to the truth where it came into
-    force. ``states``, ``sensations`` and ``true_class`` are per step (``0 .. T``)."""
+    """The verdict, and whether each version was equivalent to the truth.
+
+    A version is equivalent when some state of it behaves as the start pose (class 0) and,
+    at every step it was in force, the step's internal state behaves as the step's true
+    class (a version replaced within its own step: its own current state, with the class of
+    that step). Each state is labelled with the sensation last seen in it up to the last
+    step the version was in force. ``states``, ``sensations``, ``true_class`` (and
+    ``actions``, ``angles`` to name the move that confined the run) are per step
+    (``0 .. T``).
+    """
     steps = len(states) - 1
     labels = _Labels.of(states, sensations)
-    ends = [record.step for record in versions[1:]] + [steps + 1]
-    final = versions[-1]
-    final_model = TransitionSystem.from_snapshot(final.snapshot(), version=final.version)
-    final_labels = labels.at(final_model.states, steps)
-    sequence = check_equivalence(
-        final_model,
-        final_labels,
-        truth,
-        start_state=int(states[-1]),
-        start_class=int(true_class[-1]),
-    )
-    path = (
-        None
-        if sequence is None
-        else _walk(final_model, final_labels, truth, sequence, int(states[-1]), int(true_class[-1]))
-    )
-    watched = [] if path is None else path[0]
+    starts = np.fromiter((record.step for record in versions), np.int64, len(versions))
+    ends = np.r_[starts[1:], steps + 1]
+    index = np.searchsorted(starts, np.arange(steps + 1, dtype=np.int64), side="right") - 1
+    visits = _Visits.of(index, states, true_class, len(versions))
+    n_classes = truth.n_classes
 
     equivalent = np.zeros(len(versions), np.bool_)
-    changed_at: int | None = None
-    seen: tuple[tuple[int, ...] | None, ...] | None = None
+    final_judged = (False, False)
     model: TransitionSystem | None = None
-    for index, record in enumerate(versions):
+    for k, record in enumerate(versions):
         if model is None:
             model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
         else:
             for operation in record.operations:
                 model.apply(operation.to_operation())
             model.drain_operations()
-        start = record.step
-        bound = min(max(start, ends[index] - 1), steps)
-        equivalent[index] = (
-            check_equivalence(
-                model,
-                labels.at(model.states, bound),
-                truth,
-                start_state=int(states[start]),
-                start_class=int(true_class[start]),
-            )
-            is None
+        is_final = k == len(versions) - 1
+        if len(model) < n_classes and not is_final:
+            continue  # a state for each class is needed to behave as the start pose
+        pair_states, pair_classes = visits.of_version(k)
+        if not len(pair_states):
+            start = min(int(record.step), steps)
+            pair_states = np.array([record.current], np.int64)
+            pair_classes = true_class[start : start + 1]
+        if len(pair_states) > 1 and (pair_states[1:] == pair_states[:-1]).any() and not is_final:
+            continue  # a state stood for two classes
+        bound = min(max(int(record.step), int(ends[k]) - 1), steps)
+        judged = _judge(model, labels.at(model.states, bound), truth, pair_states, pair_classes)
+        equivalent[k] = judged[0] and judged[1]
+        if is_final:
+            final_judged = judged
+
+    assert model is not None
+    final = versions[-1]
+    final_labels = labels.at(model.states, steps)
+    learned_reachable, has_start_state = final_judged
+    learned = learned_reachable and has_start_state
+    counterexample = None
+    if not learned_reachable:
+        counterexample = _counterexample(
+            versions, model, final_labels, truth, states, true_class, int(starts[-1])
         )
-        if watched:
-            now = tuple(model.successors(s, a) if s in model else None for s, a in watched)
-            if seen is not None and now != seen:
-                changed_at = record.step
-            seen = now
 
     learned_at: int | None = None
-    if sequence is None:
-        first = len(versions) - 1
-        while first > 0 and equivalent[first - 1]:
-            first -= 1
-        learned_at = versions[first].step
-    counterexample = None
-    if path is not None and sequence is not None:
-        _, model_states, predicted, actual = path
-        counterexample = Counterexample(
-            actions=sequence,
-            from_state=int(states[-1]),
-            from_step=steps,
-            true_class=int(true_class[-1]),
-            model_states=model_states,
-            predicted=predicted,
-            actual=actual,
-            last_changed_step=changed_at,
+    if learned:
+        bad = np.flatnonzero(~equivalent[index])
+        learned_at = int(bad[-1]) + 1 if len(bad) else 0
+
+    returning = truth.classes_returning_to(0)
+    confinement = None
+    if not returning[true_class[-1]]:
+        step = int(np.flatnonzero(returning[true_class])[-1]) + 1
+        confinement = Confinement(
+            step=step,
+            action=None if actions is None else int(actions[step]),
+            pose_before=None if angles is None else tuple(angles[step - 1].tolist()),
+            pose_after=None if angles is None else tuple(angles[step].tolist()),
+            reachable_classes=int(truth.classes_reached_from(int(true_class[-1])).sum()),
         )
     return (
         Verdict(
-            learned=sequence is None,
+            learned=learned,
             learned_at_step=learned_at,
             steps=steps,
             final_states=len(final.states),
-            minimal_states=truth.n_classes,
+            minimal_states=n_classes,
             growth_per_step=_growth(versions, steps),
             last_change_step=final.step,
             counterexample=counterexample,
+            learned_reachable=learned_reachable,
+            has_start_state=has_start_state,
+            confinement=confinement,
+            reachable_classes=n_classes if confinement is None else confinement.reachable_classes,
         ),
         equivalent,
     )
+
+
+def _counterexample(
+    versions: Sequence[ModelRecord],
+    model: TransitionSystem,
+    labels: dict[int, bool],
+    truth: GroundTruth,
+    states: _Ints,
+    true_class: _Ints,
+    first_step: int,
+) -> Counterexample | None:
+    """The shortest sequence that tells the final model from the truth, from the last step
+    (of the final version's steps) whose internal state does not behave as its true class."""
+    table = ModelTable.of(model, labels, truth.actions)
+    final_states = states[first_step:]
+    rows = np.minimum(table.rows(final_states), len(table.states) - 1)
+    known = table.states[rows] == final_states
+    behaves = equivalent_classes(table, truth)[rows]
+    wrong = np.flatnonzero(~known | (behaves != true_class[first_step:]))
+    if not len(wrong):
+        return None
+    step = first_step + int(wrong[-1])
+    state, cls = int(states[step]), int(true_class[step])
+    if state not in model:
+        return None
+    sequence = check_equivalence(model, labels, truth, start_state=state, start_class=cls)
+    if sequence is None:
+        return None
+    watched, model_states, predicted, actual = _walk(model, labels, truth, sequence, state, cls)
+    return Counterexample(
+        actions=sequence,
+        from_state=state,
+        from_step=step,
+        true_class=cls,
+        model_states=model_states,
+        predicted=predicted,
+        actual=actual,
+        last_changed_step=_last_changed(versions, watched),
+    )
+
+
+def _last_changed(versions: Sequence[ModelRecord], watched: list[tuple[int, int]]) -> int | None:
+    """The last step at which the successors of any of the ``watched`` (state, action) pairs
+    changed (None: never since step 0)."""
+    if not watched:
+        return None
+    changed_at: int | None = None
+    seen: tuple[tuple[int, ...] | None, ...] | None = None
+    model: TransitionSystem | None = None
+    for record in versions:
+        if model is None:
+            model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
+        else:
+            for operation in record.operations:
+                model.apply(operation.to_operation())
+            model.drain_operations()
+        now = tuple(model.successors(s, a) if s in model else None for s, a in watched)
+        if seen is not None and now != seen:
+            changed_at = record.step
+        seen = now
+    return changed_at
 
 
 def _walk(
