@@ -63,6 +63,18 @@ def write_scenario(tmp_path: Path) -> WriteScenario:
     return write
 
 
+@pytest.fixture(scope="session")
+def truth_cache_home(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The XDG cache folder every test (and every command a test runs) uses: the truth cache
+    goes there, never into the user's own ``~/.cache``."""
+    return tmp_path_factory.mktemp("xdg-cache")
+
+
+@pytest.fixture(autouse=True)
+def _isolated_truth_cache(truth_cache_home: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("XDG_CACHE_HOME", str(truth_cache_home))
+
+
 @pytest.fixture
 def unwritable_directory(tmp_path: Path) -> Iterator[Path]:
     """A directory this user cannot create files in: a 0o500 one for an ordinary user; for

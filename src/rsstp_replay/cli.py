@@ -23,7 +23,7 @@ from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_replay.table_files import TABLE_FORMATS, sidecar_path, write_table
 from rsstp_replay.tables import TABLES, recording_table
-from rsstp_sim.commandline import Parser, UsageError, progress, run_command
+from rsstp_sim.commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_sim.files import irregular
 
 if TYPE_CHECKING:
@@ -144,7 +144,9 @@ def _cmd_table(args: argparse.Namespace) -> int:
         raise UsageError(f"table: --truth adds to the steps table, not to --what {args.what}")
     _check_table_output(out, force=args.force)
     with _open(args.file) as recording:
-        table = recording_table(recording, args.what, truth=args.truth)
+        table = recording_table(
+            recording, args.what, truth=args.truth, truth_cache=not args.no_cache
+        )
     _write_table(table, out)
     return 0
 
@@ -191,7 +193,11 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         truth = None
         if args.truth:
             bar.stage("comparing with the truth")
-            truth = audit_truth(loaded, within_versions=report.within_versions)
+            truth = audit_truth(
+                loaded,
+                truth=recording.ground_truth(cache=not args.no_cache),
+                within_versions=report.within_versions,
+            )
             bar.to(3)
     if args.json:
         document = {"model_recorded": recording.has_model, **report.to_json()}
@@ -423,6 +429,7 @@ def _build_parser() -> Parser:
         "poses) and aliased (its internal state stood for several true classes under its "
         "model version)",
     )
+    add_no_cache(p)
     p.set_defaults(func=_cmd_table)
 
     p = _table_parser(sub, "events", "write the events table (one row per event)")
@@ -451,6 +458,7 @@ def _build_parser() -> Parser:
         choices=_FAIL_ON,
         help="exit with 1 when such a finding exists (repeatable)",
     )
+    add_no_cache(p)
     p.set_defaults(func=_cmd_audit)
 
     p = sub.add_parser("view", help="stream a recording to the Rerun viewer or an .rrd file")

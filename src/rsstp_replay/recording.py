@@ -50,7 +50,8 @@ from rsstp_sim.recording.builders import model_record
 from rsstp_sim.recording.records import EventRecord, ModelRecord, TransitionsRecord
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
-from rsstp_sim.truth import GroundTruth, compute_truth
+from rsstp_sim.truth import GroundTruth
+from rsstp_sim.truth_cache import load_truth
 
 __all__ = ["EVENT_KINDS", "Recording", "open_recording"]
 
@@ -222,10 +223,12 @@ class Recording:
             self._log_times = self._agent_columns().log_time
         return self._log_times
 
-    def ground_truth(self) -> GroundTruth:
-        """The scenario's ground truth (computed once per recording; may take seconds)."""
+    def ground_truth(self, *, cache: bool = True) -> GroundTruth:
+        """The scenario's ground truth, once per recording: read from the truth cache on disk
+        (:func:`~rsstp_sim.truth_cache.load_truth`), or computed (seconds for a large world)
+        and kept there; ``cache=False`` computes it without the disk cache."""
         if self._ground_truth is None:
-            self._ground_truth = compute_truth(self.scenario)
+            self._ground_truth = load_truth(self.scenario, cache=cache)
         return self._ground_truth
 
     def memory(self) -> Memory:

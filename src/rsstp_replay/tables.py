@@ -101,7 +101,7 @@ def _flatten(data: dict[str, Any], prefix: str, row: dict[str, Any]) -> None:
 
 
 def recording_table(
-    recording: Recording, what: str = "steps", *, truth: bool = False
+    recording: Recording, what: str = "steps", *, truth: bool = False, truth_cache: bool = True
 ) -> pd.DataFrame:
     """The table ``what`` (one of :data:`TABLES`) of a recording; ``truth=True`` (steps only)
     adds the ground truth of every step (:func:`~rsstp_replay.audits.truth_table`)."""
@@ -113,7 +113,7 @@ def recording_table(
         if truth:
             from rsstp_replay.audits import truth_table
 
-            return truth_table(recording, truth=recording.ground_truth())
+            return truth_table(recording, truth=recording.ground_truth(cache=truth_cache))
         return recording.steps()
     if what == "model":
         return model_table(recording)

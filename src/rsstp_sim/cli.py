@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 from rsstp_sim import graph
-from rsstp_sim.commandline import Parser, UsageError, progress, run_command
+from rsstp_sim.commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import RecordingWriteError
 from rsstp_sim.scenario import MANY_OBSTACLES, Scenario, builtin_scenarios, load_scenario
@@ -267,11 +267,18 @@ def _cmd_record(args: argparse.Namespace) -> int:
 
 
 def _cmd_truth(args: argparse.Namespace) -> int:
-    from rsstp_sim.truth import compute_truth, format_truth
+    from rsstp_sim.truth import format_truth
+    from rsstp_sim.truth_cache import cache_info, load_truth
 
+    if args.cache_info:
+        info = cache_info()
+        print(json.dumps(info.to_json(), indent=2) if args.json else info.to_text())
+        return 0
+    if args.scenario is None:
+        raise UsageError("truth: name a scenario (or ask for --cache-info)")
     scenario = load_scenario(args.scenario)
     _warn_about(scenario)
-    truth = compute_truth(scenario, max_poses=args.max_poses)
+    truth = load_truth(scenario, cache=not args.no_cache, max_poses=args.max_poses)
     if args.json:
         print(json.dumps(truth.to_json(), indent=2))
     else:
@@ -321,13 +328,19 @@ def _build_parser() -> Parser:
     p.set_defaults(func=_cmd_record)
 
     p = sub.add_parser("truth", help="the ground truth: reachable poses and the minimal model")
-    p.add_argument("scenario", help="a built-in scenario name or a scenario .toml file")
+    p.add_argument("scenario", nargs="?", help="a built-in scenario name or a scenario .toml file")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.add_argument(
         "--max-poses",
         type=_non_negative,
         default=2_000_000,
         help="refuse larger pose spaces (default 2,000,000)",
+    )
+    add_no_cache(p)
+    p.add_argument(
+        "--cache-info",
+        action="store_true",
+        help="say where the truth cache is, whether it can be written, and how big it is",
     )
     p.set_defaults(func=_cmd_truth)
 

@@ -16,7 +16,7 @@ from typing import Any, NoReturn
 
 from rsstp_sim.errors import RsstpError, UsageError
 
-__all__ = ["Parser", "Progress", "UsageError", "progress", "run_command"]
+__all__ = ["Parser", "Progress", "UsageError", "add_no_cache", "progress", "run_command"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -53,6 +53,16 @@ class Progress:
     def __exit__(self, *_: object) -> None:
         if self._bar is not None:
             self._bar.close()
+
+
+def add_no_cache(parser: argparse.ArgumentParser) -> None:
+    """``--no-cache``: compute the ground truth without reading or writing the truth cache
+    (:mod:`rsstp_sim.truth_cache`)."""
+    parser.add_argument(
+        "--no-cache",
+        action="store_true",
+        help="compute the ground truth afresh, without the truth cache on disk",
+    )
 
 
 def progress(total: int, what: str, *, unit: str = "step", quiet: bool = False) -> Progress:

@@ -45,7 +45,8 @@ from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
-from rsstp_sim.truth import GroundTruth, compute_truth
+from rsstp_sim.truth import GroundTruth
+from rsstp_sim.truth_cache import load_truth
 
 __all__ = ["TruthFindings", "TruthSource", "audit_truth", "step_true_classes", "truth_table"]
 
@@ -78,7 +79,7 @@ def truth_table(
     :class:`~rsstp_sim.truth.GroundTruth`) and ``aliased`` (bool: the step's internal state
     stood for several true classes under the model version in force, over that version's
     steps). ``findings`` is the truth audit when already at hand."""
-    truth = compute_truth(source.scenario) if truth is None else truth
+    truth = load_truth(source.scenario) if truth is None else truth
     findings = audit_truth(source, truth=truth) if findings is None else findings
     table = source.steps()
     columns = [f"angle_deg_{j}" for j in range(truth.n_joints)]
@@ -301,7 +302,7 @@ def audit_truth(
     """Run the truth audit. The ground truth is computed unless ``truth`` is given, and the
     consistency audit within versions unless ``within_versions`` is (an
     :class:`~rsstp_replay.audits.report.AuditReport` has it)."""
-    truth = compute_truth(source.scenario) if truth is None else truth
+    truth = load_truth(source.scenario) if truth is None else truth
     loaded = load(source)
     steps = loaded.steps()
     true_class = step_true_classes(steps, truth)
