@@ -112,27 +112,11 @@ def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
         table, versions = recording.steps(), list(recording.model_versions())
         times, events = recording.step_log_times(), recording.events()
 
-    class Edited:
-        def __init__(self, table: object) -> None:
-            self.table = table
-
-        def steps(self, *, geometry: bool = True) -> object:
-            return self.table
-
-        def model_versions(self) -> list[ModelRecord]:
-            return versions
-
-        def step_log_times(self) -> object:
-            return times
-
-        def events(self) -> object:
-            return events
-
     edited = table.copy()
     edited.loc[20, "state_before"] = 999
     edited.loc[30, "internal_state"] = 998
     edited.loc[35, "model_version"] = 997
-    found = check_contract(Edited(edited))  # type: ignore[arg-type]
+    found = check_contract(_Edited(edited, versions, times, events))  # type: ignore[arg-type]
     rules = {v.rule: v.step for v in found.violations}
     assert rules == {"state-chain": 20, "state-in-model": 30, "model-version": 35}
     assert "step 30 is in internal state 998" in found.to_text()
@@ -220,3 +204,45 @@ def test_log_times_and_event_steps_are_checked(tmp_path: Path) -> None:
         found = check_contract(recording)
     assert [v.rule for v in found.violations] == ["event-in-range"]
     assert "names step 1,000,000, outside the recording's steps 0 to 40" in found.to_text()
+
+
+def test_a_model_message_whose_current_state_is_not_its_steps_is_found(tmp_path: Path) -> None:
+    """The one place a recording says the current state twice: the last model message of a
+    step names it, and so does the step record. Rewrite one message's current state to another
+    state of its version: `model-current`, at that message's step, and nothing else."""
+    import msgspec
+
+    path = tmp_path / "run.mcap"
+    record(path, load_scenario("thesis-roulette"), make_strategy("learner"), steps=60, seed=0)
+    with open_recording(path) as recording:
+        table, versions = recording.steps(), list(recording.model_versions())
+        times, events = recording.step_log_times(), recording.events()
+    assert check_contract(_Edited(table, versions, times, events)).holds
+    k = next(i for i, v in enumerate(versions) if v.step > 0 and len(v.states) > 1)
+    other = next(s for s in versions[k].states if s != versions[k].current)
+    changed = [*versions]
+    changed[k] = msgspec.structs.replace(versions[k], current=other)
+    found = check_contract(_Edited(table, changed, times, events))
+    assert [(v.rule, v.step, v.count) for v in found.violations] == [
+        ("model-current", versions[k].step, 1)
+    ]
+    assert f"says the current state is {other}" in found.to_text()
+
+
+class _Edited:
+    """A recording's columns, some of them edited, as the contract check reads them."""
+
+    def __init__(self, table: object, versions: list[ModelRecord], times: object, events: object):
+        self.table, self.versions, self.times, self.event_table = table, versions, times, events
+
+    def steps(self, *, geometry: bool = True) -> object:
+        return self.table
+
+    def model_versions(self) -> list[ModelRecord]:
+        return self.versions
+
+    def step_log_times(self) -> object:
+        return self.times
+
+    def events(self) -> object:
+        return self.event_table

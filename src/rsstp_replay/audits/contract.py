@@ -9,6 +9,9 @@ the current state of the model. The contract ties them together, step by step:
 - ``state-chain``: a step starts where the step before it ended (``state_before`` of step
   ``t`` is the internal state of step ``t - 1``);
 - ``versions-in-order``: model versions grow from one message to the next;
+- ``model-current``: a model message's own current state is the internal state of the step it
+  was written at (the last message of a step; an earlier one of the same step was replaced
+  within it);
 - ``log-time``: a step message is logged at step x 1,000,000 ns (what tools that plot by
   log time, Foxglove and Rerun's importer, rely on);
 - ``event-in-range``: an event names a step of the recording.
@@ -16,8 +19,10 @@ the current state of the model. The contract ties them together, step by step:
 (A model or event message whose log time disagrees with its step, and a channel whose message
 count differs from the summary's, are refused by the reader itself.)
 
-So ``Recording.model_at(t).current`` is the internal state of step ``t`` at every step, and an
-audit can read a state id as what its version says. :func:`check_contract` checks every step
+``Recording.model_at(t)`` takes its structure from the model message in force and its current
+state from the step record (``model-version`` and ``state-in-model`` are what make that state
+one the version has); ``model-current`` checks the one place where the file says the current
+state twice. An audit can read a state id as what its version says. :func:`check_contract` checks every step
 with numpy (no per-step Python), and reports each broken rule once, at its first step.
 """
 
@@ -156,6 +161,27 @@ def check_contract(source: ContractSource) -> ContractFindings:
             f"model version {in_force[t]}"
         ),
     )
+
+    message_steps = np.fromiter((record.step for record in versions), np.int64, len(versions))
+    currents = np.fromiter((record.current for record in versions), np.int64, len(versions))
+    last_of_step = np.r_[message_steps[1:] != message_steps[:-1], True] if len(versions) else []
+    at = np.searchsorted(step, message_steps)
+    known = (at < len(step)) & (step[np.minimum(at, max(len(step) - 1, 0))] == message_steps)
+    checked = np.flatnonzero(np.asarray(last_of_step, np.bool_) & known)
+    wrong = checked[currents[checked] != state[at[checked]]]
+    if len(wrong):
+        k = int(wrong[0])
+        found.append(
+            Violation(
+                "model-current",
+                int(message_steps[k]),
+                len(wrong),
+                f"model version {numbers[k]} (step {message_steps[k]:,}) says the current state "
+                f"is {currents[k]}, but step {message_steps[k]:,} ends in state "
+                f"{state[at[k]]}",
+                counted="model message",
+            )
+        )
 
     found += _first_of(
         "state-chain",
