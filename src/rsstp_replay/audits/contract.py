@@ -22,8 +22,9 @@ count differs from the summary's, are refused by the reader itself.)
 ``Recording.model_at(t)`` takes its structure from the model message in force and its current
 state from the step record (``model-version`` and ``state-in-model`` are what make that state
 one the version has); ``model-current`` checks the one place where the file says the current
-state twice. An audit can read a state id as what its version says. :func:`check_contract` checks every step
-with numpy (no per-step Python), and reports each broken rule once, at its first step.
+state twice. An audit can read a state id as what its version says. :func:`check_contract`
+checks every step with numpy (no per-step Python), and reports each broken rule once, at its
+first step.
 """
 
 from __future__ import annotations

@@ -297,6 +297,8 @@ def _judge(
     phi = closure(table, truth, rows, classes)
     if phi is not None and (phi == 0).any():
         return True, True
+    if len(table.states) < truth.n_classes:
+        return phi is not None, False  # a state for each class is needed to behave as class 0
     return phi is not None, bool((equivalent_classes(table, truth) == 0).any())
 
 
@@ -410,33 +412,42 @@ def _counterexample(
     first_step: int,
 ) -> Counterexample | None:
     """The shortest sequence that tells the final model from the truth, from the last step
-    (of the final version's steps) whose internal state does not behave as its true class."""
-    table = ModelTable.of(model, labels, truth.actions)
-    final_states = states[first_step:]
-    rows = np.minimum(table.rows(final_states), len(table.states) - 1)
-    known = table.states[rows] == final_states
-    behaves = equivalent_classes(table, truth)[rows]
-    wrong = np.flatnonzero(~known | (behaves != true_class[first_step:]))
-    if not len(wrong):
-        return None
-    step = first_step + int(wrong[-1])
-    state, cls = int(states[step]), int(true_class[step])
-    if state not in model:
-        return None
-    sequence = check_equivalence(model, labels, truth, start_state=state, start_class=cls)
-    if sequence is None:
-        return None
-    watched, model_states, predicted, actual = _walk(model, labels, truth, sequence, state, cls)
-    return Counterexample(
-        actions=sequence,
-        from_state=state,
-        from_step=step,
-        true_class=cls,
-        model_states=model_states,
-        predicted=predicted,
-        actual=actual,
-        last_changed_step=_last_changed(versions, watched),
-    )
+    of the final version's steps whose internal state does not behave as its true class.
+
+    The last step is tried first (where the run ended: nearly always the one); then the
+    distinct (state, class) pairs of the version's earlier steps, latest first, up to
+    :data:`_PAIRS_TRIED` of them (None when none of those tells them apart).
+    """
+    tried: set[tuple[int, int]] = set()
+    for step in range(len(states) - 1, first_step - 1, -1):
+        pair = (int(states[step]), int(true_class[step]))
+        if pair in tried:
+            continue
+        if len(tried) == _PAIRS_TRIED:
+            return None
+        tried.add(pair)
+        state, cls = pair
+        if state not in model:
+            continue
+        sequence = check_equivalence(model, labels, truth, start_state=state, start_class=cls)
+        if sequence is None:
+            continue
+        watched, model_states, predicted, actual = _walk(model, labels, truth, sequence, state, cls)
+        return Counterexample(
+            actions=sequence,
+            from_state=state,
+            from_step=step,
+            true_class=cls,
+            model_states=model_states,
+            predicted=predicted,
+            actual=actual,
+            last_changed_step=_last_changed(versions, watched),
+        )
+    return None
+
+
+_PAIRS_TRIED = 64
+"""Distinct (state, class) pairs of the final version searched for a counterexample."""
 
 
 def _last_changed(versions: Sequence[ModelRecord], watched: list[tuple[int, int]]) -> int | None:
