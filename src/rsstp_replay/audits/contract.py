@@ -166,10 +166,10 @@ def check_contract(source: ContractSource) -> ContractFindings:
     message_steps = np.fromiter((record.step for record in versions), np.int64, len(versions))
     currents = np.fromiter((record.current for record in versions), np.int64, len(versions))
     last_of_step = np.r_[message_steps[1:] != message_steps[:-1], True] if len(versions) else []
-    at = np.searchsorted(step, message_steps)
-    known = (at < len(step)) & (step[np.minimum(at, max(len(step) - 1, 0))] == message_steps)
+    row = np.searchsorted(step, message_steps)
+    known = (row < len(step)) & (step[np.minimum(row, max(len(step) - 1, 0))] == message_steps)
     checked = np.flatnonzero(np.asarray(last_of_step, np.bool_) & known)
-    wrong = checked[currents[checked] != state[at[checked]]]
+    wrong = checked[currents[checked] != state[row[checked]]]
     if len(wrong):
         k = int(wrong[0])
         found.append(
@@ -179,7 +179,7 @@ def check_contract(source: ContractSource) -> ContractFindings:
                 len(wrong),
                 f"model version {numbers[k]} (step {message_steps[k]:,}) says the current state "
                 f"is {currents[k]}, but step {message_steps[k]:,} ends in state "
-                f"{state[at[k]]}",
+                f"{state[row[k]]}",
                 counted="model message",
             )
         )
