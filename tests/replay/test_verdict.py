@@ -9,15 +9,21 @@ that alone.
 
 from __future__ import annotations
 
+import json
+import subprocess
+import sys
 from collections.abc import Mapping, Sequence
+from pathlib import Path
 
 import numpy as np
 from fakes import FakeRecording, RandomRefiner
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
 
+from rsstp_replay import open_recording
 from rsstp_replay.audits import audit_truth
-from rsstp_sim import parse_scenario
+from rsstp_sim import load_scenario, make_strategy, parse_scenario
+from rsstp_sim.recording import record
 from rsstp_sim.strategies import LearnerStrategy, RandomStrategy, SplitterStrategy
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, compute_truth
@@ -74,14 +80,14 @@ def expected_verdict(
     starts = [v.step for v in versions]
     in_force = [sum(1 for s in starts if s <= t) - 1 for t in range(len(states))]
     equivalent = []
-    for k, record in enumerate(versions):
-        model = TransitionSystem.from_snapshot(record.snapshot())
+    for k, message in enumerate(versions):
+        model = TransitionSystem.from_snapshot(message.snapshot())
         mine = [t for t in range(len(states)) if in_force[t] == k]
-        last = mine[-1] if mine else record.step
+        last = mine[-1] if mine else message.step
         labels: dict[int, bool] = {}
         for t in range(last + 1):
             labels[states[t]] = sensed[t]
-        pairs = [(states[t], classes[t]) for t in mine] or [(record.current, classes[record.step])]
+        pairs = [(states[t], classes[t]) for t in mine] or [(message.current, classes[message.step])]
         equivalent.append(
             any(behaves_as(model, labels, truth, s, 0) for s in model.states)
             and all(behaves_as(model, labels, truth, s, c) for s, c in pairs)
@@ -193,3 +199,37 @@ def test_a_one_way_world_is_not_learned_from_where_the_arm_ended() -> None:
     assert verdict.to_json()["reachable_classes"] == int(
         np.count_nonzero(truth.classes_reached_from(int(classes[-1])))
     )
+
+
+def test_the_command_line_fails_a_one_way_run_and_says_why(tmp_path: Path) -> None:
+    """`audit --truth --fail-on not-learned` exits 1 on the built-in one-way world, whatever
+    the model knows of where the arm ended; the JSON names the confinement."""
+    path = tmp_path / "one-way.mcap"
+    record(path, load_scenario("one-way"), make_strategy("learner"), steps=600, seed=0)
+    command = [sys.executable, "-m", "rsstp_replay", "audit", "--truth", str(path)]
+    gated = subprocess.run(
+        [*command, "--fail-on", "not-learned"], capture_output=True, text=True, timeout=300
+    )
+    assert gated.returncode == 1
+    assert "cannot return to where it started" in gated.stderr
+    document = json.loads(
+        subprocess.run(
+            [*command, "--json"], capture_output=True, text=True, timeout=300, check=True
+        ).stdout
+    )
+    verdict = document["verdict"]
+    truth = compute_truth(load_scenario("one-way"))
+    with open_recording(path) as recording:
+        steps = recording.steps()
+    classes = truth.classes_of(steps[["angle_deg_0", "angle_deg_1"]].to_numpy())
+    back = truth.classes_returning_to(0)
+    expected_step = int(np.flatnonzero(back[classes])[-1]) + 1
+    assert verdict["learned"] is False
+    assert verdict["confined_since_step"] == expected_step
+    assert verdict["confining_move"] == {
+        "action": int(steps["action"].iloc[expected_step]),
+        "pose_before": steps[["angle_deg_0", "angle_deg_1"]].iloc[expected_step - 1].tolist(),
+        "pose_after": steps[["angle_deg_0", "angle_deg_1"]].iloc[expected_step].tolist(),
+    }
+    assert verdict["reachable_classes"] == int(truth.classes_reached_from(int(classes[-1])).sum())
+    assert verdict["reachable_classes"] < truth.n_classes
