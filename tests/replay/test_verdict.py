@@ -87,7 +87,9 @@ def expected_verdict(
         labels: dict[int, bool] = {}
         for t in range(last + 1):
             labels[states[t]] = sensed[t]
-        pairs = [(states[t], classes[t]) for t in mine] or [(message.current, classes[message.step])]
+        pairs = [(states[t], classes[t]) for t in mine] or [
+            (message.current, classes[message.step])
+        ]
         equivalent.append(
             any(behaves_as(model, labels, truth, s, 0) for s in model.states)
             and all(behaves_as(model, labels, truth, s, c) for s, c in pairs)
