@@ -287,9 +287,12 @@ def _judge(
     truth: GroundTruth,
     states: _Ints,
     classes: _Ints,
+    *,
+    always: bool,
 ) -> tuple[bool, bool]:
     """(the model's state at every pair behaves as the pair's class, some state of the model
-    behaves as the start pose's class 0)."""
+    behaves as the start pose's class 0). The second is decided only when the first holds,
+    or ``always`` (else it is False: the version is not equivalent either way)."""
     table = ModelTable.of(model, labels, truth.actions)
     rows = np.minimum(table.rows(states), len(table.states) - 1)
     if (table.states[rows] != states).any():
@@ -297,7 +300,7 @@ def _judge(
     phi = closure(table, truth, rows, classes)
     if phi is not None and (phi == 0).any():
         return True, True
-    if len(table.states) < truth.n_classes:
+    if len(table.states) < truth.n_classes or (phi is None and not always):
         return phi is not None, False  # a state for each class is needed to behave as class 0
     return phi is not None, bool((equivalent_classes(table, truth) == 0).any())
 
@@ -351,7 +354,14 @@ def judge_versions(
         if len(pair_states) > 1 and (pair_states[1:] == pair_states[:-1]).any() and not is_final:
             continue  # a state stood for two classes
         bound = min(max(int(record.step), int(ends[k]) - 1), steps)
-        judged = _judge(model, labels.at(model.states, bound), truth, pair_states, pair_classes)
+        judged = _judge(
+            model,
+            labels.at(model.states, bound),
+            truth,
+            pair_states,
+            pair_classes,
+            always=is_final,
+        )
         equivalent[k] = judged[0] and judged[1]
         if is_final:
             final_judged = judged
