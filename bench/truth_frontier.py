@@ -4,11 +4,14 @@ cache on a world of about 340,000 poses.
 
     python bench/truth_frontier.py                      # 1,000,000 steps, then the cache
     python bench/truth_frontier.py --steps 10000000     # the same run ten times longer
+    python bench/truth_frontier.py --world three-joint-30 --only frontier
     python bench/truth_frontier.py --only cache
 
-The frontier run is ``rsstp-sim record three-joint-30 --strategy learner --seed 0`` on the
-world below (three links (3, 2, 1) at 30 degrees, one obstacle: 1,337 true classes; the run
-writes about 9,000 model versions per million steps), recorded once into the temporary folder.
+The frontier run is ``rsstp-sim record WORLD --strategy learner --seed 0``, recorded once into
+the temporary folder, on one of two worlds: ``two-joint-10`` (links (2, 1) at 10 degrees, one
+obstacle: 1,183 true classes; the issue's case) or ``three-joint-30`` (links (3, 2, 1) at 30
+degrees, one obstacle: 1,337 true classes, and a learner model of up to 1,700 states whose
+every version the file holds whole).
 Each command runs in a fresh process (wall time includes Python's start and imports; peak
 memory is the child's maximum RSS). The truth cache lives in a temporary ``XDG_CACHE_HOME``:
 the first ``audit --truth`` computes the truth and keeps it, the second (another recording of
@@ -43,6 +46,20 @@ radius = 0.8
 [feedback]
 target_deg = [0, 30, 30]
 """
+WORLDS = {
+    "two-joint-10": """name = "two-joint-10"
+[arm]
+lengths = [2.0, 1.0]
+initial_deg = [0, 0]
+step_deg = 10
+[[obstacles]]
+center = [0.0, 2.5]
+radius = 0.5
+[feedback]
+target_deg = [0, 0]
+""",
+    "three-joint-30": FRONTIER,
+}
 LARGE = (
     FRONTIER.replace("step_deg = 30", "step_deg = 5")
     .replace("center = [0.0, 4.0]\nradius = 0.8", "center = [0.0, -5.0]\nradius = 0.3")
@@ -65,10 +82,10 @@ def scenario_file(text: str) -> Path:
     return path
 
 
-def frontier(steps: int) -> None:
-    world = scenario_file(FRONTIER)
+def frontier(name: str, steps: int) -> None:
+    world = scenario_file(WORLDS[name])
     mcap = recorded(
-        f"frontier-learner-{steps}", str(world), "--strategy", "learner", "--steps", str(steps)
+        f"{name}-learner-{steps}", str(world), "--strategy", "learner", "--steps", str(steps)
     )
     print(f"{mcap}: {mcap.stat().st_size / 1e6:.1f} MB; load average {os.getloadavg()[0]:.2f}")
     replay = str(BIN / "rsstp-replay")
@@ -128,9 +145,10 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--steps", type=int, default=1_000_000)
     parser.add_argument("--only", choices=["frontier", "cache"])
+    parser.add_argument("--world", choices=sorted(WORLDS), default="two-joint-10")
     args = parser.parse_args()
     if args.only in (None, "frontier"):
-        frontier(args.steps)
+        frontier(args.world, args.steps)
     if args.only in (None, "cache"):
         cache()
 
