@@ -70,9 +70,16 @@ def truth_cache_home(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return tmp_path_factory.mktemp("xdg-cache")
 
 
-@pytest.fixture(autouse=True)
-def _isolated_truth_cache(truth_cache_home: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setenv("XDG_CACHE_HOME", str(truth_cache_home))
+@pytest.fixture(scope="session", autouse=True)
+def _isolated_truth_cache(truth_cache_home: Path) -> Iterator[None]:
+    """Session-wide, so that module fixtures that run commands (a sweep) are inside it too."""
+    before = os.environ.get("XDG_CACHE_HOME")
+    os.environ["XDG_CACHE_HOME"] = str(truth_cache_home)
+    yield
+    if before is None:
+        del os.environ["XDG_CACHE_HOME"]
+    else:
+        os.environ["XDG_CACHE_HOME"] = before
 
 
 @pytest.fixture

@@ -22,6 +22,7 @@ from rsstp_replay import open_recording
 from rsstp_sim.recording.recorder import record
 from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import make_strategy
+from rsstp_sim.truth_cache import truth_cache_dir, truth_key
 from scenarios import sweep_toml
 
 FAULTY = """
@@ -117,6 +118,8 @@ def test_every_run_is_a_row_and_a_failing_run_does_not_stop_the_others(
     assert (out / "sweep.toml").read_text() == SWEEP
     meta = json.loads((out / "sweep.json").read_text())
     assert meta["package_version"] and meta["runs"] == list(runs["run"])
+    kept = {path.stem for path in truth_cache_dir().glob("*.npz")}  # the workers share it
+    assert {truth_key(load_scenario(name)) for name in set(runs["scenario"])} <= kept
 
 
 def test_each_recording_is_the_one_record_writes(
