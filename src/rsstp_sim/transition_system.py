@@ -256,12 +256,15 @@ class TransitionSystem:
 
     def transitions(self) -> list[tuple[int, int, int]]:
         """Every transition as ``(source, action, target)``, sorted."""
-        return [
-            (s, a, t)
-            for s in self.states
-            for a, targets in sorted(self._out[s].items())
-            for t in targets
-        ]
+        return [(s, a, t) for s in self.states for a, t in self.transitions_from(s)]
+
+    def transitions_from(self, s: int) -> list[tuple[int, int]]:
+        """Every transition out of ``s`` as ``(action, target)``, sorted."""
+        try:
+            out = self._out[s]
+        except KeyError:
+            raise ModelError(f"transitions_from: unknown state {s!r}") from None
+        return [(a, t) for a, targets in sorted(out.items()) for t in targets]
 
     def index_of(self, s: int) -> int:
         """The row/column of state ``s`` in the dense matrix view."""

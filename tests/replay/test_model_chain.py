@@ -1,0 +1,54 @@
+"""The model chain's fast check: the previous snapshot with the touched states' rows replaced is
+the model the operations make, whatever the operations were."""
+
+from __future__ import annotations
+
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from rsstp_replay._models import _patched, _touched
+from rsstp_sim.recording.records import TransitionsRecord
+from rsstp_sim.transition_system import TransitionSystem
+
+
+def as_record(model: TransitionSystem) -> TransitionsRecord:
+    triples = model.transitions()
+    return TransitionsRecord(
+        source=tuple(s for s, _, _ in triples),
+        action=tuple(a for _, a, _ in triples),
+        target=tuple(t for _, _, t in triples),
+    )
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.data())
+def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(
+    data: st.DataObject,
+) -> None:
+    model = TransitionSystem(data.draw(st.integers(1, 4)), actions=(0, 1))
+    for _ in range(data.draw(st.integers(0, 12))):  # some transitions to start from
+        states = model.states
+        model.add(data.draw(st.sampled_from(states)), data.draw(st.sampled_from(states)),
+                  data.draw(st.sampled_from((0, 1))))  # fmt: skip
+    for _ in range(data.draw(st.integers(1, 6))):  # one version: several operations
+        before = as_record(model)
+        touched: set[int] = set()
+        for _ in range(data.draw(st.integers(1, 4))):
+            states = model.states
+            kind = data.draw(st.sampled_from(["add", "delete", "split", "merge"]))
+            if kind == "merge" and len(states) < 2:
+                continue
+            s = data.draw(st.sampled_from(states))
+            if kind == "split":
+                touched |= _touched(model, kind, (s,), model.next_id)
+                model.split(s)
+            elif kind == "merge":
+                t = data.draw(st.sampled_from([x for x in states if x != s]))
+                touched |= _touched(model, kind, (s, t), model.next_id)
+                model.merge(s, t)
+            else:
+                t, a = data.draw(st.sampled_from(states)), data.draw(st.sampled_from((0, 1)))
+                touched |= _touched(model, kind, (s, t, a), model.next_id)
+                getattr(model, kind)(s, t, a)
+        after = as_record(model)
+        assert _patched(before, model, touched) == (after.source, after.action, after.target)
