@@ -59,7 +59,7 @@ def verify_chain(path: Path, records: Sequence[ModelRecord]) -> None:
             )
         for k, operation in enumerate(record.operations):
             try:
-                touched |= _touched(model, operation.kind, operation.args, model.next_id)
+                touched |= model.sources_changed_by(operation.kind, operation.args)
                 model.apply(operation.to_operation())
             except ModelError as exc:
                 raise CorruptRecording(
@@ -81,22 +81,6 @@ def verify_chain(path: Path, records: Sequence[ModelRecord]) -> None:
         model.current = record.current
         _check_flags(path, record, model)
         previous = record
-
-
-def _touched(model: TransitionSystem, kind: str, args: Sequence[int], next_id: int) -> set[int]:
-    """The states whose outgoing transitions the operation may change (taken before it is
-    applied): the source of an add or delete; a split's new state and every state with a
-    transition into the split one; a merge's two states and every state with a transition
-    into the one that goes. An operation that does not apply touches nothing here (applying
-    it raises)."""
-    try:
-        if kind == "split":
-            return {next_id, *model.predecessors(args[0])}
-        if kind == "merge":
-            return {args[0], args[1], *model.predecessors(args[1])}
-        return {args[0]}
-    except (ModelError, IndexError):
-        return set()
 
 
 def _patched(

@@ -391,6 +391,21 @@ class TransitionSystem:
         self._log(Operation("merge", (s, t), s))
         return s
 
+    def sources_changed_by(self, kind: str, args: Sequence[int]) -> set[int]:
+        """The states whose outgoing transitions an operation would change, asked before it is
+        applied: the source of an ``add`` or ``delete``; a ``split``'s new state and every
+        state with a transition into the split one; a ``merge``'s two states and every state
+        with a transition into the one that goes. An operation that does not apply changes
+        nothing (applying it raises)."""
+        try:
+            if kind == "split":
+                return {self._next_id, *self.predecessors(args[0])}
+            if kind == "merge":
+                return {args[0], args[1], *self.predecessors(args[1])}
+            return {args[0]}
+        except (ModelError, IndexError):
+            return set()
+
     def apply(self, op: Operation) -> None:
         """Replay a logged operation exactly; an inconsistent one raises :class:`ModelError`."""
         arity = _ARITY.get(op.kind)

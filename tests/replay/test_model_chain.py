@@ -6,7 +6,7 @@ from __future__ import annotations
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rsstp_replay._models import _patched, _touched
+from rsstp_replay._models import _patched
 from rsstp_sim.recording.records import TransitionsRecord
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -40,15 +40,15 @@ def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(
                 continue
             s = data.draw(st.sampled_from(states))
             if kind == "split":
-                touched |= _touched(model, kind, (s,), model.next_id)
+                touched |= model.sources_changed_by(kind, (s,))
                 model.split(s)
             elif kind == "merge":
                 t = data.draw(st.sampled_from([x for x in states if x != s]))
-                touched |= _touched(model, kind, (s, t), model.next_id)
+                touched |= model.sources_changed_by(kind, (s, t))
                 model.merge(s, t)
             else:
                 t, a = data.draw(st.sampled_from(states)), data.draw(st.sampled_from((0, 1)))
-                touched |= _touched(model, kind, (s, t, a), model.next_id)
+                touched |= model.sources_changed_by(kind, (s, t, a))
                 getattr(model, kind)(s, t, a)
         after = as_record(model)
         assert _patched(before, model, touched) == (after.source, after.action, after.target)
