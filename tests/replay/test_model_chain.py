@@ -1,5 +1,6 @@
-"""The model chain's fast check: the previous snapshot with the touched states' rows replaced is
-the model the operations make, whatever the operations were."""
+"""What an operation changes, used twice: the model chain's fast check (the previous snapshot
+with the touched states' rows replaced is the model the operations make) and the truth audit's
+tracked successor table (kept through the touched states, equal to one built afresh)."""
 
 from __future__ import annotations
 
@@ -7,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rsstp_replay._models import _patched
+from rsstp_replay.audits._equivalence import ModelTable, TrackedTable
 from rsstp_sim.recording.records import TransitionsRecord
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -30,6 +32,7 @@ def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(
         states = model.states
         model.add(data.draw(st.sampled_from(states)), data.draw(st.sampled_from(states)),
                   data.draw(st.sampled_from((0, 1))))  # fmt: skip
+    tracked = TrackedTable(model, (0, 1))
     for _ in range(data.draw(st.integers(1, 6))):  # one version: several operations
         before = as_record(model)
         touched: set[int] = set()
@@ -52,3 +55,9 @@ def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(
                 getattr(model, kind)(s, t, a)
         after = as_record(model)
         assert _patched(before, model, touched) == (after.source, after.action, after.target)
+        tracked.update(model, touched)
+        labels = {s: bool(s % 2) for s in model.states}
+        fresh, kept = ModelTable.of(model, labels, (0, 1)), tracked.table(labels)
+        assert fresh.states.tolist() == kept.states.tolist()
+        assert fresh.successor.tolist() == kept.successor.tolist()
+        assert fresh.label.tolist() == kept.label.tolist()

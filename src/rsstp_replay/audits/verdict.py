@@ -35,7 +35,12 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from rsstp_replay.audits._equivalence import ModelTable, closure, equivalent_classes
+from rsstp_replay.audits._equivalence import (
+    ModelTable,
+    TrackedTable,
+    closure,
+    equivalent_classes,
+)
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence
@@ -282,8 +287,7 @@ class _Visits:
 
 
 def _judge(
-    model: TransitionSystem,
-    labels: dict[int, bool],
+    table: ModelTable,
     truth: GroundTruth,
     states: _Ints,
     classes: _Ints,
@@ -293,7 +297,6 @@ def _judge(
     """(the model's state at every pair behaves as the pair's class, some state of the model
     behaves as the start pose's class 0). The second is decided only when the first holds,
     or ``always`` (else it is False: the version is not equivalent either way)."""
-    table = ModelTable.of(model, labels, truth.actions)
     rows = np.minimum(table.rows(states), len(table.states) - 1)
     if (table.states[rows] != states).any():
         return False, False  # the contract is broken: a step's state is not in its version
@@ -336,13 +339,18 @@ def judge_versions(
     equivalent = np.zeros(len(versions), np.bool_)
     final_judged = (False, False)
     model: TransitionSystem | None = None
+    tracked: TrackedTable | None = None
     for k, record in enumerate(versions):
-        if model is None:
+        if model is None or tracked is None:
             model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
+            tracked = TrackedTable(model, truth.actions)
         else:
+            changed: set[int] = set()
             for operation in record.operations:
+                changed |= model.sources_changed_by(operation.kind, operation.args)
                 model.apply(operation.to_operation())
             model.drain_operations()
+            tracked.update(model, changed)
         is_final = k == len(versions) - 1
         if len(model) < n_classes and not is_final:
             continue  # a state for each class is needed to behave as the start pose
@@ -355,8 +363,7 @@ def judge_versions(
             continue  # a state stood for two classes
         bound = min(max(int(record.step), int(ends[k]) - 1), steps)
         judged = _judge(
-            model,
-            labels.at(model.states, bound),
+            tracked.table(labels.at(model.states, bound)),
             truth,
             pair_states,
             pair_classes,
