@@ -100,6 +100,11 @@ def _pairs(keys: NDArray[np.int64], values: NDArray[np.int64]) -> NDArray[np.int
     row-wise ``unique``)."""
     if not len(keys):
         return np.empty((0, 2), np.int64)
+    low = min(int(keys.min()), int(values.min()))
+    width = int(values.max()) + 1
+    if low >= 0 and (int(keys.max()) + 1) * width < 2**62:  # one sort of packed pairs
+        packed = np.unique(keys * width + values)
+        return np.stack([packed // width, packed % width], axis=1)
     key_ids, key_codes = _codes(keys)
     value_ids, value_codes = _codes(values)
     combined = np.unique(key_codes * len(value_ids) + value_codes)
