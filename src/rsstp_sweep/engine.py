@@ -90,7 +90,7 @@ def run_sweep(
                 threads_per_worker=1,
                 processes=True,
                 host="127.0.0.1",
-                dashboard_address=None,
+                dashboard_address="127.0.0.1:0",  # any free port: never 8787 taken by another
                 silence_logs=logging.CRITICAL,  # a run's failure is its row and one line
             )
         finally:
