@@ -498,37 +498,34 @@ def _segments_gap(seg: Sequence[float], other: Sequence[float]) -> float:
     )
 
 
-def _in_arc_of(direction: float, start: float, delta: float) -> bool:
-    """:func:`_in_arc` of one angle in plain floats."""
-    rel = (direction - start if delta >= 0 else start - direction) % _TWO_PI
-    return rel <= abs(delta) + _ANGLE_SLACK
-
-
 def _arc_gap(
-    pivot: tuple[float, float], point: tuple[float, float], delta: float, seg: Sequence[float]
+    px: float, py: float, qx: float, qy: float, delta: float, seg: Sequence[float]
 ) -> float:
-    """:func:`arc_segment_distance` of one arc and segment ``(ax, ay, bx, by)`` in plain
-    floats: the same candidates, measured the same way."""
-    px, py = pivot
-    qx, qy = point
+    """:func:`arc_segment_distance` of one arc (``(qx, qy)`` turned about ``(px, py)`` by
+    ``delta``) and one segment ``(ax, ay, bx, by)`` in plain floats: the same candidates,
+    measured the same way."""
     ax, ay, bx, by = seg
+    atan2, hypot = math.atan2, math.hypot
     vx, vy = qx - px, qy - py
-    rho = math.hypot(vx, vy)
-    start = math.atan2(vy, vx)
+    rho = hypot(vx, vy)
+    start = atan2(vy, vx)
+    span = abs(delta) + _ANGLE_SLACK
+    forward = delta >= 0
     c, s = math.cos(delta), math.sin(delta)
     ex, ey = px + (vx * c - vy * s), py + (vx * s + vy * c)
     best = min(_gap(qx, qy, ax, ay, bx, by), _gap(ex, ey, ax, ay, bx, by))
     for x, y in ((ax, ay), (bx, by)):
         wx, wy = x - px, y - py
-        if _in_arc_of(math.atan2(wy, wx), start, delta):
-            best = min(best, abs(math.hypot(wx, wy) - rho))
+        direction = atan2(wy, wx)
+        if (direction - start if forward else start - direction) % _TWO_PI <= span:
+            best = min(best, abs(hypot(wx, wy) - rho))
         else:
-            best = min(best, math.hypot(x - qx, y - qy), math.hypot(x - ex, y - ey))
+            best = min(best, hypot(x - qx, y - qy), hypot(x - ex, y - ey))
     abx, aby = bx - ax, by - ay
     ab2 = abx * abx + aby * aby
     t = ((px - ax) * abx + (py - ay) * aby) / ab2
     fx, fy = ax + t * abx, ay + t * aby
-    h = math.hypot(fx - px, fy - py)
+    h = hypot(fx - px, fy - py)
     candidates = []
     if h > 0:
         nx, ny = (fx - px) / h, (fy - py) / h
@@ -537,7 +534,8 @@ def _arc_gap(
         chord = math.sqrt(max(rho * rho - h * h, 0.0)) / math.sqrt(ab2)
         candidates += [(fx + chord * abx, fy + chord * aby), (fx - chord * abx, fy - chord * aby)]
     for x, y in candidates:
-        if _in_arc_of(math.atan2(y - py, x - px), start, delta):
+        direction = atan2(y - py, x - px)
+        if (direction - start if forward else start - direction) % _TWO_PI <= span:
             best = min(best, _gap(x, y, ax, ay, bx, by))
     return best
 
@@ -621,7 +619,7 @@ def _move_blocker(
             if hypot(cx - mx, cy - my) - half > bound or _gap(cx, cy, ax, ay, bx, by) > bound:
                 continue
             if swept:
-                distance = _arc_gap((px, py), (cx, cy), -delta, (ax, ay, bx, by))
+                distance = _arc_gap(px, py, cx, cy, -delta, (ax, ay, bx, by))
             else:
                 distance = _gap(cx, cy, ax, ay, bx, by)
             if _meets(distance, radius + eps, unsure):
@@ -640,10 +638,10 @@ def _move_blocker(
                 continue
             if swept:
                 distance = min(
-                    _arc_gap((px, py), (seg[0], seg[1]), delta, fixed),
-                    _arc_gap((px, py), (seg[2], seg[3]), delta, fixed),
-                    _arc_gap((px, py), (fixed[0], fixed[1]), -delta, seg),
-                    _arc_gap((px, py), (fixed[2], fixed[3]), -delta, seg),
+                    _arc_gap(px, py, seg[0], seg[1], delta, fixed),
+                    _arc_gap(px, py, seg[2], seg[3], delta, fixed),
+                    _arc_gap(px, py, fixed[0], fixed[1], -delta, seg),
+                    _arc_gap(px, py, fixed[2], fixed[3], -delta, seg),
                 )
             else:
                 distance = _segments_gap(fixed, seg)
@@ -685,20 +683,18 @@ def feedback_reach(points: ArrayLike, lengths: ArrayLike) -> FloatArray:
 
 def pose_feedback(
     points: Sequence[float],
-    feedback_points: Sequence[tuple[float, float]],
+    feedback_points: FloatArray,
     reach: Sequence[float],
     tolerance_abs: float,
 ) -> tuple[bool, float]:
     """:func:`feedback` of one pose given as :func:`pose_points`, equal to it bit for bit.
 
-    ``reach`` is :func:`feedback_reach`. The distances go through numpy's ``hypot`` (Python's
-    rounds differently in rare cases); numpy's mean of at most seven values adds them in
-    order, as here.
+    ``feedback_points`` is the ``(n, 2)`` array of points, ``reach`` :func:`feedback_reach`.
+    The distances go through numpy's ``hypot`` (Python's rounds differently in rare cases);
+    numpy's mean of at most seven values adds them in order, as here.
     """
-    gaps: list[float] = np.hypot(
-        [points[2 * k + 2] - fx for k, (fx, _) in enumerate(feedback_points)],
-        [points[2 * k + 3] - fy for k, (_, fy) in enumerate(feedback_points)],
-    ).tolist()
+    tips = np.array(points[2:]).reshape(-1, 2) - feedback_points
+    gaps: list[float] = np.hypot(tips[:, 0], tips[:, 1]).tolist()
     total = 0.0
     for k, (gap, r) in enumerate(zip(gaps, reach, strict=True)):
         c = 1.0 - gap / r

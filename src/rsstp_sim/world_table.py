@@ -142,7 +142,6 @@ class WorldTable:
         self._points = np.asarray(scenario.feedback_points, dtype=np.float64)
         self._tolerance_abs = scenario.tolerance * scenario.total_length
         # The same in plain Python numbers, for the move-by-move path.
-        self._point_list = [(float(x), float(y)) for x, y in self._points.tolist()]
         self._reach = geometry.feedback_reach(self._points, self.geometry.lengths).tolist()
         self._joint_list: list[int] = self._joint.tolist()
         self._delta_list: list[int] = self._delta.tolist()
@@ -272,7 +271,7 @@ class WorldTable:
         row = len(self.codes)
         points = geometry.pose_points(angles, self.geometry.link_lengths, known=known, first=first)
         sensation, closeness = geometry.pose_feedback(
-            points, self._point_list, self._reach, self._tolerance_abs
+            points, self._points, self._reach, self._tolerance_abs
         )
         if self._dense is None:
             self._row_of[code] = row
