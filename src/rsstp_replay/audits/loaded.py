@@ -3,8 +3,9 @@
 Decoding a recording's steps is the cost of an audit (a million steps take seconds), and a
 command that runs several audits (``rsstp-replay audit --truth``) would otherwise decode them
 once per audit, and hold each copy. :func:`load` reads the steps table (without the joint
-positions and distances, which no audit reads), the model messages and the memory once; the
-memory is built from the table's columns, so nothing is decoded twice. The result has the
+positions and distances, and without what blocked a move beyond the ``blocked`` flag: no
+audit reads them, and they were half the table), the model messages and the memory once;
+the memory is built from the table's columns, so nothing is decoded twice. The result has the
 methods the audits read, so it is passed to each audit in place of the recording.
 """
 
@@ -17,6 +18,7 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd
 
+from rsstp_replay._decode import BLOCKED_COLUMNS
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
@@ -36,7 +38,10 @@ class LoadedRecording:
 
     def __init__(self, source: _Source) -> None:
         self.source = source
-        self._steps = source.steps(geometry=False)
+        detail = [column for names in BLOCKED_COLUMNS.values() for column in names]
+        self._steps = source.steps(geometry=False).drop(
+            columns=["blocked_kind", *detail], errors="ignore"
+        )
         self._models = tuple(source.model_versions())
         table = self._steps
         self._memory = Memory.from_arrays(
@@ -57,7 +62,7 @@ class LoadedRecording:
 
     def steps(self, *, geometry: bool = True) -> pd.DataFrame:
         """The steps table without the joint positions and distances (``geometry`` is
-        ignored: the audits do not read them)."""
+        ignored: the audits do not read them), ``blocked_kind`` and the blocker's indices."""
         return self._steps
 
     def memory(self) -> Memory:
