@@ -13,11 +13,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-import numpy as np
-
 from rsstp_sim._arrays import FloatArray
 from rsstp_sim.errors import ActionError, UnknownPose
-from rsstp_sim.geometry import Blocker, obstacle_distances
+from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.world_table import WorldTable
 
@@ -60,21 +58,14 @@ class Pose:
     @property
     def joint_positions(self) -> FloatArray:
         if self._positions is None:
-            table, row = self._table, self._row
-            flat = table.positions[row * table.width : (row + 1) * table.width]
-            positions = np.frombuffer(flat, dtype=np.float64).reshape(-1, 2)
-            positions.flags.writeable = False
-            object.__setattr__(self, "_positions", positions)
+            object.__setattr__(self, "_positions", self._table.positions_of(self._row))
         assert self._positions is not None
         return self._positions
 
     @property
     def distances(self) -> FloatArray:
         if self._distances is None:
-            geo = self._table.geometry
-            distances = obstacle_distances(self.joint_positions[1:], geo.centers, geo.radii)
-            distances.flags.writeable = False
-            object.__setattr__(self, "_distances", distances)
+            object.__setattr__(self, "_distances", self._table.distances_of(self._row))
         assert self._distances is not None
         return self._distances
 

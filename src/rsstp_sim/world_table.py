@@ -28,8 +28,8 @@ tabulated, where nearly every move reaches a new pose. A pose space of at most
 a dict of the poses reached.
 
 Every row keeps its pose's :func:`~rsstp_sim.geometry.pose_points` (the base and the link
-tips, flat), its sensation and its float feedback, in growable arrays: a few hundred bytes a
-pose, whichever way it was computed.
+tips, flat), its obstacle distances, its sensation and its float feedback, in growable
+arrays: a few hundred bytes a pose, whichever way it was computed.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from rsstp_sim import geometry
-from rsstp_sim._arrays import BoolArray, Int32Array, IntArray
+from rsstp_sim._arrays import BoolArray, FloatArray, Int32Array, IntArray
 from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.scenario import Scenario
 
@@ -157,6 +157,11 @@ class WorldTable:
         self.feedback = array.array("d")
         self.positions = array.array("d")
         """Every row's :func:`~rsstp_sim.geometry.pose_points`, :attr:`width` floats a row."""
+        self.distances = array.array("d")
+        """Every row's :func:`~rsstp_sim.geometry.obstacle_distances` (``n * m`` floats a
+        row) when its pose came in a block; NaN for a pose added alone (see :meth:`step`),
+        whose distances its reader computes (:meth:`distances_of`)."""
+        self._unknown_distances = array.array("d", [math.nan] * (n * self.geometry.m))
         self.dense = pose_space_size(scenario) <= DENSE_LIMIT
         # Rows by pose code: a dense array over a small lattice, else a dict of the poses
         # reached.
@@ -279,6 +284,7 @@ class WorldTable:
             self._dense[self._cell(angles)] = row
         self.codes.append(code)
         self.positions.extend(points)
+        self.distances.extend(self._unknown_distances)
         self.sensation.append(sensation)
         self.feedback.append(closeness)
         self.next_row.extend(self._blank_moves)
@@ -350,9 +356,11 @@ class WorldTable:
         rows = np.arange(first, first + len(codes), dtype=np.int32)
         angles = (codes[:, None] // self.radix) % 360
         positions = geometry.joint_positions(angles, self.geometry.lengths)
+        tips = positions[:, 1:]
         sensation, closeness = geometry.feedback(
-            positions[:, 1:], self._points, self.geometry.lengths, self._tolerance_abs
+            tips, self._points, self.geometry.lengths, self._tolerance_abs
         )
+        distances = geometry.obstacle_distances(tips, self.geometry.centers, self.geometry.radii)
         if self._dense is not None:
             cells = (((angles - self._initial) % 360) // self._spacing) @ self._lattice_radix
             self._dense[cells] = rows
@@ -360,6 +368,7 @@ class WorldTable:
             self._row_of.update(zip(codes.tolist(), rows.tolist(), strict=True))
         self.codes.frombytes(codes.astype(np.int64).tobytes())
         self.positions.frombytes(positions.tobytes())
+        self.distances.frombytes(distances.tobytes())
         self.sensation.frombytes(sensation.astype(np.int8).tobytes())
         self.feedback.frombytes(closeness.astype(np.float64).tobytes())
         blank = len(codes) * len(self.actions)
@@ -375,6 +384,27 @@ class WorldTable:
     def blocker_array(self) -> Int32Array:
         """``blocker`` as a ``(rows, actions)`` numpy view (valid until the table grows)."""
         return np.frombuffer(self.blocker, dtype=np.int32).reshape(-1, len(self.actions))
+
+    def positions_of(self, row: int) -> FloatArray:
+        """``(n + 1, 2)`` the base and every link tip of a row (a read-only copy)."""
+        width = self.width
+        positions = np.frombuffer(self.positions[row * width : (row + 1) * width])
+        positions.flags.writeable = False
+        return positions.reshape(-1, 2)
+
+    def distances_of(self, row: int) -> FloatArray:
+        """``(n, m)`` from every tip of a row to every obstacle's surface (a read-only copy),
+        computed now when the row's pose was added alone."""
+        n, m = self.geometry.n, self.geometry.m
+        distances = np.frombuffer(self.distances[row * n * m : (row + 1) * n * m])
+        if m and math.isnan(distances[0]):
+            tips = self.positions_of(row)[1:]
+            distances = geometry.obstacle_distances(
+                tips, self.geometry.centers, self.geometry.radii
+            )
+            self.distances[row * n * m : (row + 1) * n * m] = array.array("d", distances.tobytes())
+        distances.flags.writeable = False
+        return distances.reshape(n, m)
 
     def angles(self) -> IntArray:
         """``(rows, n)`` joint angles of every row."""
