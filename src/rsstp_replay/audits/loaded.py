@@ -44,12 +44,21 @@ class LoadedRecording:
         )
         self._models = tuple(source.model_versions())
         table = self._steps
-        self._memory = Memory.from_arrays(
+        self._memory = memory = Memory.from_arrays(
             table["action"].to_numpy(np.int64, na_value=-1),
             table["internal_state"].to_numpy(np.int64),
             table["sensation"].to_numpy(np.bool_),
             table["feedback"].to_numpy(np.float64),
         )
+        # The memory's columns are the table's, value for value: the table reads them from
+        # the memory instead of keeping a copy.
+        shared = {
+            "internal_state": memory.internal_states,
+            "sensation": memory.sensations,
+            "feedback": memory.feedback,
+        }
+        columns = {name: shared.get(name, table[name].array) for name in table.columns}
+        self._steps = pd.DataFrame(columns, index=table.index, copy=False)
 
     @property
     def scenario(self) -> Scenario:
