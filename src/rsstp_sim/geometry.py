@@ -604,12 +604,14 @@ def _move_blocker(
     # of where it starts, and the link within half its length of its midpoint. A contact
     # farther than that, with 2 eps to spare for rounding, cannot be met.
     mids: list[tuple[float, float, float]] = []  # a moving link's midpoint and its bound
+    near = 0.0  # the moving link's start from the pivot (the first one starts there)
     for j in range(joint, n):
         ax, ay, bx, by = points[2 * j : 2 * j + 4]
         mx, my = 0.5 * (ax + bx), 0.5 * (ay + by)
         if turn:
-            near, far = hypot(ax - px, ay - py), hypot(bx - px, by - py)
+            far = hypot(bx - px, by - py)  # and its end, the next link's start
             sweep = turn * (far if far > near else near) + 4 * eps
+            near = far
         else:
             sweep = 4 * eps
         mids.append((mx, my, sweep))
