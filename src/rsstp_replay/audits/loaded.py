@@ -5,14 +5,16 @@ command that runs several audits (``rsstp-replay audit --truth``) would otherwis
 once per audit, and hold each copy. :func:`load` reads the steps table (without the joint
 positions and distances, and without what blocked a move beyond the ``blocked`` flag: no
 audit reads them, and they were half the table), the model messages and the memory once;
-the memory is built from the table's columns, so nothing is decoded twice. The result has the
+the memory is built from the table's columns, so nothing is decoded twice, and the table
+then reads those columns from the memory. Ten million steps are audited in about 200 bytes
+a step. The result has the
 methods the audits read, so it is passed to each audit in place of the recording.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import numpy.typing as npt
@@ -51,13 +53,20 @@ class LoadedRecording:
             table["feedback"].to_numpy(np.float64),
         )
         # The memory's columns are the table's, value for value: the table reads them from
-        # the memory instead of keeping a copy.
+        # the memory instead of keeping a copy; the joint angles (0 .. 359) take two bytes.
         shared = {
             "internal_state": memory.internal_states,
             "sensation": memory.sensations,
             "feedback": memory.feedback,
         }
-        columns = {name: shared.get(name, table[name].array) for name in table.columns}
+        columns: dict[str, Any] = {}
+        for name in table.columns:
+            if name in shared:
+                columns[name] = shared[name]
+            elif name.startswith("angle_deg_"):
+                columns[name] = table[name].to_numpy(np.int16)
+            else:
+                columns[name] = table[name].array
         self._steps = pd.DataFrame(columns, index=table.index, copy=False)
 
     @property
@@ -71,7 +80,8 @@ class LoadedRecording:
 
     def steps(self, *, geometry: bool = True) -> pd.DataFrame:
         """The steps table without the joint positions and distances (``geometry`` is
-        ignored: the audits do not read them), ``blocked_kind`` and the blocker's indices."""
+        ignored: the audits do not read them), ``blocked_kind`` and the blocker's indices;
+        the ``angle_deg_{j}`` columns in int16."""
         return self._steps
 
     def memory(self) -> Memory:
