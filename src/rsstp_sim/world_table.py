@@ -195,7 +195,7 @@ class WorldTable:
 
     def complete(self) -> None:
         """Compute every reachable pose and all its moves (breadth first from the start)."""
-        frontier = np.flatnonzero(self.next_array()[:, 0] < 0)
+        frontier = np.flatnonzero((self.next_array() < 0).any(axis=1))
         while frontier.size:
             first_new = len(self.codes)
             self._compute_moves(frontier)
@@ -213,7 +213,7 @@ class WorldTable:
             done += len(frontier)
             nxt = self.next_array()
             reached = np.unique(nxt[frontier].ravel())
-            frontier = reached[nxt[reached, 0] < 0]
+            frontier = reached[(nxt[reached] < 0).any(axis=1)]
             del nxt
         assert self.next_row[row * n_actions] >= 0
 

@@ -17,6 +17,7 @@ from rsstp_sim.errors import ActionError
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 from rsstp_sim.world import World
+from rsstp_sim.world_table import WorldTable
 from scenarios import arm_toml
 
 SAMPLE_DEG = 0.25
@@ -364,6 +365,33 @@ def test_a_large_pose_space_grows_with_the_walk(scenario_text) -> None:
     assert sorted(table.codes) == sorted(visited)
     assert np.count_nonzero(table.next_array() >= 0) == len(moves)  # the moves made, no other
     assert len(table.positions) == len(visited) * table.width
+
+
+def test_a_table_grown_move_by_move_completes_to_the_whole_table() -> None:
+    """Moves computed one at a time, then the rest in blocks: the same reachable poses and
+    moves as a table computed whole."""
+    scenario = load_scenario("two-joint-30")
+    world = World(scenario, per_move=True)
+    rng = np.random.default_rng(5)
+    for action in rng.choice(scenario.actions, size=300).tolist():
+        world.move(action)
+    grown, whole = world.table, WorldTable(scenario)
+    computed = grown.next_array() >= 0
+    assert (computed.any(axis=1) & ~computed.all(axis=1)).any()  # poses with some moves known
+    grown.complete()
+    whole.complete()
+
+    def moves(table: WorldTable) -> dict[tuple[int, int], tuple[int, int]]:
+        codes = np.frombuffer(table.codes, dtype=np.int64)
+        targets = codes[table.next_array()]
+        return {
+            (int(code), k): (int(targets[row, k]), int(table.blocker_array()[row, k]))
+            for row, code in enumerate(codes.tolist())
+            for k in range(table.n_actions)
+        }
+
+    assert (grown.next_array() >= 0).all()
+    assert moves(grown) == moves(whole)
 
 
 # -- reset, peek, actions -----------------------------------------------------------------------
