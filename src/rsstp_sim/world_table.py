@@ -213,7 +213,7 @@ class WorldTable:
             done += len(frontier)
             nxt = self.next_array()
             reached = np.unique(nxt[frontier].ravel())
-            frontier = reached[(nxt[reached] < 0).any(axis=1)]
+            frontier = reached[(nxt[reached] < 0).any(axis=1)].astype(np.int64)
             del nxt
         assert self.next_row[row * n_actions] >= 0
 
