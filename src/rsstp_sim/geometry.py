@@ -2,7 +2,12 @@
 
 Everything here is vectorised over a batch of poses so that the world (one
 pose at a time, cached) and the ground-truth enumeration (whole frontiers at
-once) share one implementation.
+once) share one implementation. A world too large to tabulate in blocks asks
+one move at a time: :func:`pose_points`, :func:`pose_feedback` and
+:func:`move_blocker` give the same answers, bit for bit, in plain Python floats
+(a numpy call costs more than a whole move's arithmetic), and
+:func:`move_blocker` leaves to :func:`move_blockers` every contact too near its
+threshold to be settled without numpy's own rounding.
 
 Conventions (``docs/world.md``): joint angles are integer
 degrees in ``[0, 360)``; angle ``i`` is relative to link ``i-1`` (the first to
