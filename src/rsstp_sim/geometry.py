@@ -2,7 +2,12 @@
 
 Everything here is vectorised over a batch of poses so that the world (one
 pose at a time, cached) and the ground-truth enumeration (whole frontiers at
-once) share one implementation.
+once) share one implementation. A world too large to tabulate in blocks asks
+one move at a time: :func:`pose_points`, :func:`pose_feedback` and
+:func:`move_blocker` give the same answers, bit for bit, in plain Python floats
+(a numpy call costs more than a whole move's arithmetic), and
+:func:`move_blocker` leaves to :func:`move_blockers` every contact too near its
+threshold to be settled without numpy's own rounding.
 
 Conventions (``docs/world.md``): joint angles are integer
 degrees in ``[0, 360)``; angle ``i`` is relative to link ``i-1`` (the first to
@@ -36,12 +41,16 @@ __all__ = [
     "SIN_DEG",
     "arc_segment_distance",
     "feedback",
+    "feedback_reach",
     "joint_positions",
+    "move_blocker",
     "move_blockers",
     "obstacle_distances",
     "point_segment_distance",
+    "pose_points",
     "pose_blocker",
     "pose_blockers",
+    "pose_feedback",
     "segment_distance",
 ]
 
@@ -63,6 +72,8 @@ def _trig_tables() -> tuple[FloatArray, FloatArray]:
 
 COS_DEG, SIN_DEG = _trig_tables()
 """Cosine and sine of every integer degree 0..359 (exact on the axes)."""
+_COS_LIST: list[float] = COS_DEG.tolist()
+_SIN_LIST: list[float] = SIN_DEG.tolist()
 
 _TWO_PI = 2.0 * np.pi
 _ANGLE_SLACK = 1e-12
@@ -81,6 +92,36 @@ def joint_positions(angles_deg: ArrayLike, lengths: ArrayLike) -> FloatArray:
     steps = np.stack([COS_DEG[phi], SIN_DEG[phi]], axis=-1) * lengths_arr[:, None]
     zeros = np.zeros((*theta.shape[:-1], 1, 2), dtype=np.float64)
     return np.concatenate([zeros, np.cumsum(steps, axis=-2)], axis=-2)
+
+
+def pose_points(
+    angles_deg: Sequence[int],
+    lengths: Sequence[float],
+    *,
+    known: Sequence[float] = (),
+    first: int = 0,
+) -> list[float]:
+    """:func:`joint_positions` of one pose in plain floats, ``[x0, y0, x1, y1, ...]``.
+
+    Equal bit for bit to :func:`joint_positions` (the same products of the same table
+    entries, summed in the same order), without numpy's per-call cost: the world's
+    per-move path computes a new pose with it. ``known``: the points of a pose whose links
+    before ``first`` are this pose's (a move of joint ``first``), kept as they are.
+    """
+    cos, sin = _COS_LIST, _SIN_LIST
+    points = list(known[: 2 * first + 2]) if first else [0.0, 0.0]
+    phi = sum(angles_deg[:first]) % 360
+    x, y = points[-2], points[-1]
+    for k in range(first, len(lengths)):
+        phi = (phi + angles_deg[k]) % 360
+        length = lengths[k]
+        dx, dy = cos[phi] * length, sin[phi] * length
+        if k:
+            x, y = x + dx, y + dy
+        else:  # numpy's cumsum starts from the first term itself, not from 0.0 + it
+            x, y = dx, dy
+        points += (x, y)
+    return points
 
 
 def point_segment_distance(x: ArrayLike, a: ArrayLike, b: ArrayLike) -> FloatArray:
@@ -227,10 +268,21 @@ class ArmGeometry:
     """Links (one per joint): ``len(lengths)``."""
     m: int = field(init=False)
     """Obstacles: ``len(radii)``."""
+    link_lengths: tuple[float, ...] = field(init=False, repr=False, compare=False)
+    """``lengths`` in plain floats (for :func:`move_blocker`)."""
+    half_lengths: tuple[float, ...] = field(init=False, repr=False, compare=False)
+    """Half of every link's length in plain floats (for :func:`move_blocker`)."""
+    disks: tuple[tuple[float, float, float], ...] = field(init=False, repr=False, compare=False)
+    """Every obstacle's ``(x, y, radius)`` in plain floats (for :func:`move_blocker`)."""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "n", int(self.lengths.shape[0]))
         object.__setattr__(self, "m", int(self.radii.shape[0]))
+        object.__setattr__(self, "link_lengths", tuple(self.lengths.tolist()))
+        object.__setattr__(self, "half_lengths", tuple((self.lengths * 0.5).tolist()))
+        centers, radii = self.centers.tolist(), self.radii.tolist()
+        disks = tuple((x, y, r) for (x, y), r in zip(centers, radii, strict=True))
+        object.__setattr__(self, "disks", disks)
 
     @classmethod
     def from_scenario(cls, scenario: _ScenarioLike) -> ArmGeometry:
@@ -424,6 +476,193 @@ def move_blockers(
     return _first_codes(geo, fold, obstacle, links, fold_joint)
 
 
+def _gap(px: float, py: float, ax: float, ay: float, bx: float, by: float) -> float:
+    """:func:`point_segment_distance` of one point in plain floats (a bound's input only)."""
+    abx, aby = bx - ax, by - ay
+    denom = abx * abx + aby * aby
+    t = ((px - ax) * abx + (py - ay) * aby) / denom if denom > 0 else 0.0
+    t = 0.0 if t < 0.0 else 1.0 if t > 1.0 else t
+    return math.hypot(px - ax - t * abx, py - ay - t * aby)
+
+
+def _segments_gap(seg: Sequence[float], other: Sequence[float]) -> float:
+    """:func:`segment_distance` of two segments ``(ax, ay, bx, by)`` in plain floats."""
+    ax, ay, bx, by = seg
+    cx, cy, dx, dy = other
+    o1 = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
+    o2 = (bx - ax) * (dy - ay) - (by - ay) * (dx - ax)
+    o3 = (dx - cx) * (ay - cy) - (dy - cy) * (ax - cx)
+    o4 = (dx - cx) * (by - cy) - (dy - cy) * (bx - cx)
+    if o1 * o2 < 0 and o3 * o4 < 0:
+        return 0.0
+    return min(
+        _gap(ax, ay, cx, cy, dx, dy),
+        _gap(bx, by, cx, cy, dx, dy),
+        _gap(cx, cy, ax, ay, bx, by),
+        _gap(dx, dy, ax, ay, bx, by),
+    )
+
+
+def _arc_gap(
+    px: float, py: float, qx: float, qy: float, delta: float, seg: Sequence[float]
+) -> float:
+    """:func:`arc_segment_distance` of one arc (``(qx, qy)`` turned about ``(px, py)`` by
+    ``delta``) and one segment ``(ax, ay, bx, by)`` in plain floats: the same candidates,
+    measured the same way."""
+    ax, ay, bx, by = seg
+    atan2, hypot = math.atan2, math.hypot
+    vx, vy = qx - px, qy - py
+    rho = hypot(vx, vy)
+    start = atan2(vy, vx)
+    span = abs(delta) + _ANGLE_SLACK
+    forward = delta >= 0
+    c, s = math.cos(delta), math.sin(delta)
+    ex, ey = px + (vx * c - vy * s), py + (vx * s + vy * c)
+    best = min(_gap(qx, qy, ax, ay, bx, by), _gap(ex, ey, ax, ay, bx, by))
+    for x, y in ((ax, ay), (bx, by)):
+        wx, wy = x - px, y - py
+        direction = atan2(wy, wx)
+        if (direction - start if forward else start - direction) % _TWO_PI <= span:
+            best = min(best, abs(hypot(wx, wy) - rho))
+        else:
+            best = min(best, hypot(x - qx, y - qy), hypot(x - ex, y - ey))
+    abx, aby = bx - ax, by - ay
+    ab2 = abx * abx + aby * aby
+    t = ((px - ax) * abx + (py - ay) * aby) / ab2
+    fx, fy = ax + t * abx, ay + t * aby
+    h = hypot(fx - px, fy - py)
+    candidates = []
+    if h > 0:
+        nx, ny = (fx - px) / h, (fy - py) / h
+        candidates += [(px + rho * nx, py + rho * ny), (px - rho * nx, py - rho * ny)]
+    if rho >= h:
+        chord = math.sqrt(max(rho * rho - h * h, 0.0)) / math.sqrt(ab2)
+        candidates += [(fx + chord * abx, fy + chord * aby), (fx - chord * abx, fy - chord * aby)]
+    for x, y in candidates:
+        direction = atan2(y - py, x - px)
+        if (direction - start if forward else start - direction) % _TWO_PI <= span:
+            best = min(best, _gap(x, y, ax, ay, bx, by))
+    return best
+
+
+class _Unsure(Exception):
+    """A plain-float distance too near its threshold to decide against numpy's rounding."""
+
+
+def _meets(distance: float, threshold: float, margin: float) -> bool:
+    if abs(distance - threshold) <= margin:
+        raise _Unsure
+    return distance <= threshold
+
+
+def move_blocker(
+    geo: ArmGeometry, angles_deg: Sequence[int], points: Sequence[float], joint: int, delta_deg: int
+) -> int:
+    """The blocker code of one move, equal to :func:`move_blockers` on a batch of one.
+
+    ``points`` are the start pose's :func:`pose_points`. The same tests as
+    :func:`move_blockers` (the fold; in swept mode each moving link against each obstacle and
+    each fixed link, first through the sweep bounds, then exactly; in endpoint mode the end
+    pose's links against the obstacles and each other), in the same order, in plain floats:
+    a new pose costs a few dozen float operations, not numpy's per-call cost. A distance
+    within a hair (:data:`_UNSURE` of the arm's length) of its threshold, where plain floats
+    and numpy could round to different sides, is left to :func:`move_blockers` itself, so
+    the answer is always numpy's.
+    """
+    try:
+        return _move_blocker(geo, angles_deg, points, joint, delta_deg)
+    except _Unsure:
+        return int(move_blockers(geo, [list(angles_deg)], [joint], [delta_deg])[0])
+
+
+_UNSURE = 1e-11
+"""The band around a contact threshold (a fraction of the arm's length, a hundredth of
+:data:`CONTACT_EPS`) in which :func:`move_blocker` defers to :func:`move_blockers`."""
+
+
+def _move_blocker(
+    geo: ArmGeometry, angles_deg: Sequence[int], points: Sequence[float], joint: int, delta_deg: int
+) -> int:
+    n, m, halves, eps = geo.n, geo.m, geo.half_lengths, geo.eps
+    unsure = eps * (_UNSURE / CONTACT_EPS)
+    hypot = math.hypot
+    swept = geo.swept
+    if swept:
+        if joint:
+            theta = angles_deg[joint]
+            rel = (180 - theta) % 360 if delta_deg >= 0 else (theta - 180) % 360
+            if rel <= abs(delta_deg):
+                return joint  # the fold, which move_blockers reports before any contact
+        px, py = points[2 * joint], points[2 * joint + 1]
+        delta = math.radians(delta_deg)
+    else:  # only the end pose counts: every link against everything
+        end = list(angles_deg)
+        end[joint] = (end[joint] + delta_deg) % 360
+        for k in range(1, n):
+            if end[k] == 180:
+                return k
+        points = pose_points(end, geo.link_lengths)
+        px = py = delta = 0.0
+        joint = 0
+    turn = abs(delta)
+    # Each moving link's bound (move_blockers' filters): every point stays within its sweep
+    # of where it starts, and the link within half its length of its midpoint. A contact
+    # farther than that, with 2 eps to spare for rounding, cannot be met.
+    mids: list[tuple[float, float, float]] = []  # a moving link's midpoint and its bound
+    near = 0.0  # the moving link's start from the pivot (the first one starts there)
+    for j in range(joint, n):
+        ax, ay, bx, by = points[2 * j : 2 * j + 4]
+        mx, my = 0.5 * (ax + bx), 0.5 * (ay + by)
+        if turn:
+            far = hypot(bx - px, by - py)  # and its end, the next link's start
+            sweep = turn * (far if far > near else near) + 4 * eps
+            near = far
+        else:
+            sweep = 4 * eps
+        mids.append((mx, my, sweep))
+        half = halves[j]
+        for o, (cx, cy, radius) in enumerate(geo.disks):
+            bound = radius + eps + sweep
+            if hypot(cx - mx, cy - my) - half > bound or _gap(cx, cy, ax, ay, bx, by) > bound:
+                continue
+            if swept:
+                distance = _arc_gap(px, py, cx, cy, -delta, (ax, ay, bx, by))
+            else:
+                distance = _gap(cx, cy, ax, ay, bx, by)
+            if _meets(distance, radius + eps, unsure):
+                return n + j * m + o
+    for i in range(joint if swept else n):
+        fixed = points[2 * i : 2 * i + 4]
+        fx, fy = 0.5 * (fixed[0] + fixed[2]), 0.5 * (fixed[1] + fixed[3])
+        half_i = halves[i]
+        for j in range(max(joint, i + 2), n):
+            mx, my, sweep = mids[j - joint]
+            bound = eps + sweep
+            if hypot(fx - mx, fy - my) - half_i - halves[j] > bound:
+                continue
+            seg = points[2 * j : 2 * j + 4]
+            if _segments_gap(fixed, seg) > bound:
+                continue
+            if swept:
+                distance = min(
+                    _arc_gap(px, py, seg[0], seg[1], delta, fixed),
+                    _arc_gap(px, py, seg[2], seg[3], delta, fixed),
+                    _arc_gap(px, py, fixed[0], fixed[1], -delta, seg),
+                    _arc_gap(px, py, fixed[2], fixed[3], -delta, seg),
+                )
+            else:
+                distance = _segments_gap(fixed, seg)
+            if _meets(distance, eps, unsure):
+                return n + n * m + i * n + j
+    return 0
+
+
+def _exact_move_blocker(
+    geo: ArmGeometry, angles_deg: Sequence[int], joint: int, delta_deg: int
+) -> int:
+    return int(move_blockers(geo, [list(angles_deg)], [joint], [delta_deg])[0])
+
+
 def feedback(
     tips: ArrayLike, points: ArrayLike, lengths: ArrayLike, tolerance_abs: float
 ) -> tuple[NDArray[np.bool_], FloatArray]:
@@ -436,10 +675,39 @@ def feedback(
     tips_ = np.asarray(tips, dtype=np.float64)
     points_ = np.asarray(points, dtype=np.float64)
     gap = np.hypot(*np.moveaxis(tips_ - points_, -1, 0))
-    reach = np.hypot(points_[:, 0], points_[:, 1]) + np.cumsum(np.asarray(lengths, np.float64))
+    reach = feedback_reach(points_, lengths)
     sensation = np.all(gap <= tolerance_abs, axis=-1)
     closeness = np.clip(1.0 - gap / reach, 0.0, 1.0).mean(axis=-1)
     return np.asarray(sensation), np.asarray(closeness, dtype=np.float64)
+
+
+def feedback_reach(points: ArrayLike, lengths: ArrayLike) -> FloatArray:
+    """The denominators of :func:`feedback`'s closeness: ``|f_k| + sum_{i<=k} L_i``."""
+    points_ = np.asarray(points, dtype=np.float64)
+    reach = np.hypot(points_[:, 0], points_[:, 1]) + np.cumsum(np.asarray(lengths, np.float64))
+    return np.asarray(reach, dtype=np.float64)
+
+
+def pose_feedback(
+    points: Sequence[float],
+    feedback_points: FloatArray,
+    reach: Sequence[float],
+    tolerance_abs: float,
+) -> tuple[bool, float]:
+    """:func:`feedback` of one pose given as :func:`pose_points`, equal to it bit for bit.
+
+    ``feedback_points`` is the ``(n, 2)`` array of points, ``reach`` :func:`feedback_reach`.
+    The distances go through numpy's ``hypot`` (Python's rounds differently in rare cases);
+    numpy's mean of at most seven values adds them in order, as here.
+    """
+    tips = np.array(points[2:]).reshape(-1, 2) - feedback_points
+    gaps: list[float] = np.hypot(tips[:, 0], tips[:, 1]).tolist()
+    total = 0.0
+    for k, (gap, r) in enumerate(zip(gaps, reach, strict=True)):
+        c = 1.0 - gap / r
+        c = 0.0 if c < 0.0 else 1.0 if c > 1.0 else c
+        total = total + c if k else c
+    return max(gaps) <= tolerance_abs, total / len(gaps)
 
 
 def obstacle_distances(tips: ArrayLike, centers: ArrayLike, radii: ArrayLike) -> FloatArray:

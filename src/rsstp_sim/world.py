@@ -3,13 +3,15 @@
 The world knows nothing about the agent, its model or any recording. Its answer
 for a move depends only on the pose and the action, and the pose space is
 finite (integer angles), so every answer comes from the scenario's
-:class:`~rsstp_sim.world_table.WorldTable`: computed once, in vectorised
-batches, and read back with a couple of array lookups per move.
+:class:`~rsstp_sim.world_table.WorldTable`, computed once and read back with a
+couple of array lookups per move: a small pose space's in vectorised blocks
+around the arm, a large one's (many links, small steps) move by move, each new
+move checked alone.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from rsstp_sim._arrays import FloatArray
 from rsstp_sim.errors import ActionError, UnknownPose
@@ -20,9 +22,7 @@ from rsstp_sim.world_table import WorldTable
 __all__ = ["Pose", "World"]
 
 _FIRST_BLOCK = 256
-"""The poses a small pose space's table grows by at its first miss (doubling at each)."""
-_LAST_BLOCK = 4096
-"""The most poses a large pose space's table grows by at once (see :meth:`World._expand`)."""
+"""The poses a table grown in blocks grows by at its first miss (doubling at each)."""
 
 
 @dataclass(frozen=True, slots=True, eq=False)
@@ -34,14 +34,40 @@ class Pose:
     - ``sensation``: every tip within tolerance of its feedback point.
     - ``feedback``: float closeness to the feedback points, in [0, 1].
     - ``distances``: ``(n, m)`` distance from tip ``k`` to obstacle ``j``'s surface.
+
+    The sensation and the feedback are read at every step; the rest is computed from the
+    world table's row at first use (most poses of a long run are never asked for it).
     """
 
     code: int
-    angles_deg: tuple[int, ...]
-    joint_positions: FloatArray
     sensation: bool
     feedback: float
-    distances: FloatArray
+    _table: WorldTable = field(repr=False)
+    _row: int = field(repr=False)
+    _angles: tuple[int, ...] | None = field(default=None, init=False, repr=False)
+    _positions: FloatArray | None = field(default=None, init=False, repr=False)
+    _distances: FloatArray | None = field(default=None, init=False, repr=False)
+
+    @property
+    def angles_deg(self) -> tuple[int, ...]:
+        if self._angles is None:
+            object.__setattr__(self, "_angles", tuple(self._table.angles_of(self.code)))
+        assert self._angles is not None
+        return self._angles
+
+    @property
+    def joint_positions(self) -> FloatArray:
+        if self._positions is None:
+            object.__setattr__(self, "_positions", self._table.positions_of(self._row))
+        assert self._positions is not None
+        return self._positions
+
+    @property
+    def distances(self) -> FloatArray:
+        if self._distances is None:
+            object.__setattr__(self, "_distances", self._table.distances_of(self._row))
+        assert self._distances is not None
+        return self._distances
 
 
 class World:
@@ -57,9 +83,13 @@ class World:
     blockers, obstacle distances) is ground truth for analysis.
     """
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario, *, per_move: bool | None = None) -> None:
+        """``per_move``: grow the world table move by move (True) or in blocks of poses
+        (False); by default per move exactly when the pose space is too large for a dense
+        table (see :mod:`rsstp_sim.world_table`). Both give the same answers."""
         self.scenario = scenario
         self.table = WorldTable(scenario)
+        self.per_move = not self.table.dense if per_move is None else per_move
         self.geometry = self.table.geometry
         self._actions = {action: k for k, action in enumerate(self.table.actions)}
         self._n_actions = len(self._actions)
@@ -67,7 +97,6 @@ class World:
         self._blocker_codes = self.table.blocker
         self._blockers: dict[int, Blocker] = {}
         self._poses: dict[int, Pose] = {}
-        self._moves_since_miss = 0
         self._block = _FIRST_BLOCK
         self._row = 0
         self._pose = self._pose_at(0)
@@ -78,14 +107,9 @@ class World:
     def _pose_at(self, row: int) -> Pose:
         pose = self._poses.get(row)
         if pose is None:
-            block, i = self.table.block_of(row)
+            table = self.table
             pose = self._poses[row] = Pose(
-                self.table.codes[row],
-                tuple(block.angles[i].tolist()),
-                block.positions[i],
-                bool(block.sensation[i]),
-                float(block.feedback[i]),
-                block.distances[i],
+                table.codes[row], bool(table.sensation[row]), table.feedback[row], table, row
             )
         return pose
 
@@ -97,20 +121,10 @@ class World:
         return self._pose_at(row)
 
     def _expand(self, row: int) -> None:
-        """Compute the moves of ``row`` and of a block of poses around it.
-
-        A small pose space (a dense table) doubles the block at every miss, from
-        :data:`_FIRST_BLOCK`: a short run pays for a few hundred poses, a long one for the
-        whole space in a dozen misses. In a large one the block is as many poses as the run
-        made moves since the last miss (1 to :data:`_LAST_BLOCK`): a walk that keeps to
-        known poses gets large blocks, one that keeps finding new poses (an arm of many
-        joints) pays just for the poses it stands on.
-        """
-        if self.table.dense:
-            budget, self._block = self._block, self._block * 2
-        else:
-            budget = min(_LAST_BLOCK, max(1, self._moves_since_miss))
-        self._moves_since_miss = 0
+        """Compute the moves of ``row`` and of a block of poses around it: the block doubles
+        at every miss, from :data:`_FIRST_BLOCK` (a short run pays for a few hundred poses, a
+        long one for the whole space in a dozen misses)."""
+        budget, self._block = self._block, self._block * 2
         self.table.expand(row, budget)
 
     def _blocker(self, blocker_code: int) -> Blocker | None:
@@ -142,14 +156,16 @@ class World:
         at = self._row * self._n_actions + k
         row = self._next[at]
         if row < 0:
-            self._expand(self._row)
-            row = self._next[at]
+            if self.per_move:
+                row = self.table.step(self._row, k)
+            else:
+                self._expand(self._row)
+                row = self._next[at]
         return row, self._blocker_codes[at]
 
     def move(self, action: int) -> Blocker | None:
         """Execute an action; return None when the arm moved, else why it was blocked."""
         row, blocker_code = self._outcome(action)
-        self._moves_since_miss += 1
         if row != self._row:
             self._row = row
             pose = self._poses.get(row)
@@ -191,5 +207,5 @@ class World:
         return self._pose.distances
 
     def cache_info(self) -> tuple[int, int]:
-        """(poses in the world's table, poses whose moves are computed)."""
+        """(poses in the world's table, poses with at least one move computed)."""
         return len(self.table), self.table.moves_computed()

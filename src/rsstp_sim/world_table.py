@@ -16,20 +16,27 @@ of poses and moves at once.
   a free move, never as a neighbour on a lattice, so invalid and unreachable poses cost
   nothing.
 
-The table grows on demand: :meth:`WorldTable.expand` computes the moves of a block of
-poses around the one the arm stands on, breadth first, one vectorised batch per frontier,
-as many poses as the caller's budget allows; :meth:`WorldTable.complete` computes every
-reachable pose the same way (the ground truth's enumeration). A pose space of at most
-:data:`DENSE_LIMIT` lattice poses finds rows by pose code in a dense array, a larger one
-in a dict of the poses reached.
+The table grows on demand, in one of two ways. By blocks: :meth:`WorldTable.expand`
+computes the moves of a block of poses around the one the arm stands on, breadth first, one
+vectorised batch per frontier, as many poses as the caller's budget allows, and
+:meth:`WorldTable.complete` computes every reachable pose the same way (the ground truth's
+enumeration). Or move by move: :meth:`WorldTable.step` computes just the move the arm makes
+(one swept check of the joint that turns, see :func:`~rsstp_sim.geometry.move_blocker`) and
+the one pose it reaches, in plain floats: the way of a pose space too large to be
+tabulated, where nearly every move reaches a new pose. A pose space of at most
+:data:`DENSE_LIMIT` lattice poses finds rows by pose code in a dense array, a larger one in
+a dict of the poses reached.
+
+Every row keeps its pose's :func:`~rsstp_sim.geometry.pose_points` (the base and the link
+tips, flat), its obstacle distances, its sensation and its float feedback, in growable
+arrays: a few hundred bytes a pose, whichever way it was computed.
 """
 
 from __future__ import annotations
 
 import array
-import bisect
 import math
-from dataclasses import dataclass
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -40,7 +47,6 @@ from rsstp_sim.scenario import Scenario
 
 __all__ = [
     "DENSE_LIMIT",
-    "PoseBlock",
     "WorldTable",
     "lattice_sizes",
     "pose_space_size",
@@ -115,26 +121,6 @@ def pose_space_size(scenario: Scenario) -> int:
     return math.prod(lattice_sizes(scenario))
 
 
-@dataclass(frozen=True, slots=True)
-class PoseBlock:
-    """The per-pose geometry of rows ``first .. first + len(angles) - 1``, computed together.
-
-    - ``angles``: ``(k, n)`` relative joint angles in integer degrees;
-    - ``positions``: ``(k, n + 1, 2)`` the base then every link tip;
-    - ``sensation``, ``feedback``: the feedback point's boolean and float readings;
-    - ``distances``: ``(k, n, m)`` from every tip to every obstacle's surface.
-
-    The arrays are read-only.
-    """
-
-    first: int
-    angles: IntArray
-    positions: FloatArray
-    sensation: BoolArray
-    feedback: FloatArray
-    distances: FloatArray
-
-
 class WorldTable:
     """The reachable poses of ``scenario`` found so far, and the moves computed so far."""
 
@@ -155,14 +141,27 @@ class WorldTable:
         )
         self._points = np.asarray(scenario.feedback_points, dtype=np.float64)
         self._tolerance_abs = scenario.tolerance * scenario.total_length
+        # The same in plain Python numbers, for the move-by-move path.
+        self._reach = geometry.feedback_reach(self._points, self.geometry.lengths).tolist()
+        self._joint_list: list[int] = self._joint.tolist()
+        self._delta_list: list[int] = self._delta.tolist()
+        self._reverse_list: list[int] = self._reverse.tolist()
+        self._radix_list: list[int] = self.radix.tolist()
+        self.width = 2 * (n + 1)
+        """Floats a row takes in :attr:`positions`."""
 
         self.codes = array.array("q")
         self.next_row = array.array("i")
         self.blocker = array.array("i")
         self.sensation = array.array("b")
         self.feedback = array.array("d")
-        self.blocks: list[PoseBlock] = []
-        self._block_firsts: list[int] = []
+        self.positions = array.array("d")
+        """Every row's :func:`~rsstp_sim.geometry.pose_points`, :attr:`width` floats a row."""
+        self.distances = array.array("d")
+        """Every row's :func:`~rsstp_sim.geometry.obstacle_distances` (``n * m`` floats a
+        row) when its pose came in a block; NaN for a pose added alone (see :meth:`step`),
+        whose distances its reader computes (:meth:`distances_of`)."""
+        self._unknown_distances = array.array("d", [math.nan] * (n * self.geometry.m))
         self.dense = pose_space_size(scenario) <= DENSE_LIMIT
         # Rows by pose code: a dense array over a small lattice, else a dict of the poses
         # reached.
@@ -172,6 +171,10 @@ class WorldTable:
         self._initial = np.asarray(scenario.initial_deg, dtype=np.int64)
         self._dense = np.full(int(sizes.prod()), -1, dtype=np.int32) if self.dense else None
         self._row_of: dict[int, int] = {}
+        self._initial_list: list[int] = self._initial.tolist()
+        self._lattice_list: list[int] = self._lattice_radix.tolist()
+        self._blank_moves = array.array("i", [-1] * len(self.actions))
+        self._no_blockers = array.array("i", [0] * len(self.actions))
         start = int(self._initial @ self.radix)
         self._add_poses(np.array([start], dtype=np.int64))
 
@@ -184,18 +187,15 @@ class WorldTable:
     def n_actions(self) -> int:
         return len(self.actions)
 
-    def has_moves(self, row: int) -> bool:
-        return self.next_row[row * len(self.actions)] >= 0
-
     def moves_computed(self) -> int:
-        """How many rows have their moves computed."""
-        return int(np.count_nonzero(self.next_array()[:, 0] >= 0))
+        """How many rows have at least one move computed."""
+        return int(np.count_nonzero((self.next_array() >= 0).any(axis=1)))
 
     # -- growing ---------------------------------------------------------------
 
     def complete(self) -> None:
         """Compute every reachable pose and all its moves (breadth first from the start)."""
-        frontier = np.flatnonzero(self.next_array()[:, 0] < 0)
+        frontier = np.flatnonzero((self.next_array() < 0).any(axis=1))
         while frontier.size:
             first_new = len(self.codes)
             self._compute_moves(frontier)
@@ -213,9 +213,83 @@ class WorldTable:
             done += len(frontier)
             nxt = self.next_array()
             reached = np.unique(nxt[frontier].ravel())
-            frontier = reached[nxt[reached, 0] < 0]
+            frontier = reached[(nxt[reached] < 0).any(axis=1)].astype(np.int64)
             del nxt
         assert self.next_row[row * n_actions] >= 0
+
+    def step(self, row: int, k: int) -> int:
+        """Compute the scenario's ``k``-th action from ``row`` alone; the row it reaches.
+
+        The move's reverse, when already computed from the pose the move reaches, gives its
+        blocker (they sweep the same poses); else one check of the joint that turns
+        (:func:`~rsstp_sim.geometry.move_blocker`). A free move to a pose not in the table
+        adds that one pose.
+        """
+        n_actions = len(self.actions)
+        code = self.codes[row]
+        joint, delta = self._joint_list[k], self._delta_list[k]
+        radix = self._radix_list[joint]
+        angle = code // radix % 360
+        turned = (angle + delta) % 360
+        moved = code + (turned - angle) * radix
+        there = self._find(moved)
+        back = self._reverse_list[k]
+        if there >= 0 and back >= 0 and self.next_row[there * n_actions + back] >= 0:
+            blocker = self.blocker[there * n_actions + back]
+        else:
+            angles = self.angles_of(code)
+            width = self.width
+            points = self.positions[row * width : (row + 1) * width]
+            blocker = geometry.move_blocker(self.geometry, angles, points, joint, delta)
+            if not blocker and there < 0:
+                angles[joint] = turned
+                there = self._add_pose(moved, angles, known=points, first=joint)
+        if blocker:
+            there = row
+        self.next_row[row * n_actions + k] = there
+        self.blocker[row * n_actions + k] = blocker
+        return there
+
+    def angles_of(self, code: int) -> list[int]:
+        """The joint angles (integer degrees) of a pose code."""
+        return [code // r % 360 for r in self._radix_list]
+
+    def _find(self, code: int) -> int:
+        """:meth:`row_of` without numpy, for the move-by-move path."""
+        if self._dense is None:
+            return self._row_of.get(code, -1)
+        return int(self._dense[self._cell(self.angles_of(code))])
+
+    def _cell(self, angles: list[int]) -> int:
+        """A pose's index in the dense array (see :meth:`rows_of`)."""
+        cell = 0
+        for angle, start, stride in zip(
+            angles, self._initial_list, self._lattice_list, strict=True
+        ):
+            cell += (angle - start) % 360 // self._spacing * stride
+        return cell
+
+    def _add_pose(self, code: int, angles: list[int], *, known: Sequence[float], first: int) -> int:
+        """Append one pose (a new code, its ``angles``) as a row, computed in plain floats
+        (its points from ``known``, those of a pose one move of joint ``first`` away); its
+        row."""
+        row = len(self.codes)
+        points = geometry.pose_points(angles, self.geometry.link_lengths, known=known, first=first)
+        sensation, closeness = geometry.pose_feedback(
+            points, self._points, self._reach, self._tolerance_abs
+        )
+        if self._dense is None:
+            self._row_of[code] = row
+        else:
+            self._dense[self._cell(angles)] = row
+        self.codes.append(code)
+        self.positions.extend(points)
+        self.distances.extend(self._unknown_distances)
+        self.sensation.append(sensation)
+        self.feedback.append(closeness)
+        self.next_row.extend(self._blank_moves)
+        self.blocker.extend(self._no_blockers)
+        return row
 
     def _compute_moves(self, rows: IntArray) -> None:
         """Blockers and targets of every action from ``rows`` (poses without moves yet).
@@ -287,16 +361,14 @@ class WorldTable:
             tips, self._points, self.geometry.lengths, self._tolerance_abs
         )
         distances = geometry.obstacle_distances(tips, self.geometry.centers, self.geometry.radii)
-        for a in (angles, positions, sensation, closeness, distances):
-            a.flags.writeable = False
-        self.blocks.append(PoseBlock(first, angles, positions, sensation, closeness, distances))
-        self._block_firsts.append(first)
         if self._dense is not None:
             cells = (((angles - self._initial) % 360) // self._spacing) @ self._lattice_radix
             self._dense[cells] = rows
         else:
             self._row_of.update(zip(codes.tolist(), rows.tolist(), strict=True))
         self.codes.frombytes(codes.astype(np.int64).tobytes())
+        self.positions.frombytes(positions.tobytes())
+        self.distances.frombytes(distances.tobytes())
         self.sensation.frombytes(sensation.astype(np.int8).tobytes())
         self.feedback.frombytes(closeness.astype(np.float64).tobytes())
         blank = len(codes) * len(self.actions)
@@ -304,11 +376,6 @@ class WorldTable:
         self.blocker.frombytes(np.zeros(blank, dtype=np.int32).tobytes())
 
     # -- reading ---------------------------------------------------------------
-
-    def block_of(self, row: int) -> tuple[PoseBlock, int]:
-        """The block holding ``row`` and the row's offset in it."""
-        block = self.blocks[bisect.bisect_right(self._block_firsts, row) - 1]
-        return block, row - block.first
 
     def next_array(self) -> Int32Array:
         """``next_row`` as a ``(rows, actions)`` numpy view (valid until the table grows)."""
@@ -318,10 +385,32 @@ class WorldTable:
         """``blocker`` as a ``(rows, actions)`` numpy view (valid until the table grows)."""
         return np.frombuffer(self.blocker, dtype=np.int32).reshape(-1, len(self.actions))
 
+    def positions_of(self, row: int) -> FloatArray:
+        """``(n + 1, 2)`` the base and every link tip of a row (a read-only copy)."""
+        width = self.width
+        positions = np.frombuffer(self.positions[row * width : (row + 1) * width])
+        positions.flags.writeable = False
+        return positions.reshape(-1, 2)
+
+    def distances_of(self, row: int) -> FloatArray:
+        """``(n, m)`` from every tip of a row to every obstacle's surface (a read-only copy),
+        computed now when the row's pose was added alone."""
+        n, m = self.geometry.n, self.geometry.m
+        distances = np.frombuffer(self.distances[row * n * m : (row + 1) * n * m])
+        if m and math.isnan(distances[0]):
+            tips = self.positions_of(row)[1:]
+            distances = geometry.obstacle_distances(
+                tips, self.geometry.centers, self.geometry.radii
+            )
+            self.distances[row * n * m : (row + 1) * n * m] = array.array("d", distances.tobytes())
+        distances.flags.writeable = False
+        return distances.reshape(n, m)
+
     def angles(self) -> IntArray:
         """``(rows, n)`` joint angles of every row."""
-        return np.concatenate([block.angles for block in self.blocks])
+        codes = np.frombuffer(self.codes, dtype=np.int64)
+        return np.asarray((codes[:, None] // self.radix) % 360, dtype=np.int64)
 
     def sensations(self) -> BoolArray:
         """The boolean sensation of every row."""
-        return np.concatenate([block.sensation for block in self.blocks])
+        return np.frombuffer(self.sensation, dtype=np.int8).astype(bool)

@@ -450,3 +450,31 @@ def test_audits_of_a_real_recording_equal_those_of_the_live_run(tmp_path: Path) 
                 assert compare(recording, int(n), int(m)) == compare(live, int(n), int(m))
     assert report.summary.blocked == fake.runner.blocked > 0
     assert report.summary.splits == refiner_run()[1].counts["split"]
+
+
+def test_a_loaded_recording_keeps_what_the_audits_read_once(tmp_path: Path) -> None:
+    """The steps table read for the audits: the recording's table less the geometry and
+    the blocker's details, its angles in two bytes, its memory columns shared with the
+    memory (one copy), the values unchanged."""
+    from rsstp_replay.audits.loaded import load
+
+    path = tmp_path / "run.mcap"
+    record_run(path, load_scenario("two-joint-30"), RandomRefiner(), steps=2000, seed=7)
+    with open_recording(path) as recording:
+        loaded = load(recording)
+        table, full = loaded.steps(), recording.steps(geometry=False)
+        memory = loaded.memory()
+    detail = {"blocked_kind", "blocked_joint", "blocked_link", "blocked_obstacle"}
+    detail |= {"blocked_link_i", "blocked_link_j"}
+    assert detail <= set(full.columns)
+    assert list(table.columns) == [name for name in full.columns if name not in detail]
+    assert table.index.equals(full.index)
+    for name in table.columns:
+        expected = full[name].astype(np.int16) if name.startswith("angle_deg_") else full[name]
+        pd.testing.assert_series_equal(table[name], expected)
+    for name, column in (
+        ("internal_state", memory.internal_states),
+        ("sensation", memory.sensations),
+        ("feedback", memory.feedback),
+    ):
+        assert np.shares_memory(table[name].to_numpy(), column)

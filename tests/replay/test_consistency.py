@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from unittest import mock
 
 import numpy as np
 import numpy.typing as npt
@@ -259,7 +260,7 @@ def test_bad_columns(columns: tuple[object, object, object], message: str) -> No
     seed=st.integers(0, 2**32 - 1),
 )
 def test_range_minima_and_nearest_smaller_against_brute_force(values: list[int], seed: int):
-    """The O(n)-memory range minima (blocks of 256) and the pointer-jumping nearest position
+    """The O(n)-memory range minima (blocks of 16) and the pointer-jumping nearest position
     with a value at most one's own, against plain Python."""
     from rsstp_replay.audits._suffixes import RangeMin, nearest_at_most
 
@@ -276,3 +277,40 @@ def test_range_minima_and_nearest_smaller_against_brute_force(values: list[int],
     for p, b, a in zip(inner.tolist(), before.tolist(), after.tolist(), strict=True):
         assert b == max(c for c in range(p) if fenced[c] <= fenced[p])
         assert a == min(c for c in range(p + 1, len(fenced)) if fenced[c] <= fenced[p])
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    symbols=st.lists(st.integers(0, 3), min_size=2, max_size=600)
+    | st.lists(st.integers(0, 700), min_size=2, max_size=600),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_suffix_ranks_and_common_prefixes_against_brute_force(
+    symbols: list[int], seed: int
+) -> None:
+    """The doubling levels, each in the narrowest type of its ranks (a byte, two, int32),
+    order the prefixes as plain Python does; the common prefixes, a few pairs at a time,
+    are the plain ones."""
+    from rsstp_replay.audits import _suffixes
+
+    levels = _suffixes.suffix_ranks(np.array(symbols, dtype=np.int64))
+    for level, ranks in enumerate(levels):
+        assert ranks.dtype == (np.uint8 if ranks.max() < 2**8 else np.uint16)
+        prefixes = [tuple(symbols[p : p + 2**level]) for p in range(len(symbols))]
+        order = sorted(set(prefixes))
+        assert ranks.tolist() == [order.index(prefix) for prefix in prefixes]
+    assert len(set(levels[-1].tolist())) == len(symbols)  # the last level: the suffix order
+    rng = np.random.default_rng(seed)
+    left, right = rng.integers(0, len(symbols), (2, 50))
+    right = np.where(left == right, (right + 1) % len(symbols), right)
+    with mock.patch.object(_suffixes, "_PAIRS_AT_ONCE", 7):
+        found = _suffixes.common_prefix_lengths(left, right, levels)
+
+    def common(p: int, q: int) -> int:
+        length = 0
+        while max(p, q) + length < len(symbols) and symbols[p + length] == symbols[q + length]:
+            length += 1
+        return length
+
+    pairs = zip(left.tolist(), right.tolist(), strict=True)
+    assert found.tolist() == [common(p, q) for p, q in pairs]

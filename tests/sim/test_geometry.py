@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 import pytest
@@ -13,6 +14,7 @@ from shapely.geometry import LineString, Point
 
 from conftest import THIN_OBSTACLE_TOML
 from rsstp_sim import geometry
+from rsstp_sim._arrays import IntArray
 from rsstp_sim.geometry import ArmGeometry, Blocker
 from rsstp_sim.scenario import parse_scenario
 from scenarios import arm_toml
@@ -289,3 +291,100 @@ def test_move_blockers_fold_only_for_joints_after_the_first() -> None:
     # Joint 0 passes 180 freely; joint 1 turning +20 from 170 passes 180 (fold), -20 does not.
     got = geometry.move_blockers(geo, [[170, 170]] * 3, [0, 1, 1], [20, 20, -20])
     assert [geo.decode(c) for c in got.tolist()] == [None, Blocker("fold", (1,)), None]
+
+
+# -- one pose, one move, in plain floats -------------------------------------------------------
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.tuples(st.integers(0, 359), st.floats(0.1, 5.0)), min_size=1, max_size=7),
+    st.integers(0, 6),
+)
+def test_pose_points_equal_joint_positions_bit_for_bit(
+    joints: list[tuple[int, float]], first: int
+) -> None:
+    angles = [a for a, _ in joints]
+    lengths = [length for _, length in joints]
+    expected = geometry.joint_positions(angles, lengths).ravel().tolist()
+    assert geometry.pose_points(angles, lengths) == expected
+    # From the points of a pose that differs in the joints from ``first`` on.
+    first = min(first, len(angles) - 1)
+    other = angles[:first] + [(a + 90) % 360 for a in angles[first:]]
+    known = geometry.pose_points(other, lengths)
+    assert geometry.pose_points(angles, lengths, known=known, first=first) == expected
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(st.tuples(point, st.floats(0.1, 5.0)), min_size=1, max_size=7),
+    st.lists(point, min_size=7, max_size=7),
+)
+def test_pose_feedback_equals_feedback_bit_for_bit(
+    joints: list[tuple[tuple[float, float], float]], points: list[tuple[float, float]]
+) -> None:
+    tips = np.array([tip for tip, _ in joints])
+    lengths = [length for _, length in joints]
+    feedback_points = np.array(points[: len(joints)])
+    flat = [0.0, 0.0, *tips.ravel().tolist()]
+    reach = geometry.feedback_reach(feedback_points, lengths).tolist()
+    for tolerance in (0.5, 3.0, 30.0):
+        sensed, closeness = geometry.feedback(tips, feedback_points, lengths, tolerance)
+        got = geometry.pose_feedback(flat, feedback_points, reach, tolerance)
+        assert got == (bool(sensed), float(closeness))
+
+
+def _crowded_arm(n: int, mode: str) -> ArmGeometry:
+    """``n`` unit links and two disks in their reach: many moves pass near a contact."""
+    disks = [((1.5, 1.0), 0.5), ((1.5, -1.5), 0.5), ((-1.0, 0.5), 0.3)]
+    toml = arm_toml([1.0] * n, [0] + [30] * (n - 1), 5, disks, motion={"collision": mode})
+    return ArmGeometry.from_scenario(parse_scenario(toml))
+
+
+@pytest.mark.parametrize("mode", ["swept", "endpoint"])
+@pytest.mark.parametrize("n", [2, 4, 7])
+def test_move_blocker_equals_move_blockers(mode: str, n: int) -> None:
+    """One move in plain floats gives the vectorised batch's blocker, over valid random poses
+    of a crowded arm and turns small and large (a twentieth or more of them blocked)."""
+    geo = _crowded_arm(n, mode)
+    rng = np.random.default_rng(n)
+    poses = rng.integers(0, 360, size=(6000, n))
+    poses = poses[geometry.pose_blockers(geo, poses) == 0][:1500]
+    joints = rng.integers(0, n, size=len(poses))
+    deltas = rng.choice([1, -1, 5, -5, 30, -30, 90, -135], size=len(poses))
+    expected = geometry.move_blockers(geo, poses, joints, deltas).tolist()
+    got = [
+        geometry.move_blocker(geo, pose, geometry.pose_points(pose, geo.link_lengths), j, d)
+        for pose, j, d in zip(poses.tolist(), joints.tolist(), deltas.tolist(), strict=True)
+    ]
+    assert got == expected
+    assert sum(map(bool, expected)) > len(expected) // 20
+
+
+@pytest.mark.parametrize("mode", ["swept", "endpoint"])
+def test_move_blocker_leaves_a_contact_at_the_threshold_to_numpy(
+    mode: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A link of length 2 turning 90 degrees ends with its tip at distance 1 from the centre
+    # of a disk of radius 1 - eps: exactly the contact threshold (radius + eps), up to a
+    # rounding that plain floats cannot settle against numpy's.
+    eps = geometry.CONTACT_EPS * 2.0
+    disk = [((0.0, 3.0), 1.0 - eps)]
+    geo = ArmGeometry.from_scenario(
+        parse_scenario(arm_toml([2.0], [0], 90, disk, motion={"collision": mode}))
+    )
+    batches: list[tuple[object, ...]] = []
+    vectorised = geometry.move_blockers
+
+    def counted(*args: Any) -> IntArray:
+        batches.append(args)
+        return vectorised(*args)
+
+    monkeypatch.setattr(geometry, "move_blockers", counted)
+    points = geometry.pose_points([0], geo.link_lengths)
+    expected = int(vectorised(geo, [[0]], [0], [90])[0])
+    assert geometry.move_blocker(geo, [0], points, 0, 90) == expected
+    assert len(batches) == 1  # numpy decided
+    batches.clear()
+    assert geometry.move_blocker(geo, [0], points, 0, -90) == 0  # far from the disk
+    assert batches == []  # plain floats decided

@@ -17,6 +17,7 @@ from rsstp_sim.errors import ActionError
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 from rsstp_sim.world import World
+from rsstp_sim.world_table import WorldTable
 from scenarios import arm_toml
 
 SAMPLE_DEG = 0.25
@@ -151,8 +152,10 @@ def check_walk(data: st.DataObject, collision: str) -> None:
     alone): a free move ends at its end pose, a blocked one stays where it was and its blocker
     is real there; every reached pose is valid."""
     scenario = data.draw(small_scenarios(collision=collision), label="scenario")
-    world = World(scenario)
+    world = World(scenario, per_move=False)
+    alone = World(scenario, per_move=True)  # each move checked on its own, in plain floats
     for action in data.draw(walks(scenario), label="actions"):
+        assert alone.move(action) == world.peek(action)[1]
         start = world.angles_deg
         end = end_pose(scenario, start, action)
         if collision == "swept":
@@ -169,6 +172,9 @@ def check_walk(data: st.DataObject, collision: str) -> None:
             assert world.angles_deg == start
             assert_blocked_by(scenario, poses, blocker)
         assert_free(scenario, np.array([world.angles_deg], dtype=np.float64))
+        assert alone.current.feedback == world.current.feedback
+        assert alone.current.sensation == world.current.sensation
+        assert np.array_equal(alone.joint_positions, world.joint_positions)
 
 
 @settings(max_examples=150, deadline=None)
@@ -192,10 +198,12 @@ step_deg = 90
 @example(parse_scenario(FIXED_END_ON_MOVING_LINK))
 def test_swept_link_contacts_against_shapely(scenario: Scenario) -> None:
     """Every move of three links from a random pose: links meet however they touch first."""
-    world = World(scenario)
+    world = World(scenario, per_move=False)
+    alone = World(scenario, per_move=True)
     start = world.angles_deg
     for action in scenario.actions:
         pose, blocker = world.peek(action)
+        assert alone.peek(action)[1] == blocker
         poses = path(scenario, start, action)
         if blocker is None:
             assert pose.angles_deg == end_pose(scenario, start, action)
@@ -269,7 +277,7 @@ def test_large_step_cannot_jump_over_a_thin_obstacle_unless_endpoint() -> None:
 @given(st.data())
 def test_cached_answers_equal_a_fresh_computation(data: st.DataObject) -> None:
     scenario = data.draw(small_scenarios(), label="scenario")
-    world = World(scenario)
+    world = World(scenario, per_move=data.draw(st.booleans(), label="per_move"))
     visited = {world.pose_code}
     for action in data.draw(walks(scenario), label="actions"):
         world.move(action)
@@ -297,9 +305,9 @@ def test_cached_answers_equal_a_fresh_computation(data: st.DataObject) -> None:
             code_alone = int(geometry.move_blockers(geo, [angles], [joint], [delta])[0])
             expected = angles if code_alone else end_pose(scenario, angles, action)
             table, row = world.table, world.table.row_of(code)
-            if not table.has_moves(row):  # the walk's last pose: its moves not asked yet
-                table.expand(row, 1)
             at = row * len(scenario.actions) + scenario.actions.index(action)
+            if table.next_row[at] < 0:  # a move the walk did not make
+                table.step(row, scenario.actions.index(action))
             target = table.codes[table.next_row[at]]
             blocker = geo.decode(table.blocker[at])
             assert blocker == geo.decode(code_alone)
@@ -340,17 +348,50 @@ def test_a_small_pose_space_grows_in_doubling_blocks() -> None:
 
 
 def test_a_large_pose_space_grows_with_the_walk(scenario_text) -> None:
-    """Seven links at 5 degrees (72**7 lattice poses): the table holds the poses the walk
-    reached and their targets, never a box of the lattice."""
+    """Seven links at 5 degrees (72**7 lattice poses): the table grows move by move and holds
+    the poses the walk stood on, no other."""
     arm = {"lengths": [1.0] * 7, "initial_deg": [0, 30, 30, 30, 30, 30, 30], "step_deg": 5}
     world = World(parse_scenario(scenario_text({"arm": arm})))
+    assert world.per_move
     assert world.cache_info() == (1, 0)
     rng = np.random.default_rng(3)
+    visited, moves = {world.pose_code}, set()
     for action in rng.integers(0, 14, size=200).tolist():
+        moves.add((world.pose_code, action))
         world.move(action)
-    poses, moves = world.cache_info()
-    assert moves <= 201  # one pose's moves per miss: the walk keeps finding new poses
-    assert poses <= 1 + 14 * moves
+        visited.add(world.pose_code)
+    assert len(visited) > 150  # the walk keeps finding new poses
+    table = world.table
+    assert sorted(table.codes) == sorted(visited)
+    assert np.count_nonzero(table.next_array() >= 0) == len(moves)  # the moves made, no other
+    assert len(table.positions) == len(visited) * table.width
+
+
+def test_a_table_grown_move_by_move_completes_to_the_whole_table() -> None:
+    """Moves computed one at a time, then the rest in blocks: the same reachable poses and
+    moves as a table computed whole."""
+    scenario = load_scenario("two-joint-30")
+    world = World(scenario, per_move=True)
+    rng = np.random.default_rng(5)
+    for action in rng.choice(scenario.actions, size=300).tolist():
+        world.move(action)
+    grown, whole = world.table, WorldTable(scenario)
+    computed = grown.next_array() >= 0
+    assert (computed.any(axis=1) & ~computed.all(axis=1)).any()  # poses with some moves known
+    grown.complete()
+    whole.complete()
+
+    def moves(table: WorldTable) -> dict[tuple[int, int], tuple[int, int]]:
+        codes = np.frombuffer(table.codes, dtype=np.int64)
+        targets = codes[table.next_array()]
+        return {
+            (int(code), k): (int(targets[row, k]), int(table.blocker_array()[row, k]))
+            for row, code in enumerate(codes.tolist())
+            for k in range(table.n_actions)
+        }
+
+    assert (grown.next_array() >= 0).all()
+    assert moves(grown) == moves(whole)
 
 
 # -- reset, peek, actions -----------------------------------------------------------------------

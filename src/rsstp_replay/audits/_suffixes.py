@@ -1,6 +1,12 @@
 """Suffix order of an integer sequence, and the queries the consistency audit asks of it:
 ranks by prefix doubling, common prefixes of pairs of suffixes, the nearest smaller value
-and range minima. All numpy, ``O(n log n)`` time and at most that memory.
+and range minima. All numpy, ``O(n log n)`` time.
+
+Memory is what bounds the audit of a long recording, so every array of one value per
+position is as narrow as its values allow: positions and ranks in int32 (below ``2**31``
+positions), each doubling level in the narrowest unsigned type that holds its ranks (the
+first levels of a walk over a few actions fit in a byte), and the common prefixes are
+computed a block of pairs at a time.
 """
 
 from __future__ import annotations
@@ -10,44 +16,86 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["RangeMin", "common_prefix_lengths", "nearest_at_most", "suffix_ranks"]
+__all__ = [
+    "RangeMin",
+    "common_prefix_lengths",
+    "index_type",
+    "nearest_at_most",
+    "suffix_ranks",
+]
 
 _IntArray = npt.NDArray[np.int64]
+_AnyInts = npt.NDArray[np.integer[Any]]
+_PAIRS_AT_ONCE = 1 << 18
+"""Pairs of suffixes whose common prefix :func:`common_prefix_lengths` computes together."""
 
 
-def suffix_ranks(symbols: _IntArray) -> list[npt.NDArray[np.integer[Any]]]:
+def index_type(size: int) -> type[np.integer[Any]]:
+    """The integer type of positions and ranks below ``size``: int32 while they fit."""
+    return np.int32 if size < 2**31 else np.int64
+
+
+def _narrowest(distinct: int, size: int) -> type[np.integer[Any]]:
+    """The narrowest type of ranks ``0 .. distinct - 1`` (``size`` positions in all)."""
+    if distinct <= 2**8:
+        return np.uint8
+    if distinct <= 2**16:
+        return np.uint16
+    return index_type(size)
+
+
+def suffix_ranks(symbols: _AnyInts) -> list[_AnyInts]:
     """Ranks of every suffix's prefixes of length 1, 2, 4, ...: ``levels[e][p] == levels[e][q]``
     iff the suffixes at ``p`` and ``q`` agree on their first ``2**e`` symbols (shorter suffixes
-    sort first). Stops as soon as all ranks differ: the last level is the suffix order."""
+    sort first). Stops as soon as all ranks differ: the last level is the suffix order.
+
+    Each level is kept in :func:`_narrowest` type of its ranks; besides the levels, a round
+    holds the ranks (int32) and the 64-bit sort key, its order and the sorted keys."""
     size = len(symbols)
-    rank = np.unique(symbols, return_inverse=True)[1].astype(np.int64)
-    # Kept as int32 where they fit (ranks < size): the levels are most of the audit's memory.
-    store: type[np.integer[Any]] = np.int32 if size < 2**31 else np.int64
-    levels: list[npt.NDArray[np.integer[Any]]] = [rank.astype(store)]
+    positions = index_type(size)
+    inverse = np.unique(symbols, return_inverse=True)[1]
+    rank = inverse.astype(positions)
+    del inverse
     distinct = int(rank.max()) + 1
+    levels: list[_AnyInts] = [rank.astype(_narrowest(distinct, size))]
     half = 1
     while distinct < size:
-        following = np.zeros(size, dtype=np.int64)
-        following[: size - half] = rank[half:] + 1
-        key = rank * (size + 1) + following
+        # key = rank * (size + 1) + (rank of the suffix ``half`` further on, + 1; 0 past the end)
+        key = rank.astype(np.int64)
+        key *= size + 1
+        key[: size - half] += rank[half:]
+        key[: size - half] += 1
         by_key = np.argsort(key)
         sorted_key = key[by_key]
-        new_group = np.empty(size, dtype=np.int64)
-        new_group[0] = 0
+        del key
+        new_group = np.empty(size, dtype=np.bool_)
+        new_group[0] = False
         np.not_equal(sorted_key[1:], sorted_key[:-1], out=new_group[1:])
-        rank = np.empty(size, dtype=np.int64)
-        rank[by_key] = np.cumsum(new_group)
-        levels.append(rank.astype(store))
-        distinct = int(rank[by_key[-1]]) + 1
+        del sorted_key
+        rank = np.empty(size, dtype=positions)
+        rank[by_key] = np.cumsum(new_group, dtype=positions)
+        del by_key, new_group
+        distinct = int(rank.max()) + 1
+        levels.append(rank.astype(_narrowest(distinct, size), copy=False))
         half *= 2
     return levels
 
 
-def common_prefix_lengths(
-    left: _IntArray, right: _IntArray, rank_levels: list[npt.NDArray[np.integer[Any]]]
-) -> _IntArray:
+def common_prefix_lengths(left: _AnyInts, right: _AnyInts, rank_levels: list[_AnyInts]) -> _AnyInts:
     """Longest common prefix of the suffixes at ``left[x]`` and ``right[x]`` (all distinct),
-    by binary lifting over the doubling levels (it is below ``2**(len(rank_levels) - 1)``)."""
+    by binary lifting over the doubling levels (it is below ``2**(len(rank_levels) - 1)``),
+    :data:`_PAIRS_AT_ONCE` pairs at a time; in :func:`index_type`."""
+    size = len(rank_levels[0])
+    lcp = np.empty(len(left), dtype=index_type(size))
+    for first in range(0, len(left), _PAIRS_AT_ONCE):
+        last = first + _PAIRS_AT_ONCE
+        lcp[first:last] = _common_prefix(
+            left[first:last].astype(np.int64), right[first:last].astype(np.int64), rank_levels
+        )
+    return lcp
+
+
+def _common_prefix(left: _IntArray, right: _IntArray, rank_levels: list[_AnyInts]) -> _IntArray:
     size = len(rank_levels[0])
     lcp = np.zeros(len(left), dtype=np.int64)
     for level in range(len(rank_levels) - 2, -1, -1):
@@ -60,7 +108,7 @@ def common_prefix_lengths(
     return lcp
 
 
-def nearest_at_most(values: _IntArray, wanted: _IntArray, *, step: int) -> _IntArray:
+def nearest_at_most(values: _AnyInts, wanted: _IntArray, *, step: int) -> _IntArray:
     """For each position ``p`` of ``wanted``, the nearest position ``c`` before it (``step``
     -1) or after it (``step`` 1) with ``values[c] <= values[p]``; one must exist.
 
@@ -70,10 +118,10 @@ def nearest_at_most(values: _IntArray, wanted: _IntArray, *, step: int) -> _IntA
     each round.
     """
     size = len(values)
-    index_type = np.int32 if size < 2**31 else np.int64
-    near = np.arange(step, size + step, dtype=index_type)
+    positions = index_type(size)
+    near = np.arange(step, size + step, dtype=positions)
     np.clip(near, 0, size - 1, out=near)
-    active = np.flatnonzero(values[near] > values).astype(index_type)
+    active = np.flatnonzero(values[near] > values).astype(positions)
     while active.size:
         near[active] = near[near[active]]
         active = active[values[near[active]] > values[active]]
@@ -81,13 +129,14 @@ def nearest_at_most(values: _IntArray, wanted: _IntArray, *, step: int) -> _IntA
 
 
 class RangeMin:
-    """Range minima in ``O(n)`` memory: minima of blocks of :data:`_BLOCK` values with a sparse
-    table over them, each value's minimum to the end and from the start of its block, and a
-    sparse table of the first levels for ranges inside one block."""
+    """Range minima in ``O(n)`` memory (about eight values per position): minima of blocks of
+    :data:`_BLOCK` values with a sparse table over them, each value's minimum to the end and
+    from the start of its block, and a sparse table of the first levels for ranges inside
+    one block."""
 
-    def __init__(self, values: _IntArray) -> None:
+    def __init__(self, values: _AnyInts) -> None:
         dtype = np.int32 if len(values) < 2**31 and values.max(initial=0) < 2**31 else np.int64
-        self.values: npt.NDArray[np.integer[Any]] = values.astype(dtype)
+        self.values: npt.NDArray[np.integer[Any]] = values.astype(dtype, copy=False)
         self.near = _sparse_table(self.values, levels=_BLOCK_LEVELS)
         n_blocks = -(-len(values) // _BLOCK)
         padded: npt.NDArray[np.integer[Any]] = np.full(
@@ -117,9 +166,11 @@ class RangeMin:
         return result
 
 
-_BLOCK_LEVELS = 9
+_BLOCK_LEVELS = 5
 _BLOCK = 1 << (_BLOCK_LEVELS - 1)
-"""Values per block of :class:`RangeMin` (256): ranges inside a block use the first levels."""
+"""Values per block of :class:`RangeMin` (16): ranges inside a block use the first levels
+(four arrays of one value per position besides the values), the others the blocks'
+sparse table (a sixteenth of a value per position and level)."""
 
 
 def _sparse_table(

@@ -32,6 +32,7 @@ import numpy.typing as npt
 from rsstp_replay.audits._suffixes import (
     RangeMin,
     common_prefix_lengths,
+    index_type,
     nearest_at_most,
     suffix_ranks,
 )
@@ -197,36 +198,44 @@ def find_contradictions(
     steps = len(action_column) - 1
     if steps < 2:  # a contradiction needs i < j and j + k <= T with k >= 1
         return ConsistencyFindings((), steps)
+    # Columns of one value per step in int32 where they fit (positions, ranks, codes): the
+    # audit of ten million steps is bounded by its memory.
+    positions = index_type(steps + 1)
     # The string y_p = (a_{p+1}, o_{p+1}), p = 0..T-1: the suffix at p is the memory after time p.
-    action_codes = np.unique(action_column[1:], return_inverse=True)[1].astype(np.int64)
+    action_codes = np.unique(action_column[1:], return_inverse=True)[1].astype(positions)
     symbols = 2 * action_codes + sensation_column[1:]
     rank_levels = suffix_ranks(symbols)
-
+    del symbols
     # Every time p = 0..T-1 (time T has nothing after it), sorted by (state, suffix rank).
     state_ids, state_codes = np.unique(state_column[:steps], return_inverse=True)
-    order = np.lexsort((rank_levels[-1], state_codes))
+    state_codes = state_codes.astype(positions)
+    order = np.lexsort((rank_levels[-1], state_codes)).astype(positions)
     sorted_codes = state_codes[order]
+    del state_codes
     same_state = sorted_codes[1:] == sorted_codes[:-1]
     left, right = order[:-1][same_state], order[1:][same_state]
     lcp = common_prefix_lengths(left, right, rank_levels)
     del rank_levels
     # A pair of neighbours with common prefix l contradicts iff both go on and the next
     # actions agree (the sensations then differ, or the common prefix would be longer).
-    contradicts = (left + lcp < steps) & (right + lcp < steps)
-    contradicts[contradicts] = (
-        action_codes[(left + lcp)[contradicts]] == action_codes[(right + lcp)[contradicts]]
-    )
+    left += lcp
+    right += lcp
+    contradicts = (left < steps) & (right < steps)
+    contradicts[contradicts] = action_codes[left[contradicts]] == action_codes[right[contradicts]]
+    del left, right, action_codes
     if not contradicts.any():
         return ConsistencyFindings((), steps)
-
     # boundary_lcp[b]: common prefix of sorted neighbours b-1 and b; -1 between states and at
     # both ends, so the groups found below never cross a state.
     size = len(order)
-    boundary_lcp = np.full(size + 1, -1, dtype=np.int64)
+    boundary_lcp = np.full(size + 1, -1, dtype=positions)
     boundary_lcp[1:size][same_state] = lcp
+    del lcp
     boundaries = (np.flatnonzero(same_state) + 1)[contradicts]
-    depth = boundary_lcp[boundaries]
+    del same_state, contradicts
+    depth = boundary_lcp[boundaries].astype(np.int64)
     group_start, group_end = _sibling_groups(boundary_lcp, boundaries)
+    del boundary_lcp
     first_times = RangeMin(order)
     first_left = first_times.query(group_start, boundaries - 1)
     first_right = first_times.query(boundaries, group_end - 1)
@@ -243,7 +252,7 @@ def find_contradictions(
 
 def _validated(
     actions: npt.ArrayLike, states: npt.ArrayLike, sensations: npt.ArrayLike
-) -> tuple[_IntArray, npt.NDArray[Any], _IntArray]:
+) -> tuple[npt.NDArray[np.integer[Any]], npt.NDArray[Any], npt.NDArray[np.int8]]:
     columns = {
         "actions": np.asarray(actions),
         "states": np.asarray(states),
@@ -261,14 +270,12 @@ def _validated(
         raise MemoryRangeError(f"actions: expected integers, got {columns['actions'].dtype}")
     if columns["sensations"].dtype.kind != "b":
         raise MemoryRangeError(f"sensations: expected booleans, got {columns['sensations'].dtype}")
-    return (
-        columns["actions"].astype(np.int64, copy=False),
-        columns["states"],
-        columns["sensations"].astype(np.int64),
-    )
+    return columns["actions"], columns["states"], columns["sensations"].view(np.int8)
 
 
-def _sibling_groups(boundary_lcp: _IntArray, boundaries: _IntArray) -> tuple[_IntArray, _IntArray]:
+def _sibling_groups(
+    boundary_lcp: npt.NDArray[np.integer[Any]], boundaries: _IntArray
+) -> tuple[_IntArray, _IntArray]:
     """For each boundary ``b`` of depth ``d``: the sibling groups it separates are the sorted
     entries ``[start, b)`` and ``[b, end)``, bounded by the nearest boundaries of depth ``<= d``
     (``boundary_lcp`` is -1 at both ends, so there always is one)."""
@@ -285,7 +292,7 @@ def _per_state(
     witness_j: _IntArray,
     k: _IntArray,
     pairs: _IntArray,
-    action_column: _IntArray,
+    action_column: npt.NDArray[np.integer[Any]],
 ) -> tuple[StateContradiction, ...]:
     """Reduce the contradicting boundaries to one finding per state."""
     best = np.lexsort((witness_i, witness_j, k, boundary_state))
