@@ -29,7 +29,8 @@ grows with the number of changes, not with versions times model size. At a row:
   arrows; ``world/model/state/{id}/poses``, ``LineStrips2D``: the thin lines to its poses.
 
 The current state is ``world/model/current``: a ring at its place, with a row at each step at
-which it changes. ``world/model/legend`` names the role colours (static, in a corner).
+which it changes, labelled ``now: {id}`` through a static annotation context (a class id per
+state). ``world/model/legend`` names the role colours (static, in a corner).
 """
 
 from __future__ import annotations
@@ -120,6 +121,8 @@ others are unvisited)."""
 
 _CURRENT_COLOR = (235, 100, 0)
 _POSE_COLOR = (150, 150, 150, 110)
+_MAX_CLASS_ID = 1 << 16
+"""Rerun's class ids are 16-bit: larger state ids are labelled by strings."""
 _Floats = npt.NDArray[np.float64]
 
 
@@ -452,7 +455,9 @@ def log_current_state(
         return 0
     change = np.flatnonzero(np.r_[True, internal_states[1:] != internal_states[:-1]])
     states = internal_states[change]
-    positions = np.array([places.places[int(s)] for s in states.tolist()], np.float64)
+    ids = np.array(sorted(places.places), np.int64)
+    xy = np.array([places.places[s] for s in ids.tolist()], np.float64).reshape(-1, 2)
+    positions = xy[np.searchsorted(ids, states)]
     stream.log(
         CURRENT,
         rr.Points2D.from_fields(
@@ -460,6 +465,23 @@ def log_current_state(
         ),
         static=True,
     )
+    if int(ids[-1]) < _MAX_CLASS_ID:
+        # The label "now: {id}" by class id (2 bytes a row) from an annotation context,
+        # rather than a string in every row: a million steps, a third of the file less.
+        stream.log(
+            CURRENT,
+            rr.AnnotationContext(
+                [rr.ClassDescription(info=(s, f"now: {s}")) for s in ids.tolist()]
+            ),
+            static=True,
+        )
+        classes = states.astype(np.uint16)
+        return send_rows(
+            stream,
+            CURRENT,
+            times[change],
+            lambda rows: rr.Points2D.columns(positions=positions[rows], class_ids=classes[rows]),
+        )
     labels = np.array([f"now: {s}" for s in states.tolist()], np.object_)
     return send_rows(
         stream,

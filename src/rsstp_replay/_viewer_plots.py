@@ -8,8 +8,7 @@ The log (``rr.TextLog`` at ``log/audit``) holds, at their steps: every contradic
 consistency audit finds within a model version (the state, its shortest witness, the number of
 contradicting pairs, the version): a WARN when the memory proved it while that version was in
 force (or at the step that replaced it), else an INFO (an old version, proved wrong after it
-was gone); the same audit accumulated over the whole history (state ids across versions) as
-INFO, when the model changed; the step from which the model stayed deterministic (or, at the
+was gone); the step from which the model stayed deterministic (or, at the
 last step, that it never did), the first step at which it was deterministic and complete,
 every split and merge, and the contradictions and notes a strategy recorded as events.
 """
@@ -155,7 +154,6 @@ class LogLine:
 def audit_lines(
     versions: Sequence[ModelRecord],
     within: ConsistencyFindings | None,
-    history: ConsistencyFindings | None,
     determinism: DeterminismFindings | None,
     events: pd.DataFrame,
     *,
@@ -163,8 +161,7 @@ def audit_lines(
 ) -> list[LogLine]:
     """Every line of the audit log over the whole recording, sorted by step (stable):
     ``within`` is the consistency audit within versions
-    (:func:`~rsstp_replay.audits.consistency.audit_consistency_by_version`), ``history`` the
-    same over the whole history (None: not run, or the model never changed)."""
+    (:func:`~rsstp_replay.audits.consistency.audit_consistency_by_version`)."""
     lines: list[LogLine] = []
     for record in versions:
         for operation in record.operations:
@@ -202,12 +199,6 @@ def audit_lines(
                         f"{_contradiction(found)} (an old version: replaced at step {gone})",
                     )
                 )
-    if history is not None:
-        for found in history.contradictions:
-            text = _contradiction(found)
-            lines.append(
-                LogLine(found.first_step, "INFO", f"accumulated over the whole history: {text}")
-            )
     if determinism is not None:
         lines += _determinism_lines(determinism, last_step=last_step)
     for step, kind, text in zip(

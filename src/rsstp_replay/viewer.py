@@ -40,11 +40,7 @@ from rsstp_replay._viewer_blueprint import default_blueprint, view_reach
 from rsstp_replay._viewer_chunks import TIMELINE
 from rsstp_replay._viewer_layout import graph_positions
 from rsstp_replay._viewer_serve import DEFAULT_BIND, CtrlC, WebServer, check_port
-from rsstp_replay.audits.consistency import (
-    ConsistencyFindings,
-    audit_consistency,
-    audit_consistency_by_version,
-)
+from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.audits.truth import step_true_classes
 from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
@@ -333,7 +329,6 @@ class _Loaded:
     versions: list[ModelRecord]
     events: pd.DataFrame
     within: ConsistencyFindings | None
-    history: ConsistencyFindings | None
     determinism: DeterminismFindings | None
     roles: model_part.Roles | None
     places: model_part.StatePlaces
@@ -348,7 +343,7 @@ def _load(recording: ViewSource) -> _Loaded:
     versions = list(recording.model_versions())
     events = recording.events()
     read = time.perf_counter()
-    within, history, determinism = _audits(steps, versions)
+    within, determinism = _audits(steps, versions)
     scenario = recording.scenario
     places = model_part.state_places(
         steps, versions, n_joints=scenario.n_joints, reach=scenario.total_length
@@ -361,7 +356,6 @@ def _load(recording: ViewSource) -> _Loaded:
         versions,
         events,
         within,
-        history,
         determinism,
         _roles(scenario, steps),
         places,
@@ -391,7 +385,6 @@ def _log(
     every_line = plots_part.audit_lines(
         loaded.versions,
         loaded.within,
-        loaded.history,
         loaded.determinism,
         loaded.events,
         last_step=recording.n_steps,
@@ -481,12 +474,12 @@ def _versions_in(
 
 def _audits(
     steps: pd.DataFrame, versions: Sequence[ModelRecord]
-) -> tuple[ConsistencyFindings | None, ConsistencyFindings | None, DeterminismFindings | None]:
-    """The consistency audit within versions and over the whole history (None when the
-    model never changed: the same findings), and the determinism audit; None (with a
-    warning) for an audit that fails."""
+) -> tuple[ConsistencyFindings | None, DeterminismFindings | None]:
+    """The consistency audit within versions and the determinism audit; None (with a
+    warning) for an audit that fails. (The same consistency audit over the whole history,
+    state ids across versions, is ``rsstp-replay audit``'s: a learner's early versions reused
+    ids that meant something else then, and a million steps audit in seconds.)"""
     within: ConsistencyFindings | None = None
-    history: ConsistencyFindings | None = None
     determinism: DeterminismFindings | None = None
     try:
         memory = Memory.from_arrays(
@@ -495,17 +488,14 @@ def _audits(
             steps["sensation"].to_numpy(np.bool_),
             steps["feedback"].to_numpy(np.float64),
         )
-        in_force = steps["model_version"].to_numpy(np.int64)
-        within = audit_consistency_by_version(memory, in_force)
-        if len(in_force) and (in_force != in_force[0]).any():
-            history = audit_consistency(memory)
+        within = audit_consistency_by_version(memory, steps["model_version"].to_numpy(np.int64))
     except RsstpError as exc:
         warnings.warn(ViewerWarning(f"consistency audit not shown: {exc}"), stacklevel=3)
     try:
         determinism = audit_determinism(versions)
     except RsstpError as exc:
         warnings.warn(ViewerWarning(f"determinism audit not shown: {exc}"), stacklevel=3)
-    return within, history, determinism
+    return within, determinism
 
 
 def _roles(scenario: Scenario, steps: pd.DataFrame) -> model_part.Roles | None:
