@@ -8,7 +8,16 @@ import rerun.blueprint as rrb
 from rsstp_replay._viewer_chunks import TIMELINE
 from rsstp_sim.scenario import Scenario
 
-__all__ = ["default_blueprint"]
+__all__ = ["default_blueprint", "view_reach"]
+
+
+def view_reach(scenario: Scenario) -> float:
+    """Half the side of the square both 2D views frame, centred on the base: the arm's reach
+    and every obstacle, with a margin."""
+    reach = 1.1 * scenario.total_length
+    for obstacle in scenario.obstacles:
+        reach = max(reach, 1.05 * (float(np.hypot(*obstacle.center)) + obstacle.radius))
+    return reach
 
 
 def default_blueprint(scenario: Scenario, *, first: int, last: int) -> rrb.Blueprint:
@@ -18,9 +27,7 @@ def default_blueprint(scenario: Scenario, *, first: int, last: int) -> rrb.Bluep
     obstacles); below them the plots (sensation and feedback, obstacle distances, model size,
     their time axes linked and showing steps ``first .. last``) and the audit log; the
     ``step`` timeline selected."""
-    reach = 1.1 * scenario.total_length
-    for obstacle in scenario.obstacles:
-        reach = max(reach, 1.05 * (float(np.hypot(*obstacle.center)) + obstacle.radius))
+    reach = view_reach(scenario)
     bounds = rrb.VisualBounds2D(x_range=[-reach, reach], y_range=[-reach, reach])
     steps = rrb.TimeRange(
         start=rrb.TimeRangeBoundary.absolute(seq=first),

@@ -11,11 +11,15 @@ A state current at several distinct poses over those steps (aliasing, or a true 
 several poses) gets a thin line to the tip of each, the :data:`POSE_LINES` most visited.
 
 Logging: one entity per state, ``world/model/state/{id}``, with a row only at the steps where
-that state appears or its transitions change (found by replaying each version's operations
-and marking the states they touch), and an :class:`rr.Clear` when it is deleted; so the data
+that state appears, its transitions change (found by replaying each version's operations
+and marking the states they touch) or its role changes, and an :class:`rr.Clear` when it is
+deleted; so the data
 grows with the number of changes, not with versions times model size. At a row:
 
-- ``Points2D``: the state, labelled with its id;
+- ``Points2D``: the state, coloured by its role in the version in force (what the truth audit
+  says it stood for: :mod:`rsstp_replay.audits.state_roles`, colours :data:`ROLE_COLORS`;
+  dark grey without the truth), labelled with its id where the label fits
+  (:func:`labelled_states`; the id is in the entity path, shown on hover, everywhere);
 - ``Arrows2D``: one arrow per transition to another state, from the state towards the
   target (stopping short of it), coloured by action (:data:`ACTION_COLORS`), several actions
   to the same target side by side;
@@ -25,7 +29,8 @@ grows with the number of changes, not with versions times model size. At a row:
   arrows; ``world/model/state/{id}/poses``, ``LineStrips2D``: the thin lines to its poses.
 
 The current state is ``world/model/current``: a ring at its place, with a row at each step at
-which it changes.
+which it changes, labelled ``now: {id}`` through a static annotation context (a class id per
+state). ``world/model/legend`` names the role colours (static, in a corner).
 """
 
 from __future__ import annotations
@@ -40,20 +45,36 @@ import numpy.typing as npt
 import pandas as pd
 import rerun as rr
 
-from rsstp_replay._viewer_chunks import TIMELINE
+from rsstp_replay._viewer_chunks import TIMELINE, send_rows
 from rsstp_replay.audits.contract import version_index
+from rsstp_replay.audits.state_roles import (
+    ALIASED,
+    EXACT,
+    REDUNDANT,
+    ROLE_NAMES,
+    UNVISITED,
+    state_roles,
+)
+from rsstp_sim import palette
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = [
     "ACTION_COLORS",
     "CURRENT",
+    "LABEL_ROOM",
+    "LEGEND",
     "MODEL",
     "POSE_LINES",
+    "ROLE_COLORS",
     "STATES",
     "StatePlaces",
+    "Roles",
+    "labelled_states",
     "log_current_state",
+    "log_legend",
     "log_model",
+    "roles_by_version",
     "state_path",
     "state_places",
 ]
@@ -61,6 +82,7 @@ __all__ = [
 MODEL = "world/model"
 STATES = "world/model/state"
 CURRENT = "world/model/current"
+LEGEND = "world/model/legend"
 POSE_LINES = 32
 """Thin lines drawn from a state to at most this many of its poses (the most visited)."""
 
@@ -82,9 +104,25 @@ ACTION_COLORS: tuple[tuple[int, int, int], ...] = (
 )
 """Action ``a``'s colour is ``ACTION_COLORS[a % 14]`` (matplotlib's tab10, then more)."""
 
-_STATE_COLOR = (60, 60, 60)
+ROLE_COLORS: dict[int, tuple[int, int, int]] = {
+    EXACT: palette.STATE_EXACT,
+    REDUNDANT: palette.STATE_REDUNDANT,
+    ALIASED: palette.STATE_ALIASED,
+    UNVISITED: palette.STATE_UNVISITED,
+}
+"""A state's colour by its role (:mod:`rsstp_replay.audits.state_roles`)."""
+LABEL_ROOM = 0.09
+"""A state's label is drawn when no other state lies within this fraction of the arm's reach
+across, or half of it up and down (about a label's size in the default view)."""
+
+Roles = dict[int, dict[int, int]]
+"""Per model version number, the role of every state the version was in at a step (the
+others are unvisited)."""
+
 _CURRENT_COLOR = (235, 100, 0)
 _POSE_COLOR = (150, 150, 150, 110)
+_MAX_CLASS_ID = 1 << 16
+"""Rerun's class ids are 16-bit: larger state ids are labelled by strings."""
 _Floats = npt.NDArray[np.float64]
 
 
@@ -148,6 +186,41 @@ def state_places(
     return StatePlaces(places, _poses(kept_states, angles, kept_tips), scale)
 
 
+def roles_by_version(
+    step_versions: npt.NDArray[np.int64],
+    step_states: npt.NDArray[np.int64],
+    step_classes: npt.NDArray[np.int64],
+) -> Roles:
+    """The role of every (version, state) pair seen at a step, by version."""
+    if not len(step_states):
+        return {}
+    width = int(step_states.max()) + 1
+    pairs = np.unique(step_versions * width + step_states)
+    versions, states = pairs // width, pairs % width
+    roles = state_roles(step_versions, step_states, step_classes, versions=versions, states=states)
+    found: Roles = {}
+    for version, state, role in zip(
+        versions.tolist(), states.tolist(), roles.tolist(), strict=True
+    ):
+        found.setdefault(version, {})[state] = role
+    return found
+
+
+def labelled_states(places: dict[int, tuple[float, float]], *, room: float) -> set[int]:
+    """The states whose label fits: no other state within ``room`` across and ``room / 2``
+    up and down (places are fixed, so one answer holds for every version)."""
+    ids = np.array(sorted(places), np.int64)
+    if len(ids) < 2:
+        return set(ids.tolist())
+    xy = np.array([places[s] for s in ids.tolist()], np.float64)
+    fits = np.ones(len(ids), np.bool_)
+    for begin in range(0, len(ids), 1024):  # blocks: memory stays at 1,024 x N
+        block = xy[begin : begin + 1024, None, :] - xy[None, :, :]
+        near = (np.abs(block[..., 0]) < room) & (np.abs(block[..., 1]) < room / 2)
+        fits[begin : begin + 1024] = near.sum(axis=1) == 1  # itself only
+    return set(ids[fits].tolist())
+
+
 def _poses(
     states: npt.NDArray[np.int64], angles: npt.NDArray[np.int64], tips: _Floats
 ) -> dict[int, _Floats]:
@@ -197,25 +270,70 @@ def _touched(model: TransitionSystem, record: ModelRecord) -> set[int]:
     return touched
 
 
+_Row = tuple[int, tuple[tuple[int, int], ...] | None, int | None]
+"""A state's row: the step, its transitions out (None: deleted), its role (None: unknown)."""
+
+
 def log_model(
     stream: rr.RecordingStream,
     versions: Sequence[ModelRecord],
     steps: Sequence[int],
     places: StatePlaces,
+    *,
+    roles: Roles | None = None,
+    labelled: set[int] | None = None,
 ) -> dict[str, int]:
-    """Every state of ``versions[0]`` at ``steps[0]``, then each later version's changes at its
-    step; returns rows per entity path (the per-state paths summed under :data:`STATES`)."""
-    rows: dict[int, list[tuple[int, tuple[tuple[int, int], ...] | None]]] = defaultdict(list)
+    """Every state of ``versions[0]`` at ``steps[0]``, then each later version's changes (and
+    role changes, with ``roles``) at its step; labels on the ``labelled`` states (default:
+    all). Returns rows per entity path (the per-state paths summed under :data:`STATES`)."""
+    rows: dict[int, list[_Row]] = defaultdict(list)
     model = TransitionSystem.from_snapshot(versions[0].snapshot(), version=versions[0].version)
+
+    def role(version: int, state: int) -> int | None:
+        return None if roles is None else roles.get(version, {}).get(state, UNVISITED)
+
+    shown: dict[int, int | None] = {}
     for state in model.states:
-        rows[state].append((steps[0], _outs(model, state)))
+        shown[state] = role(versions[0].version, state)
+        rows[state].append((steps[0], _outs(model, state), shown[state]))
+    previous = versions[0].version
     for record, step in zip(versions[1:], steps[1:], strict=True):
-        for state in sorted(_touched(model, record)):
-            rows[state].append((step, _outs(model, state) if state in model else None))
+        touched = _touched(model, record)
+        candidates = set(touched)
+        if roles is not None:  # states whose role may have changed
+            candidates |= roles.get(record.version, {}).keys() | roles.get(previous, {}).keys()
+        for state in sorted(candidates):
+            if state in model:
+                now = role(record.version, state)
+                if state in touched or now != shown.get(state):
+                    rows[state].append((step, _outs(model, state), now))
+                    shown[state] = now
+            elif state in touched:
+                rows[state].append((step, None, None))
+        previous = record.version
     count = 0
     for state, changes in sorted(rows.items()):
-        count += _log_state(stream, state, changes, places)
+        count += _log_state(
+            stream, state, changes, places, labelled=labelled is None or state in labelled
+        )
     return {STATES: count}
+
+
+def log_legend(stream: rr.RecordingStream, *, reach: float) -> None:
+    """The role colours named, as static points in the top left corner of a view of half-side
+    ``reach`` (world coordinates, y up)."""
+    order = (EXACT, REDUNDANT, ALIASED, UNVISITED)
+    stream.log(
+        LEGEND,
+        rr.Points2D(
+            [(-0.92 * reach, (0.92 - 0.08 * k) * reach) for k in range(len(order))],
+            colors=[ROLE_COLORS[r] for r in order],
+            labels=[f"{ROLE_NAMES[r]} state" for r in order],
+            radii=rr.Radius.ui_points(5.0),
+            draw_order=30.0,
+        ),
+        static=True,
+    )
 
 
 def _outs(model: TransitionSystem, state: int) -> tuple[tuple[int, int], ...]:
@@ -226,18 +344,24 @@ def _outs(model: TransitionSystem, state: int) -> tuple[tuple[int, int], ...]:
 def _log_state(
     stream: rr.RecordingStream,
     state: int,
-    changes: list[tuple[int, tuple[tuple[int, int], ...] | None]],
+    changes: list[_Row],
     places: StatePlaces,
+    *,
+    labelled: bool,
 ) -> int:
     """The rows of one state's entity (and its loops), a clear where it was deleted."""
     path = state_path(state)
     x, y = places.places[state]
-    alive = [(step, outs) for step, outs in changes if outs is not None]
+    alive = [(step, outs, role) for step, outs, role in changes if outs is not None]
     if alive:
-        times = np.array([step for step, _ in alive], np.int64)
+        times = np.array([step for step, _, _ in alive], np.int64)
+        state_colors = np.array(
+            [palette.STATE if role is None else ROLE_COLORS[role] for _, _, role in alive],
+            np.uint8,
+        )
         origins, vectors, colors, arrow_counts = [], [], [], []
         loops, loop_colors, loop_counts = [], [], []
-        for _, outs in alive:
+        for _, outs, _ in alive:
             arrows = [(a, t) for a, t in outs if t != state]
             for slot, (a, t) in enumerate(arrows):
                 start, delta = _arrow((x, y), places.places[t], slot, len(arrows), places.scale)
@@ -260,8 +384,8 @@ def _log_state(
             columns=[
                 *rr.Points2D.columns(
                     positions=np.tile([x, y], (len(times), 1)),
-                    labels=[str(state)] * len(times),
-                    colors=np.tile(_STATE_COLOR, (len(times), 1)).astype(np.uint8),
+                    colors=state_colors,
+                    labels=[str(state)] * len(times) if labelled else None,
                 ),
                 *rr.Arrows2D.columns(
                     origins=np.array(origins, np.float64).reshape(-1, 2),
@@ -291,7 +415,7 @@ def _log_state(
                     radii=np.full(len(strips), -0.5, np.float32),  # ui points
                 ).partition([len(strips)]),
             )
-    for step, gone in changes:
+    for step, gone, _ in changes:
         if gone is None:
             stream.set_time(TIMELINE, sequence=step)
             stream.log(path, rr.Clear(recursive=True))
@@ -331,7 +455,9 @@ def log_current_state(
         return 0
     change = np.flatnonzero(np.r_[True, internal_states[1:] != internal_states[:-1]])
     states = internal_states[change]
-    positions = np.array([places.places[int(s)] for s in states.tolist()], np.float64)
+    ids = np.array(sorted(places.places), np.int64)
+    xy = np.array([places.places[s] for s in ids.tolist()], np.float64).reshape(-1, 2)
+    positions = xy[np.searchsorted(ids, states)]
     stream.log(
         CURRENT,
         rr.Points2D.from_fields(
@@ -339,11 +465,27 @@ def log_current_state(
         ),
         static=True,
     )
-    stream.send_columns(
+    if int(ids[-1]) < _MAX_CLASS_ID:
+        # The label "now: {id}" by class id (2 bytes a row) from an annotation context,
+        # rather than a string in every row: a million steps, a third of the file less.
+        stream.log(
+            CURRENT,
+            rr.AnnotationContext(
+                [rr.ClassDescription(info=(s, f"now: {s}")) for s in ids.tolist()]
+            ),
+            static=True,
+        )
+        classes = states.astype(np.uint16)
+        return send_rows(
+            stream,
+            CURRENT,
+            times[change],
+            lambda rows: rr.Points2D.columns(positions=positions[rows], class_ids=classes[rows]),
+        )
+    labels = np.array([f"now: {s}" for s in states.tolist()], np.object_)
+    return send_rows(
+        stream,
         CURRENT,
-        indexes=[rr.TimeColumn(TIMELINE, sequence=times[change])],
-        columns=rr.Points2D.columns(
-            positions=positions, labels=[f"now: {s}" for s in states.tolist()]
-        ),
+        times[change],
+        lambda rows: rr.Points2D.columns(positions=positions[rows], labels=labels[rows].tolist()),
     )
-    return len(change)

@@ -5,10 +5,12 @@ sensation (0 or 1), the float feedback, the obstacle sensor readings (one entity
 tip and obstacle), and the model's size.
 
 The log (``rr.TextLog`` at ``log/audit``) holds, at their steps: every contradiction the
-consistency audit finds (the state, its shortest witness, the number of contradicting pairs),
-the step from which the model stayed deterministic (or, at the last step, that it never did),
-the first step at which it was deterministic and complete, every split and merge, and the
-contradictions and notes a strategy recorded as events.
+consistency audit finds within a model version (the state, its shortest witness, the number of
+contradicting pairs, the version): a WARN when the memory proved it while that version was in
+force (or at the step that replaced it), else an INFO (an old version, proved wrong after it
+was gone); the step from which the model stayed deterministic (or, at the
+last step, that it never did), the first step at which it was deterministic and complete,
+every split and merge, and the contradictions and notes a strategy recorded as events.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import pandas as pd
 import rerun as rr
 
 from rsstp_replay._viewer_chunks import TIMELINE, send_rows
-from rsstp_replay.audits.consistency import ConsistencyFindings
+from rsstp_replay.audits.consistency import ConsistencyFindings, StateContradiction
 from rsstp_replay.audits.determinism import DeterminismFindings
 from rsstp_sim.recording.records import ModelRecord
 
@@ -151,13 +153,15 @@ class LogLine:
 
 def audit_lines(
     versions: Sequence[ModelRecord],
-    consistency: ConsistencyFindings | None,
+    within: ConsistencyFindings | None,
     determinism: DeterminismFindings | None,
     events: pd.DataFrame,
     *,
     last_step: int,
 ) -> list[LogLine]:
-    """Every line of the audit log over the whole recording, sorted by step (stable)."""
+    """Every line of the audit log over the whole recording, sorted by step (stable):
+    ``within`` is the consistency audit within versions
+    (:func:`~rsstp_replay.audits.consistency.audit_consistency_by_version`)."""
     lines: list[LogLine] = []
     for record in versions:
         for operation in record.operations:
@@ -181,20 +185,20 @@ def audit_lines(
                         f"merge: state {t} into state {s} (model version {record.version})",
                     )
                 )
-    if consistency is not None:
-        for found in consistency.contradictions:
-            witness = found.witness
-            lines.append(
-                LogLine(
-                    found.first_step,
-                    "WARN",
-                    f"contradiction: state {found.state}: after steps {witness.i} and "
-                    f"{witness.j} (both in state {found.state}) the actions "
-                    f"{list(witness.actions)} give different sensations at steps "
-                    f"{witness.i + witness.k} and {witness.j + witness.k}; {found.pairs} "
-                    f"contradicting pair{'' if found.pairs == 1 else 's'}",
+    if within is not None:
+        replaced = _replaced_at(versions)
+        for found in within.contradictions:
+            gone = replaced.get(-1 if found.version is None else found.version)
+            if gone is None or found.first_step <= gone:
+                lines.append(LogLine(found.first_step, "WARN", _contradiction(found)))
+            else:
+                lines.append(
+                    LogLine(
+                        found.first_step,
+                        "INFO",
+                        f"{_contradiction(found)} (an old version: replaced at step {gone})",
+                    )
                 )
-            )
     if determinism is not None:
         lines += _determinism_lines(determinism, last_step=last_step)
     for step, kind, text in zip(
@@ -209,6 +213,25 @@ def audit_lines(
             lines.append(LogLine(int(step), "DEBUG", f"strategy note: {text}"))
     lines.sort(key=lambda line: line.step)
     return lines
+
+
+def _replaced_at(versions: Sequence[ModelRecord]) -> dict[int, int]:
+    """The step at which each version (by number) but the last was replaced."""
+    return {
+        record.version: following.step
+        for record, following in zip(versions[:-1], versions[1:], strict=True)
+    }
+
+
+def _contradiction(found: StateContradiction) -> str:
+    witness = found.witness
+    return (
+        f"contradiction: state {found.state}: after steps {witness.i} and {witness.j} (both in "
+        f"state {found.state}) the actions {list(witness.actions)} give different sensations "
+        f"at steps {witness.i + witness.k} and {witness.j + witness.k}; {found.pairs} "
+        f"contradicting pair{'' if found.pairs == 1 else 's'}"
+        + ("" if found.version is None else f"; model version {found.version}")
+    )
 
 
 def _determinism_lines(found: DeterminismFindings, *, last_step: int) -> list[LogLine]:

@@ -36,12 +36,13 @@ import rerun as rr
 from rsstp_replay import _viewer_model as model_part
 from rsstp_replay import _viewer_plots as plots_part
 from rsstp_replay import _viewer_world as world_part
-from rsstp_replay._viewer_blueprint import default_blueprint
+from rsstp_replay._viewer_blueprint import default_blueprint, view_reach
 from rsstp_replay._viewer_chunks import TIMELINE
 from rsstp_replay._viewer_layout import graph_positions
 from rsstp_replay._viewer_serve import DEFAULT_BIND, CtrlC, WebServer, check_port
-from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
+from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
+from rsstp_replay.audits.truth import step_true_classes
 from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
 from rsstp_sim import graph
 from rsstp_sim.errors import RsstpError
@@ -50,6 +51,7 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.truth import compute_truth
 
 __all__ = [
     "APPLICATION_ID",
@@ -69,6 +71,9 @@ __all__ = [
 APPLICATION_ID = "rsstp"
 SPAWN_PORT = 9876
 """The port of a spawned native viewer (Rerun's default)."""
+TRUTH_MAX_POSES = 500_000
+"""The viewer colours states by the truth audit only for worlds of at most this many poses
+(the truth of 322,000 poses takes about 3 s)."""
 SERVE_PORT = 9877
 """The default gRPC port of ``serve_web``'s server (the data; the web page is on 9090)."""
 WEB_PORT = 9090
@@ -85,6 +90,7 @@ ENTITY_PATHS: tuple[str, ...] = (
     model_part.STATES + "/{id}/loops",
     model_part.STATES + "/{id}/poses",
     model_part.CURRENT,
+    model_part.LEGEND,
     plots_part.SENSATION,
     plots_part.FEEDBACK,
     plots_part.DISTANCE,
@@ -322,9 +328,11 @@ class _Loaded:
     steps: pd.DataFrame
     versions: list[ModelRecord]
     events: pd.DataFrame
-    consistency: ConsistencyFindings | None
+    within: ConsistencyFindings | None
     determinism: DeterminismFindings | None
+    roles: model_part.Roles | None
     places: model_part.StatePlaces
+    labelled: set[int]
     seconds_read: float
     seconds_prepare: float
 
@@ -335,18 +343,23 @@ def _load(recording: ViewSource) -> _Loaded:
     versions = list(recording.model_versions())
     events = recording.events()
     read = time.perf_counter()
-    consistency, determinism = _audits(steps, versions)
+    within, determinism = _audits(steps, versions)
     scenario = recording.scenario
     places = model_part.state_places(
         steps, versions, n_joints=scenario.n_joints, reach=scenario.total_length
+    )
+    labelled = model_part.labelled_states(
+        places.places, room=model_part.LABEL_ROOM * scenario.total_length
     )
     return _Loaded(
         steps,
         versions,
         events,
-        consistency,
+        within,
         determinism,
+        _roles(scenario, steps),
         places,
+        labelled,
         seconds_read=read - began,
         seconds_prepare=time.perf_counter() - read,
     )
@@ -359,23 +372,19 @@ def _log(
     window = loaded.steps.iloc[first : last + 1]
     scenario = recording.scenario
     stream.send_recording_name(f"{scenario.name} ({getattr(recording, 'path', 'recording')})")
+    # The small entities first: a viewer reads the file in order, so the model, its size and
+    # the audit log show while the per-step series still load.
     world_part.log_world_static(stream, scenario)
-    rows = world_part.log_world(stream, window, scenario)
-    rows |= plots_part.log_series(
-        stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
-    )
+    if loaded.roles is not None:
+        model_part.log_legend(stream, reach=view_reach(scenario))
     shown, times = _versions_in(loaded.versions, first, last)
-    rows |= model_part.log_model(stream, shown, times, loaded.places)
-    rows |= plots_part.log_model_size(stream, shown, times, last)
-    rows[model_part.CURRENT] = model_part.log_current_state(
-        stream,
-        window.index.to_numpy(np.int64),
-        window["internal_state"].to_numpy(np.int64),
-        loaded.places,
+    rows = model_part.log_model(
+        stream, shown, times, loaded.places, roles=loaded.roles, labelled=loaded.labelled
     )
+    rows |= plots_part.log_model_size(stream, shown, times, last)
     every_line = plots_part.audit_lines(
         loaded.versions,
-        loaded.consistency,
+        loaded.within,
         loaded.determinism,
         loaded.events,
         last_step=recording.n_steps,
@@ -383,6 +392,16 @@ def _log(
     lines = [line for line in every_line if first <= line.step <= last]
     if lines:
         rows[plots_part.LOG] = plots_part.log_lines(stream, lines)
+    rows[model_part.CURRENT] = model_part.log_current_state(
+        stream,
+        window.index.to_numpy(np.int64),
+        window["internal_state"].to_numpy(np.int64),
+        loaded.places,
+    )
+    rows |= world_part.log_world(stream, window, scenario)
+    rows |= plots_part.log_series(
+        stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
+    )
     return LogSummary(
         first_step=first,
         last_step=last,
@@ -456,8 +475,11 @@ def _versions_in(
 def _audits(
     steps: pd.DataFrame, versions: Sequence[ModelRecord]
 ) -> tuple[ConsistencyFindings | None, DeterminismFindings | None]:
-    """The consistency and determinism audits, or None (with a warning) when they fail."""
-    consistency: ConsistencyFindings | None = None
+    """The consistency audit within versions and the determinism audit; None (with a
+    warning) for an audit that fails. (The same consistency audit over the whole history,
+    state ids across versions, is ``rsstp-replay audit``'s: a learner's early versions reused
+    ids that meant something else then, and a million steps audit in seconds.)"""
+    within: ConsistencyFindings | None = None
     determinism: DeterminismFindings | None = None
     try:
         memory = Memory.from_arrays(
@@ -466,11 +488,27 @@ def _audits(
             steps["sensation"].to_numpy(np.bool_),
             steps["feedback"].to_numpy(np.float64),
         )
-        consistency = audit_consistency(memory)
+        within = audit_consistency_by_version(memory, steps["model_version"].to_numpy(np.int64))
     except RsstpError as exc:
         warnings.warn(ViewerWarning(f"consistency audit not shown: {exc}"), stacklevel=3)
     try:
         determinism = audit_determinism(versions)
     except RsstpError as exc:
         warnings.warn(ViewerWarning(f"determinism audit not shown: {exc}"), stacklevel=3)
-    return consistency, determinism
+    return within, determinism
+
+
+def _roles(scenario: Scenario, steps: pd.DataFrame) -> model_part.Roles | None:
+    """Every visited state's role per version by the truth audit, or None (with a warning)
+    when the truth cannot be computed (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
+    try:
+        truth = compute_truth(scenario, max_poses=TRUTH_MAX_POSES)
+        classes = step_true_classes(steps, truth)
+    except RsstpError as exc:
+        warnings.warn(ViewerWarning(f"states not coloured by the truth audit: {exc}"), stacklevel=3)
+        return None
+    return model_part.roles_by_version(
+        steps["model_version"].to_numpy(np.int64),
+        steps["internal_state"].to_numpy(np.int64),
+        classes,
+    )

@@ -19,13 +19,17 @@ from fakes import RandomRefiner
 from rerun.chunk import Chunk, RrdReader
 
 from rsstp_replay import _viewer_layout, viewer
-from rsstp_replay._viewer_model import ACTION_COLORS, POSE_LINES, state_places
+from rsstp_replay._viewer_model import ACTION_COLORS, LABEL_ROOM, POSE_LINES, state_places
+from rsstp_replay.audits.consistency import audit_consistency, audit_consistency_by_version
 from rsstp_replay.audits.contract import version_index
+from rsstp_replay.audits.truth import audit_truth
 from rsstp_replay.errors import ReplayError, StepOutOfRange
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_replay.viewer import ViewerWarning, graph_positions, render_graph, view
+from rsstp_sim import palette
 from rsstp_sim.recording import record
 from rsstp_sim.scenario import load_scenario
+from rsstp_sim.truth import compute_truth
 
 REFERENCE = Path(__file__).parents[2] / "recordings" / "three-joint-random.mcap"
 LEARNER = Path(__file__).parents[2] / "recordings" / "two-joint-30-learner.mcap"
@@ -280,22 +284,49 @@ def _outs(record: Any) -> dict[int, list[tuple[int, int]]]:
     return outs
 
 
+def _brute_force_roles(recording: Recording) -> dict[tuple[int, int], str]:
+    """The role of every (version, state) pair seen at a step, with sets."""
+    table = recording.steps()
+    truth = compute_truth(recording.scenario)
+    angles = table[[f"angle_deg_{j}" for j in range(recording.scenario.n_joints)]].to_numpy()
+    classes: dict[tuple[int, int], set[int]] = defaultdict(set)
+    for version, state, pose in zip(
+        table["model_version"].tolist(), table["internal_state"].tolist(), angles, strict=True
+    ):
+        classes[version, state].add(truth.class_of(pose.tolist()))
+    roles = {}
+    for (version, state), mine in classes.items():
+        if len(mine) > 1:
+            roles[version, state] = "aliased"
+        else:
+            shared = any(
+                v == version and s != state and mine <= other for (v, s), other in classes.items()
+            )
+            roles[version, state] = "redundant" if shared else "exact"
+    return roles
+
+
 def test_a_state_has_a_row_where_it_changed_and_a_clear_where_it_went(
     refined: tuple[Recording, Rrd],
 ) -> None:
     """Rows against a brute force over the versions: a state gets a row at the step of every
-    version in which it appears or its transitions out differ from the version before, and a
-    clear at the step of the version that deletes it."""
+    version in which it appears, its transitions out differ from the version before or its
+    role does (the true classes it stood for over the version's steps), and a clear at the
+    step of the version that deletes it."""
     recording, rrd = refined
     versions = recording.model_versions()
     expected_rows: dict[int, list[int]] = defaultdict(list)
     expected_clears: dict[int, list[int]] = defaultdict(list)
     previous: dict[int, list[tuple[int, int]]] = {}
+    previous_roles: dict[int, str] = {}
+    roles = _brute_force_roles(recording)
     for version in versions:
         now = _outs(version)
+        now_roles = {s: roles.get((version.version, s), "unvisited") for s in now}
         for state, outs in now.items():
-            if previous.get(state) != outs:
+            if previous.get(state) != outs or previous_roles.get(state) != now_roles[state]:
                 expected_rows[state].append(version.step)
+        previous_roles = now_roles
         for state in set(previous) - set(now):
             expected_clears[state].append(version.step)
         previous = now
@@ -343,10 +374,18 @@ def test_current_state_at_every_step(refined: tuple[Recording, Rrd]) -> None:
     recording, rrd = refined
     states = recording.steps()["internal_state"].tolist()
     changes = [0] + [t for t in range(1, len(states)) if states[t] != states[t - 1]]
-    labels = rrd.column("world/model/current", "Points2D:labels")
-    assert [step for step, _ in labels] == changes
+    classes = rrd.column("world/model/current", "Points2D:class_ids")
+    assert [step for step, _ in classes] == changes
+    # The label of a class id comes from the static annotation context.
+    [[context]] = [
+        batch.column("AnnotationContext:context").to_pylist()[0]
+        for batch in (chunk.to_record_batch() for chunk in rrd.static["world/model/current"])
+        if "AnnotationContext:context" in batch.schema.names
+    ]
+    label = {item["class_id"]: item["class_description"]["info"]["label"] for item in context}
     for step in range(0, len(states), 37):
-        assert rrd.at("world/model/current", "Points2D:labels", step) == [f"now: {states[step]}"]
+        [class_id] = rrd.at("world/model/current", "Points2D:class_ids", step)
+        assert label[class_id] == f"now: {states[step]}"
 
 
 def test_an_aliased_state_has_lines_to_its_poses(reference: tuple[Recording, Rrd]) -> None:
@@ -576,3 +615,124 @@ def test_entity_paths_are_documented() -> None:
     documented = (Path(__file__).parents[2] / "docs" / "viewer.md").read_text()
     for path in viewer.ENTITY_PATHS:
         assert f"`{path}`" in documented
+
+
+# ------------------------------------------------- the truth: log levels, colours, labels
+
+
+@pytest.fixture(scope="module")
+def learner(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Recording, Rrd]]:
+    """The learner's reference recording (12,000 steps, learned at step 8,599), viewed."""
+    out = tmp_path_factory.mktemp("viewer") / "learner.rrd"
+    with open_recording(LEARNER) as recording:
+        view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+        yield recording, Rrd(out)
+
+
+def _log(rrd: Rrd) -> list[tuple[int, str, str]]:
+    texts = rrd.column("log/audit", "TextLog:text")
+    levels = rrd.column("log/audit", "TextLog:level")
+    return [(step, level, text) for (step, [text]), (_, [level]) in zip(texts, levels, strict=True)]
+
+
+def test_per_version_findings_warn_and_history_ones_are_left_out(
+    learner: tuple[Recording, Rrd],
+) -> None:
+    """Within-version contradictions are WARN where their version was in force (or replaced
+    at that step), INFO after; the whole-history ones are not shown; no WARN after the step
+    from which the run learned (the truth audit's verdict)."""
+    recording, rrd = learner
+    lines = _log(rrd)
+    findings = audit_truth(recording)
+    learned = findings.learned_at_step
+    assert learned is not None
+    assert [line for line in lines if line[1] == "WARN" and line[0] > learned] == []
+    versions = recording.model_versions()
+    replaced = {a.version: b.step for a, b in zip(versions[:-1], versions[1:], strict=True)}
+    within = audit_consistency_by_version(
+        recording.memory(), recording.steps()["model_version"].to_numpy()
+    )
+    expected = sorted(
+        (
+            found.first_step,
+            "WARN" if found.first_step <= replaced.get(found.version, found.first_step) else "INFO",
+        )
+        for found in within.contradictions
+    )
+    shown = sorted(
+        (step, level)
+        for step, level, text in lines
+        if text.startswith("contradiction:") and "model version" in text
+    )
+    assert shown == expected and "WARN" in {level for _, level in shown}
+    # The whole history's findings (state ids across versions) are more, and none is shown.
+    history = audit_consistency(recording.memory()).contradictions
+    assert len(history) > len(within.contradictions)
+    assert len([text for _, _, text in lines if text.startswith("contradiction:")]) == len(shown)
+
+
+def test_states_are_coloured_by_what_they_stood_for(learner: tuple[Recording, Rrd]) -> None:
+    recording, rrd = learner
+    roles = _brute_force_roles(recording)
+    colors = {
+        "exact": palette.STATE_EXACT,
+        "redundant": palette.STATE_REDUNDANT,
+        "aliased": palette.STATE_ALIASED,
+        "unvisited": palette.STATE_UNVISITED,
+    }
+    versions = recording.model_versions()
+    seen = set()
+    for index in (len(versions) // 3, len(versions) - 1):
+        version = versions[index]
+        at = version.step if index == len(versions) - 1 else versions[index + 1].step - 1
+        for state in version.states:
+            role = roles.get((version.version, state), "unvisited")
+            [color] = rrd.at(f"world/model/state/{state}", "Points2D:colors", at)
+            assert _rgb(color) == colors[role], (version.version, state)
+            seen.add(role)
+    assert {"exact", "aliased"} <= seen
+    legend = rrd.static["world/model/legend"][0].to_record_batch()
+    assert legend.column("Points2D:labels").to_pylist()[0] == [
+        "exact state",
+        "redundant state",
+        "aliased state",
+        "unvisited state",
+    ]
+
+
+def test_labels_only_where_they_fit(refined: tuple[Recording, Rrd]) -> None:
+    """A state is labelled iff no other state is within the label's room of it."""
+    recording, rrd = refined
+    places = state_places(recording.steps(), recording.model_versions(), n_joints=3, reach=6.0)
+    room = LABEL_ROOM * 6.0
+    labelled = 0
+    for state, (x, y) in places.places.items():
+        rows = rrd.column(f"world/model/state/{state}", "Points2D:labels")
+        fits = all(
+            abs(x - u) >= room or abs(y - v) >= room / 2
+            for other, (u, v) in places.places.items()
+            if other != state
+        )
+        positions = rrd.column(f"world/model/state/{state}", "Points2D:positions")
+        if not positions:
+            continue
+        if fits:
+            assert [labels for _, labels in rows] == [[str(state)]] * len(positions)
+            labelled += 1
+        else:
+            assert rows == []
+    assert 0 < labelled < len(places.places)
+
+
+def test_without_the_truth_the_states_are_not_coloured(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(viewer, "TRUTH_MAX_POSES", 10)
+    out = tmp_path / "plain.rrd"
+    with open_recording(REFERENCE) as recording:
+        with pytest.warns(ViewerWarning, match="states not coloured by the truth audit: .*poses"):
+            view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+    rrd = Rrd(out)
+    assert "world/model/legend" not in rrd.static
+    [(_, [color])] = rrd.column("world/model/state/0", "Points2D:colors")
+    assert _rgb(color) == palette.STATE

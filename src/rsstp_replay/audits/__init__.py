@@ -11,6 +11,8 @@ Each audit returns a frozen findings object with ``to_text()`` and ``to_json()``
   step (a state id means what its version says);
 - :func:`audit_truth`: the verdict (learned, from which step, or why not), and every model
   version against the ground truth (aliasing, redundancy, contradictions, equivalence);
+- :func:`state_roles`: what each state of each version stood for by the truth (exact,
+  redundant, aliased, unvisited);
 - :func:`check_contract`: the step records against the model messages, at every step.
 
 The audits read a recording through :class:`AuditSource` (``memory()``, ``model_versions()``,
@@ -34,6 +36,7 @@ from rsstp_replay.audits.determinism import (
     audit_determinism,
 )
 from rsstp_replay.audits.report import AuditReport, run_audits
+from rsstp_replay.audits.state_roles import ROLE_NAMES, state_roles
 from rsstp_replay.audits.summary import AuditSource, ModelSize, SummaryFindings, audit_summary
 from rsstp_replay.audits.truth import (
     TruthFindings,
@@ -55,6 +58,7 @@ __all__ = [
     "HasMemory",
     "HasModelVersions",
     "ModelSize",
+    "ROLE_NAMES",
     "StateContradiction",
     "SummaryFindings",
     "TruthFindings",
@@ -72,6 +76,7 @@ __all__ = [
     "compare",
     "find_contradictions",
     "run_audits",
+    "state_roles",
     "step_true_classes",
     "truth_table",
 ]
