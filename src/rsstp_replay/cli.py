@@ -24,7 +24,7 @@ from rsstp_replay.recording import Recording, open_recording
 from rsstp_replay.table_files import TABLE_FORMATS, sidecar_path, write_table
 from rsstp_replay.tables import TABLES, recording_table
 from rsstp_sim.commandline import Parser, UsageError, progress, run_command
-from rsstp_sim.files import irregular
+from rsstp_sim.files import check_output
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -124,9 +124,9 @@ def _check_table_output(out: Path, *, force: bool) -> None:
             f"{out}: unknown table format {out.suffix or '(no suffix)'!r}: expected "
             f"{' or '.join(TABLE_FORMATS)}"
         )
-    _check_output(out, force=force)
+    check_output(out, force=force)
     if out.suffix.lower() == ".csv":
-        _check_output(sidecar_path(out), force=force)
+        check_output(sidecar_path(out), force=force)
 
 
 def _write_table(table: pd.DataFrame, out: Path) -> None:
@@ -273,20 +273,6 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_output(out: Path, *, force: bool) -> None:
-    """One line for an output path we must not or cannot write."""
-    if out.is_dir():
-        raise UsageError(f"{out}: is a directory, not an output file")
-    kind = irregular(out)
-    if kind is not None:
-        raise UsageError(f"{out}: {kind}: only a regular file is ever written or replaced")
-    if out.exists() and not force:
-        raise UsageError(f"{out}: already exists (use --force to overwrite)")
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir():
-        raise UsageError(f"{out}: the output directory {parent} does not exist")
-
-
 def _cmd_view(args: argparse.Namespace) -> int:
     from rsstp_replay._viewer_serve import check_port, ctrl_c_remembered, has_display
     from rsstp_replay.viewer import ViewerWarning, ViewResult, view
@@ -299,7 +285,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
             "write a file with --save OUT.rrd, or serve the web viewer with --serve-web"
         )
     if save is not None:
-        _check_output(save, force=args.force)
+        check_output(save, force=args.force)
     if args.serve_web:  # before anything is read: a port in use is one line
         check_port(args.bind, args.web_port, option="--web-port")
         check_port(args.bind, args.grpc_port, option="--grpc-port")
@@ -349,7 +335,7 @@ def _cmd_graph(args: argparse.Namespace) -> int:
     from rsstp_replay.viewer import render_graph
 
     out = Path(args.output)
-    _check_output(out, force=args.force)
+    check_output(out, force=args.force)
     with _open(args.file) as recording:
         written = render_graph(recording, args.step, out, on_world=args.on_world)
     where = "on the world" if args.on_world else "laid out as in every version"
@@ -367,7 +353,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
         )
     if out.resolve() == Path(args.foxglove).resolve():
         raise UsageError(f"{out}: is the recording being exported: give another output")
-    _check_output(out, force=args.force)
+    check_output(out, force=args.force)
     with _open(args.foxglove) as recording:
         print(export_foxglove(recording, out).to_text())
     return 0

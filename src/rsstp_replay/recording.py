@@ -282,7 +282,7 @@ class Recording:
                 self._models = (model_record(one_state, step=0, operations=()),)
                 return self._models
             models = self._records("/rsstp/model", keep=_SharedIds())
-            verify_chain(self.path, models)
+            verify_chain(self.path, models, last_step=self.n_steps)
             self._models = tuple(models)
         return self._models
 
