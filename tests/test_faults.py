@@ -259,3 +259,25 @@ def test_numbers_that_overflow_the_geometry_are_refused_first(
             f"rsstp-sim: error: {scenario}: {where}: expected a number of size at most "
             f"{MAX_MAGNITUDE:g}, found {first!r}",
         )
+
+
+def test_view_save_never_starts_reruns_file_writer(
+    roulette: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Rerun's file-writer thread can hang its flush for good after a failed write (``view
+    --save`` under ``ulimit -f 8`` hung in 4 of 8 tries): a save without a viewer to feed
+    encodes in memory and writes the bytes itself, so that thread never runs."""
+    import rerun as rr
+
+    from rsstp_replay import open_recording
+    from rsstp_replay.viewer import view
+
+    def no_file_sink(*args: object, **kwargs: object) -> None:
+        raise AssertionError("rr.FileSink was used")
+
+    monkeypatch.setattr(rr, "FileSink", no_file_sink)
+    out = tmp_path / "run.rrd"
+    with open_recording(roulette) as recording:
+        view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+    assert out.read_bytes().startswith(b"RRF2")
+    assert [p.name for p in tmp_path.iterdir()] == ["run.rrd"]

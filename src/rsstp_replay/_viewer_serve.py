@@ -29,6 +29,7 @@ from rsstp_replay.errors import ReplayError
 
 __all__ = [
     "DEFAULT_BIND",
+    "STOP_SIGNALS",
     "CtrlC",
     "WebServer",
     "check_port",
@@ -73,9 +74,14 @@ class CtrlC:
     pressed: bool = False
 
 
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+"""What stops a view as Ctrl-C does: a terminal closed (SIGHUP) and ``kill`` (SIGTERM) too, so
+the servers and the temporary folder go with the command."""
+
+
 @contextmanager
 def ctrl_c_remembered(*, interrupt: bool = True) -> Iterator[CtrlC]:
-    """Within: Ctrl-C (SIGINT) sets the flag yielded and, with ``interrupt``, also raises
+    """Within: Ctrl-C (SIGINT, or SIGTERM or SIGHUP: :data:`STOP_SIGNALS`) sets the flag yielded and, with ``interrupt``, also raises
     :class:`KeyboardInterrupt`; a wait that polls the flag stops even when the exception
     was lost.
 
@@ -95,11 +101,12 @@ def ctrl_c_remembered(*, interrupt: bool = True) -> Iterator[CtrlC]:
     if threading.current_thread() is not threading.main_thread():
         yield pressed
         return
-    previous = signal.signal(signal.SIGINT, handler)
+    previous = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
     try:
         yield pressed
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig, before in previous.items():
+            signal.signal(sig, before)
 
 
 def rerun_program() -> str:

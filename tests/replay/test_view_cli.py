@@ -208,10 +208,14 @@ def test_ctrl_c_as_the_server_starts_leaves_no_server(tmp_path: Path) -> None:
 
 
 @pytest.mark.skipif(not Path("/proc/net/tcp").exists(), reason="needs Linux's /proc/net/tcp")
-def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(tmp_path: Path) -> None:
+@pytest.mark.parametrize("stop", [signal.SIGINT, signal.SIGTERM, signal.SIGHUP], ids=str)
+def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(
+    stop: signal.Signals, tmp_path: Path
+) -> None:
     """A real server: once it says it serves, the page answers on 127.0.0.1, nothing listens
-    on another address, and SIGINT stops it with exit 0 and removes the temporary file it
-    served. (A Ctrl-C before that line, while the file is read, is "interrupted", exit 130.)"""
+    on another address, and SIGINT (or SIGTERM, SIGHUP) stops both servers with exit 0 and
+    removes the temporary file it served. (A Ctrl-C before that line, while the file is read,
+    is "interrupted", exit 130.)"""
     web, grpc = _free_port(), _free_port()
     server = _serve(web, grpc, tmp_path)
     said = b""  # read from the pipe itself: a text reader's buffer would hide what it holds
@@ -229,7 +233,7 @@ def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(tmp_path: Path) -> No
         assert b"<html" in page.lower()
         assert list(tmp_path.glob("rsstp-view-*/view.rrd"))
     finally:
-        server.send_signal(signal.SIGINT)
+        server.send_signal(stop)
         try:
             out, err = server.communicate(timeout=60)
         except subprocess.TimeoutExpired:  # fail this test alone: leave nothing running
@@ -241,7 +245,8 @@ def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(tmp_path: Path) -> No
     assert "serving the web viewer at http://127.0.0.1:" in out and "stopped serving" in out
     assert "Traceback" not in err
     assert not list(tmp_path.glob("rsstp-view-*"))
-    assert not _listening(web)
+    time.sleep(0.5)  # the server's child has had its SIGTERM; give the kernel a moment
+    assert not _listening(web) and not _listening(grpc)
 
 
 def test_a_file_size_limit_never_leaves_a_truncated_rrd(tmp_path: Path) -> None:
