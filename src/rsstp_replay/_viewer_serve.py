@@ -82,8 +82,8 @@ the servers and the temporary folder go with the command."""
 @contextmanager
 def ctrl_c_remembered(*, interrupt: bool = True) -> Iterator[CtrlC]:
     """Within: Ctrl-C (SIGINT, or SIGTERM or SIGHUP: :data:`STOP_SIGNALS`) sets the flag
-    yielded and, with ``interrupt``, also raises :class:`KeyboardInterrupt`; a wait that polls the flag stops even when the exception
-    was lost.
+    yielded and, with ``interrupt``, also raises :class:`KeyboardInterrupt`; a wait that polls
+    the flag stops even when the exception was lost.
 
     Python ignores an exception raised inside a finaliser (``__del__``), and a
     ``KeyboardInterrupt`` lands in one whenever the signal arrives while the garbage collector
