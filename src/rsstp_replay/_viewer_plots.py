@@ -25,6 +25,7 @@ from rsstp_replay._viewer_chunks import TIMELINE, send_rows
 from rsstp_replay.audits.consistency import ConsistencyFindings
 from rsstp_replay.audits.determinism import DeterminismFindings
 from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.words import counted
 
 __all__ = [
     "DISTANCE",
@@ -191,8 +192,8 @@ def audit_lines(
                     f"contradiction: state {found.state}: after steps {witness.i} and "
                     f"{witness.j} (both in state {found.state}) the actions "
                     f"{list(witness.actions)} give different sensations at steps "
-                    f"{witness.i + witness.k} and {witness.j + witness.k}; {found.pairs} "
-                    f"contradicting pair{'' if found.pairs == 1 else 's'}",
+                    f"{witness.i + witness.k} and {witness.j + witness.k}; "
+                    f"{counted(found.pairs, 'contradicting pair')}",
                 )
             )
     if determinism is not None:

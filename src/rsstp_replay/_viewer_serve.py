@@ -35,6 +35,7 @@ __all__ = [
     "check_port",
     "ctrl_c_remembered",
     "has_display",
+    "rerun_command",
     "rerun_program",
 ]
 
@@ -115,6 +116,16 @@ def rerun_program() -> str:
     if found is None:
         raise ReplayError("the 'rerun' program of rerun-sdk was not found beside Python or on PATH")
     return found
+
+
+def rerun_command() -> str:
+    """How to run :func:`rerun_program` from this shell: ``rerun`` when that is what ``PATH``
+    finds, else its full path (a venv that is not activated)."""
+    program = rerun_program()
+    on_path = shutil.which("rerun")
+    if on_path is not None and Path(on_path).resolve() == Path(program).resolve():
+        return "rerun"
+    return program
 
 
 class WebServer:

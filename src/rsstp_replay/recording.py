@@ -51,6 +51,7 @@ from rsstp_sim.recording.records import EventRecord, ModelRecord, TransitionsRec
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, compute_truth
+from rsstp_sim.words import counted
 
 __all__ = ["EVENT_KINDS", "Recording", "open_recording"]
 
@@ -85,7 +86,7 @@ def open_recording(path: str | os.PathLike[str]) -> Recording:
         warnings.warn(
             UnfinishedRecordingWarning(
                 f"{recording.path}: the file was not finished; recovered "
-                f"{recording.recovered_steps} steps from its complete chunks "
+                f"{counted(recording.recovered_steps, 'step')} from its complete chunks "
                 f"(read {recording._file.container.recovered_bytes} of "
                 f"{recording._file.container.size} bytes)"
             ),

@@ -50,6 +50,7 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.words import counted
 
 __all__ = [
     "APPLICATION_ID",
@@ -152,8 +153,10 @@ class ViewResult:
         if self.web_url is not None:
             where.append(f"serving the web viewer at {self.web_url}")
         return (
-            f"steps {s.first_step}..{s.last_step}: {len(s.rows)} entities, "
-            f"{s.model_versions} model versions, {s.log_lines} log lines; read "
+            f"steps {s.first_step:,}..{s.last_step:,}: "
+            f"{counted(len(s.rows), 'entity', 'entities')}, "
+            f"{counted(s.model_versions, 'model version')}, {counted(s.log_lines, 'log line')}; "
+            "read "
             f"{s.seconds_read:.2f} s, audits and placing {s.seconds_prepare:.2f} s, Rerun "
             f"{self.seconds_rerun:.2f} s" + ("; " + ", ".join(where) if where else "")
         )

@@ -25,6 +25,7 @@ from rsstp_sim.nesting import too_deep
 from rsstp_sim.scenario import MANY_OBSTACLES, Scenario, builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.words import counted
 
 __all__ = ["main"]
 
@@ -220,7 +221,7 @@ def _cmd_graph(args: argparse.Namespace) -> int:
         model = runner.model
     out = Path(args.output)
     written = graph.render(model, out)
-    print(f"wrote {written} ({len(model)} states)")
+    print(f"wrote {written} ({counted(len(model), 'state')})")
     return 0
 
 
@@ -255,16 +256,16 @@ def _cmd_record(args: argparse.Namespace) -> int:
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    counts = ", ".join(f"{topic} {count}" for topic, count in result.messages.items())
+    counts = ", ".join(f"{topic} {count:,}" for topic, count in result.messages.items())
     if result.interrupted:
         name = signal.Signals(received[0]).name if received else "a stop request"
         print(
-            f"{PROG}: interrupted by {name}: kept {result.steps} steps in {result.path} "
+            f"{PROG}: interrupted by {name}: kept {counted(result.steps, 'step')} in {result.path} "
             f"(file finished)",
             file=sys.stderr,
         )
         return 128 + received[0] if received else 1
-    print(f"recorded {result.steps} steps to {result.path} ({counts})")
+    print(f"recorded {counted(result.steps, 'step')} to {result.path} ({counts})")
     return 0
 
 

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import select
+import shlex
 import shutil
 import signal
 import socket
@@ -36,7 +37,15 @@ def test_view_saves_an_rrd_and_says_how_to_open_it(tmp_path: Path) -> None:
     assert done.returncode == 0, done.stderr
     assert out.stat().st_size > 0
     assert out.read_bytes()[:4] == b"RRF2"  # Rerun's file magic
-    assert f"open it with: rerun {out}" in done.stdout
+    # PATH without the venv's bin (not activated): the printed command runs as printed
+    rerun = str(Path(sys.executable).parent / "rerun")
+    assert f"open it with: {rerun} {out}" in done.stdout
+    shown = next(line for line in done.stdout.splitlines() if line.startswith("open it with"))
+    verified = subprocess.run(
+        [*shlex.split(shown.removeprefix("open it with: "))[:1], "rrd", "verify", str(out)],
+        capture_output=True, text=True, timeout=120, env={"PATH": "/usr/bin:/bin"},
+    )  # fmt: skip
+    assert verified.returncode == 0, verified.stderr
     again = run_cli("view", str(REFERENCE), "--save", str(out))
     assert again.returncode == 2
     assert (
