@@ -281,3 +281,28 @@ def test_view_save_never_starts_reruns_file_writer(
         view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
     assert out.read_bytes().startswith(b"RRF2")
     assert [p.name for p in tmp_path.iterdir()] == ["run.rrd"]
+
+
+def test_a_world_too_big_to_tabulate_is_refused_at_once(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Three joints among 1,000 obstacles: `truth` took 130 s and 8.6 GB; now one line."""
+    import time
+
+    obstacles = "".join(
+        f"[[obstacles]]\ncenter = [{40 + i % 40}.0, {40 + i // 40}.0]\nradius = 0.1\n"
+        for i in range(1000)
+    )
+    scenario = tmp_path / "many.toml"
+    scenario.write_text(
+        "[arm]\nlengths = [3.0, 2.0, 1.0]\ninitial_deg = [330, 3, 357]\nstep_deg = 5\n" + obstacles
+    )
+    began = time.perf_counter()
+    assert sim_main(["truth", str(scenario)]) == 2
+    assert time.perf_counter() - began < 20
+    err = capsys.readouterr().err.strip().splitlines()
+    assert err[-1] == (
+        "rsstp-sim: error: many: refused: tabulating the world would take about 6,718,464,000 "
+        "link-obstacle checks (373,248 poses x 6 moves x 3 links x 1,000 obstacles), more than "
+        "the 1,000,000,000 (about 20 s) the ground truth takes on"
+    )
