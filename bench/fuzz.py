@@ -1,11 +1,18 @@
 """Fuzz scenario files and recordings with a long budget; report cases tried and failures.
 
     PYTHONPATH=src:tests python bench/fuzz.py [--scenarios 5000] [--recordings 5000]
+        [--deep 1000] [--rewrites 500] [--outputs 500]
 
 The strategies and the properties are the test suite's (``tests/fuzzing.py``); the default
 test run tries 80 fixed cases of each, this tries many more, random ones, and does not stop
 at the first failure: every case that breaks a property is counted and the first few of each
 kind are printed. Exit 1 when any case failed.
+
+The categories: scenario files (any TOML value at any key, integer extremes among them);
+damaged recordings (bytes flipped, cut, overwritten...); deep nesting (TOML and JSON inputs of
+every command line nested up to 5,000 deep); semantic rewrites (a ground-truth value of a real
+recording changed, the file still well-formed: ``check --physics`` must not pass it); output
+faults (every command that writes, into a read-only folder or past a file-size limit).
 
 The recordings mutated are real ones of several chunks, model versions and events: a
 three-joint splitter run of 300 steps (chunks of 8 KiB) and a two-joint-30 learner run of
@@ -100,9 +107,13 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenarios", type=int, default=5_000, help="scenario cases (0: none)")
     parser.add_argument("--recordings", type=int, default=5_000, help="recording cases (0: none)")
+    parser.add_argument("--deep", type=int, default=1_000, help="deep nesting cases (0: none)")
+    parser.add_argument("--rewrites", type=int, default=500, help="semantic rewrites (0: none)")
+    parser.add_argument("--outputs", type=int, default=500, help="output faults (0: none)")
     args = parser.parse_args()
-    if min(args.scenarios, args.recordings) < 0:
-        parser.error("--scenarios and --recordings take a number of cases >= 0")
+    budgets = (args.scenarios, args.recordings, args.deep, args.rewrites, args.outputs)
+    if min(budgets) < 0:
+        parser.error("every budget takes a number of cases >= 0")
     with tempfile.TemporaryDirectory() as name:
         folder = Path(name)
         scenarios = Tally("scenario files", args.scenarios)
@@ -119,7 +130,33 @@ def main() -> int:
             lambda case: fuzzing.check_recording(case[1], references[case[0]], folder),
         )
         recordings.report()
-    return 1 if scenarios.failures or recordings.failures else 0
+
+        deep = Tally("deep nesting", args.deep)
+        explore(deep, fuzzing.deep_texts(), lambda case: fuzzing.check_deep(case, folder))
+        deep.report()
+
+        walk = folder / "walk.mcap"
+        record(walk, load_scenario("three-joint"), make_strategy("random"), steps=400, seed=2,
+               chunk_size=8_192)  # fmt: skip
+        rewrites = Tally("semantic rewrites", args.rewrites)
+        explore(
+            rewrites,
+            fuzzing.semantic_rewrites(),
+            lambda case: fuzzing.check_rewrite(case, walk, 400, folder),
+        )
+        rewrites.report()
+
+        outputs = Tally("output faults", args.outputs)
+        explore(
+            outputs,
+            fuzzing.output_faults(),
+            lambda case: fuzzing.check_output_fault(case, walk, folder),
+        )
+        outputs.report()
+    tallies = (scenarios, recordings, deep, rewrites, outputs)
+    print(f"total: {sum(t.cases for t in tallies):,} cases, "
+          f"{sum(sum(t.failures.values()) for t in tallies):,} failed")  # fmt: skip
+    return 1 if any(t.failures for t in tallies) else 0
 
 
 if __name__ == "__main__":

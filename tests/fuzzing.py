@@ -6,6 +6,13 @@ must keep to.
   deleted, unknown keys added, and now and then a character of the text changed.
 - :func:`recording_mutations`: edits of a real recording's bytes: bit flips, truncation,
   ranges overwritten, deleted, duplicated or inserted.
+- :func:`deep_texts`: TOML and JSON texts nested up to thousands deep, for every command line
+  input that is parsed (a scenario file, a sweep file, ``--matrix``, ``--param``).
+- :func:`semantic_rewrites`: a real recording re-encoded with a ground-truth value of a step
+  changed (integer extremes among the values): still well-formed, it must be refused, or
+  caught by ``check --physics`` (the re-simulation).
+- :func:`output_faults`: every command that writes, with its output in a read-only folder or
+  past a file-size limit.
 
 :func:`check_scenario` and :func:`check_recording` return what went wrong with one case
 (``None`` when nothing did): an exception that is not the package's documented error, a
@@ -19,7 +26,11 @@ from __future__ import annotations
 import contextlib
 import copy
 import io
+import json
+import os
+import resource
 import signal
+import sys
 import time
 import warnings
 from collections.abc import Callable, Iterator
@@ -29,6 +40,8 @@ from typing import Any
 
 import pandas as pd
 from hypothesis import strategies as st
+
+sys.path.insert(0, str(Path(__file__).resolve().parent / "replay"))  # test_corrupt's rewrite
 
 from conftest import VALID_SCENARIO
 from rsstp_replay import ReplayError, UnfinishedRecordingWarning, open_recording
@@ -76,7 +89,8 @@ _SCALARS = st.one_of(
     st.booleans(),
     st.integers(-(2**63), 2**63 - 1),
     st.floats(allow_nan=True, allow_infinity=True),
-    st.sampled_from([0, -1, 1, 359, 360, 361, 1e308, -1e308, 5e-324, 1e-6]),
+    st.sampled_from([0, -1, 1, 359, 360, 361, 1e308, -1e308, 5e-324, 1e-6, 3e307, 1e12, 1e13]),
+    st.sampled_from([2**63 - 1, 2**63, -(2**63) - 1, 2**64, 10**30, -(10**30)]),
     st.text(max_size=12),
 )
 _TOML = st.recursive(
@@ -412,3 +426,247 @@ def check_recording(mutations: list[Mutation], written: Written, folder: Path) -
         return f"over {RECORDING_SECONDS} s ({time.perf_counter() - began:.1f} s)"
     except Exception as exc:
         return f"{type(exc).__name__}: {str(exc)[:300]}"
+
+
+# ----------------------------------------------------------------------------- deep nesting
+
+
+@dataclass(frozen=True, slots=True)
+class Deep:
+    """A text nested ``depth`` deep given to one of the command line's parsed inputs."""
+
+    where: str  # "scenario", "sweep", "matrix" or "param"
+    depth: int
+    opener: str  # "[" or "{"
+
+    def text(self) -> str:
+        if self.where in ("matrix", "param"):  # JSON
+            inner = "[" * self.depth + "]" * self.depth
+            if self.opener == "{":
+                inner = '{"a":' * self.depth + "0" + "}" * self.depth
+            return inner
+        if self.opener == "{":
+            return "x = " + "{a = " * self.depth + "1" + "}" * self.depth + "\n"
+        return "x = " + "[" * self.depth + "]" * self.depth + "\n"
+
+
+def deep_texts() -> st.SearchStrategy[Deep]:
+    return st.builds(
+        Deep,
+        where=st.sampled_from(["scenario", "sweep", "matrix", "param"]),
+        depth=st.one_of(st.integers(1, 200), st.integers(200, 5000)),
+        opener=st.sampled_from(["[", "{"]),
+    )
+
+
+def check_deep(case: Deep, folder: Path) -> str | None:
+    """The command ends in 0, 1 or 2 with at most one error line; never a traceback; past
+    the nesting limit it is refused (exit 2)."""
+    from rsstp_sim.nesting import MAX_NESTING
+
+    text = case.text()
+    file = folder / "deep.toml"
+    file.write_text(text, encoding="utf-8")
+    argv = {
+        "scenario": ["run", str(file), "--steps", "1"],
+        "sweep": ["sweep", str(file), "-o", str(folder / "deep-sweep")],
+        "matrix": ["graph", "--matrix", text, "-o", str(folder / "deep.dot"), "--force"],
+        "param": ["run", "thesis-roulette", "--steps", "1", "--param", f"actions={text}"],
+    }[case.where]
+    try:
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            code = sim_cli.main(argv)
+    except Exception as exc:
+        return f"{type(exc).__name__}: {str(exc)[:200]}"
+    errors = err.getvalue().splitlines()
+    if code not in (0, 1, 2) or len([e for e in errors if "error:" in e]) > 1:
+        return f"{case.where}: exit {code}, {errors[:3]}"
+    if case.depth > MAX_NESTING and code != 2:
+        return f"{case.where}: nested {case.depth} deep, exit {code}"
+    return None
+
+
+# ------------------------------------------------------------------------ semantic rewrites
+
+_EXTREMES = [0, -1, 1, 7, 359, 360, 2**31, 2**63 - 1, 2**63, 2**64, -(2**63) - 1, 10**30]
+
+
+@dataclass(frozen=True, slots=True)
+class Rewrite:
+    """A ground-truth field of the step message at ``where`` (a fraction of the steps)
+    given ``value`` (``nudge``: the old number plus ``value``)."""
+
+    where: float
+    field: str
+    value: Any
+    nudge: bool
+
+
+_FIELDS = [
+    "agent.sensation",
+    "agent.feedback",
+    "agent.action",
+    "truth.angles_deg.0",
+    "truth.angles_deg.2",
+    "truth.joint_positions.1.x",
+    "truth.joint_positions.3.y",
+    "truth.distances.2.obstacles.0",
+    "truth.blocked",
+]
+
+
+def semantic_rewrites() -> st.SearchStrategy[Rewrite]:
+    number = st.one_of(
+        st.sampled_from(_EXTREMES),
+        st.integers(-400, 400),
+        st.floats(allow_nan=False, allow_infinity=False, width=64),
+        st.sampled_from([1e-12, 5e-324, 0.5, 1e308]),
+    )
+    return st.builds(
+        Rewrite,
+        where=st.floats(0.0, 1.0),
+        field=st.sampled_from(_FIELDS),
+        value=number,
+        nudge=st.booleans(),
+    )
+
+
+def _rewrite_message(data: bytes, case: Rewrite) -> bytes | None:
+    """The message with the field changed, or None when the change would not change it."""
+    message = json.loads(data)
+    *path, last = case.field.split(".")
+    here: Any = message
+    for key in path:
+        here = here[int(key)] if key.isdigit() else here[key]
+    key: Any = int(last) if last.isdigit() else last
+    old = here[key]
+    if isinstance(old, bool):
+        new: Any = not old
+    elif case.nudge and isinstance(case.value, int | float):
+        new = old + case.value
+    else:
+        new = case.value
+    if type(new) is type(old) and new == old:
+        return None
+    here[key] = new
+    return json.dumps(message, separators=(",", ":")).encode()
+
+
+def check_rewrite(case: Rewrite, source: Path, steps: int, folder: Path) -> str | None:
+    """A recording with one ground-truth value changed must not pass ``check --physics``."""
+    from test_corrupt import rewrite
+
+    step = max(1, min(steps, int(case.where * (steps + 1))))
+    target = step
+    changed: list[bool] = []
+
+    def message(topic: str, log_time: int, data: bytes) -> bytes:
+        if topic != "/rsstp/step" or log_time != target * 1_000_000:
+            return data
+        new = _rewrite_message(data, case)
+        if new is None:
+            return data
+        changed.append(True)
+        return new
+
+    path = rewrite(source, folder / "rewritten.mcap", message=message)
+    if not changed:
+        return None
+    began = time.perf_counter()
+    try:
+        with _time_bound(RECORDING_SECONDS):
+            err, out = io.StringIO(), io.StringIO()
+            with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+                code = replay_cli.main(["check", "--physics", str(path)])
+    except _OverTime:
+        return f"over {RECORDING_SECONDS} s ({time.perf_counter() - began:.1f} s)"
+    except Exception as exc:
+        return f"{type(exc).__name__}: {str(exc)[:300]}"
+    if code == 0:
+        return f"{case.field} changed at step {step} passed check --physics"
+    if code == 2 and len(err.getvalue().splitlines()) != 1:
+        return f"exit 2 with {err.getvalue().splitlines()[:3]}"
+    return None
+
+
+# ----------------------------------------------------------------------------- output faults
+
+_WRITERS = ["table.csv", "table.parquet", "events.csv", "view", "export", "graph", "sim-graph"]
+
+
+@dataclass(frozen=True, slots=True)
+class OutputFault:
+    """A command that writes, its output in a read-only folder or past ``limit`` bytes."""
+
+    command: str
+    read_only: bool
+    limit: int
+
+
+def output_faults() -> st.SearchStrategy[OutputFault]:
+    return st.builds(
+        OutputFault,
+        command=st.sampled_from(_WRITERS),
+        read_only=st.booleans(),
+        limit=st.one_of(st.integers(0, 4096), st.integers(4096, 400_000)),
+    )
+
+
+def read_only_folder() -> Path:
+    """A folder where no file can be created, by root too (procfs)."""
+    return Path("/proc/1") if os.geteuid() == 0 else Path("/")
+
+
+def check_output_fault(case: OutputFault, source: Path, folder: Path) -> str | None:
+    """Exit 0 (it fit), 1 (a write error) or 2 (refused before work) with one line; on a
+    failure the old output stays as it was and no side file is left."""
+    where = read_only_folder() if case.read_only else folder
+    suffix = {
+        "table.csv": "t.csv",
+        "table.parquet": "t.parquet",
+        "events.csv": "e.csv",
+        "view": "v.rrd",
+        "export": "f.mcap",
+        "graph": "g.dot",
+        "sim-graph": "m.dot",
+    }
+    out = where / suffix[case.command]
+    argv, main, prog = {
+        "table.csv": (["table", str(source), "-o"], replay_cli.main, "rsstp-replay"),
+        "table.parquet": (["table", str(source), "-o"], replay_cli.main, "rsstp-replay"),
+        "events.csv": (["events", str(source), "-o"], replay_cli.main, "rsstp-replay"),
+        "view": (["view", str(source), "--quiet", "--save"], replay_cli.main, "rsstp-replay"),
+        "export": (["export", "--foxglove", str(source), "-o"], replay_cli.main, "rsstp-replay"),
+        "graph": (["graph", str(source), "--step", "3", "-o"], replay_cli.main, "rsstp-replay"),
+        "sim-graph": (["graph", "--matrix", "[[[0],[1]],[[1],[0]]]", "-o"], sim_cli.main,
+                      "rsstp-sim"),
+    }[case.command]  # fmt: skip
+    if not case.read_only:
+        out.write_bytes(b"the old output")
+        for stale in out.parent.glob(out.name + "*"):
+            if stale != out:
+                stale.unlink()
+    soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+    err = io.StringIO()
+    try:
+        if not case.read_only:
+            resource.setrlimit(resource.RLIMIT_FSIZE, (case.limit, hard))
+        with contextlib.redirect_stderr(err), contextlib.redirect_stdout(io.StringIO()):
+            code = main([*argv, str(out), "--force"])
+    except Exception as exc:
+        return f"{case.command}: {type(exc).__name__}: {str(exc)[:300]}"
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
+    lines = err.getvalue().splitlines()
+    errors = [line for line in lines if not line.startswith(f"{prog}: warning: ")]
+    if code not in (0, 1, 2) or (code and len(errors) != 1):
+        return f"{case.command}: exit {code} with {errors[:3]}"
+    if case.read_only:
+        return None if code == 2 else f"{case.command}: read-only folder, exit {code}"
+    left = sorted(p.name for p in out.parent.glob(out.name + "*") if p != out)
+    if code and [n for n in left if n.endswith(".partial")]:
+        return f"{case.command}: side files left: {left}"
+    if code and out.read_bytes() != b"the old output":
+        return f"{case.command}: a failed write changed the old output"
+    return None

@@ -10,12 +10,21 @@ import pytest
 from hypothesis import HealthCheck, example, given, settings
 
 from fuzzing import (
+    Deep,
     Mutation,
+    OutputFault,
+    Rewrite,
     Written,
+    check_deep,
+    check_output_fault,
     check_recording,
+    check_rewrite,
     check_scenario,
+    deep_texts,
+    output_faults,
     recording_mutations,
     scenario_texts,
+    semantic_rewrites,
     splitter_run,
 )
 
@@ -55,3 +64,48 @@ def test_damage_to_a_recording_never_returns_what_was_not_written(
     mutations: list[Mutation], reference: Written, tmp_path: Path
 ) -> None:
     assert check_recording(mutations, reference, tmp_path) is None
+
+
+FEW = settings(SHORT, max_examples=20)
+
+
+@FEW
+@given(case=deep_texts())
+@example(case=Deep(where="scenario", depth=3000, opener="["))
+@example(case=Deep(where="matrix", depth=3000, opener="["))
+def test_deep_nesting_is_one_line(case: Deep, tmp_path: Path) -> None:
+    assert check_deep(case, tmp_path) is None
+
+
+@pytest.fixture(scope="module")
+def walk(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    from rsstp_sim import load_scenario, make_strategy
+    from rsstp_sim.recording import record
+
+    path = tmp_path_factory.mktemp("fuzz-walk") / "walk.mcap"
+    record(path, load_scenario("three-joint"), make_strategy("random"), steps=400, seed=2,
+           chunk_size=8_192)  # fmt: skip
+    return path
+
+
+@FEW
+@given(case=semantic_rewrites())
+@example(case=Rewrite(where=0.5, field="truth.joint_positions.1.x", value=1e-12, nudge=True))
+@example(case=Rewrite(where=0.3, field="agent.action", value=2**63, nudge=False))
+def test_a_rewritten_truth_never_passes_the_physics_check(
+    case: Rewrite, walk: Path, tmp_path: Path
+) -> None:
+    assert check_rewrite(case, walk, 400, tmp_path) is None
+
+
+@FEW
+@given(case=output_faults())
+@example(case=OutputFault(command="view", read_only=False, limit=8_192))
+@example(case=OutputFault(command="table.parquet", read_only=True, limit=0))
+# Found by bench/fuzz.py (2026-11-26): the Foxglove SDK's writer fails as it opens a file that
+# takes no bytes, with its own RuntimeError, outside the block that turned it into one line.
+@example(case=OutputFault(command="export", read_only=False, limit=249))
+def test_an_output_that_cannot_be_written_is_one_line(
+    case: OutputFault, walk: Path, tmp_path: Path
+) -> None:
+    assert check_output_fault(case, walk, tmp_path) is None

@@ -251,7 +251,7 @@ def check_schemas(container: Container, channels: dict[str, int]) -> dict[str, s
         try:
             version = json.loads(schema.data).get("version")
             major, minor = parse_version(version)
-        except (ValueError, AttributeError, RecordFormatError):
+        except (ValueError, AttributeError, RecordFormatError, RecursionError):
             major = supported
         if major != supported:
             raise UnsupportedVersion(f"{where}: schema {name} {version_refusal(version)}")

@@ -38,7 +38,8 @@ __all__ = [
     "pose_numbers",
 ]
 
-_Count = Annotated[int, msgspec.Meta(ge=0)]
+_Count = Annotated[int, msgspec.Meta(ge=0, le=2**63 - 1)]
+"""A count or an id: read into int64 columns, so bounded where it is read."""
 _Angle = Annotated[int, msgspec.Meta(ge=0, le=359)]
 _Closeness = Annotated[float, msgspec.Meta(ge=0.0, le=1.0)]
 
@@ -190,7 +191,7 @@ class StepColumns:
         batch, one = _DECODERS[self.truth]
         try:
             rows: list[Any] = batch.decode(b"[" + b",".join(parts) + b"]")
-        except msgspec.DecodeError:
+        except (msgspec.DecodeError, RecursionError):
             rows = []
         if len(rows) != len(parts):  # find the culprit, one message at a time
             for index, part in enumerate(parts):
@@ -198,6 +199,8 @@ class StepColumns:
                     one.decode(part)
                 except msgspec.DecodeError as exc:
                     raise BadStep(_describe(exc), index=index) from None
+                except RecursionError:
+                    raise BadStep("nested too deeply", index=index) from None
             raise BadStep("the messages do not decode one by one", index=0)
         k = len(rows)
         r = self.rows

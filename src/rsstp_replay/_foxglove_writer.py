@@ -62,10 +62,17 @@ def _written(path: Path) -> Iterator[SceneWriter]:
     context = foxglove.Context()  # not the global one: nothing else logs into this file
     with io.FileIO(path, "w") as raw, _sdk_warnings_kept() as warnings:
         file = _KeepsError(raw)
-        writer = foxglove.open_mcap(file, context=context, writer_options=options)
+        try:  # it writes the file's header at once: a full disk fails here
+            writer = foxglove.open_mcap(file, context=context, writer_options=options)
+        except RuntimeError as exc:
+            raise file.error or OSError(f"the MCAP writer failed: {exc}") from None
         scene = SceneWriter(file, context, writer)
         try:
             yield scene
+        except RuntimeError:  # an SDK call of the block, failing on a write of ours
+            if file.error is not None:
+                raise file.error from None
+            raise
         finally:
             try:
                 writer.close()

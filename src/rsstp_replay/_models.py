@@ -29,8 +29,9 @@ def build_model(path: Path, record: ModelRecord) -> TransitionSystem:
         raise CorruptRecording(f"{path}: {_name(record)}: invalid snapshot: {exc}") from None
 
 
-def verify_chain(path: Path, records: Sequence[ModelRecord]) -> None:
+def verify_chain(path: Path, records: Sequence[ModelRecord], *, last_step: int) -> None:
     """Check the model messages in file order; :class:`CorruptRecording` names the version.
+    No message may come after ``last_step``, the recording's last step.
 
     The first snapshot is built; every later message's operations are applied to the model
     rebuilt so far, and the result is compared with the message's snapshot field by field, so
@@ -52,6 +53,10 @@ def verify_chain(path: Path, records: Sequence[ModelRecord]) -> None:
     _check_flags(path, previous, model)
     for record in records[1:]:
         touched: set[int] = set()
+        if record.step > last_step:
+            raise CorruptRecording(
+                f"{path}: {_name(record)} comes after the last step, {last_step:,}"
+            )
         if record.step < previous.step:
             raise CorruptRecording(
                 f"{path}: {_name(record)} comes after the model message of step "

@@ -27,6 +27,7 @@ from rsstp_replay._viewer_chunks import TIMELINE, send_rows
 from rsstp_replay.audits.consistency import ConsistencyFindings, StateContradiction
 from rsstp_replay.audits.determinism import DeterminismFindings
 from rsstp_sim.recording.records import ModelRecord
+from rsstp_sim.words import counted
 
 __all__ = [
     "DISTANCE",
@@ -228,8 +229,8 @@ def _contradiction(found: StateContradiction) -> str:
     return (
         f"contradiction: state {found.state}: after steps {witness.i} and {witness.j} (both in "
         f"state {found.state}) the actions {list(witness.actions)} give different sensations "
-        f"at steps {witness.i + witness.k} and {witness.j + witness.k}; {found.pairs} "
-        f"contradicting pair{'' if found.pairs == 1 else 's'}"
+        f"at steps {witness.i + witness.k} and {witness.j + witness.k}; "
+        f"{counted(found.pairs, 'contradicting pair')}"
         + ("" if found.version is None else f"; model version {found.version}")
     )
 

@@ -29,11 +29,13 @@ from rsstp_replay.errors import ReplayError
 
 __all__ = [
     "DEFAULT_BIND",
+    "STOP_SIGNALS",
     "CtrlC",
     "WebServer",
     "check_port",
     "ctrl_c_remembered",
     "has_display",
+    "rerun_command",
     "rerun_program",
 ]
 
@@ -73,11 +75,16 @@ class CtrlC:
     pressed: bool = False
 
 
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+"""What stops a view as Ctrl-C does: a terminal closed (SIGHUP) and ``kill`` (SIGTERM) too, so
+the servers and the temporary folder go with the command."""
+
+
 @contextmanager
 def ctrl_c_remembered(*, interrupt: bool = True) -> Iterator[CtrlC]:
-    """Within: Ctrl-C (SIGINT) sets the flag yielded and, with ``interrupt``, also raises
-    :class:`KeyboardInterrupt`; a wait that polls the flag stops even when the exception
-    was lost.
+    """Within: Ctrl-C (SIGINT, or SIGTERM or SIGHUP: :data:`STOP_SIGNALS`) sets the flag
+    yielded and, with ``interrupt``, also raises :class:`KeyboardInterrupt`; a wait that polls
+    the flag stops even when the exception was lost.
 
     Python ignores an exception raised inside a finaliser (``__del__``), and a
     ``KeyboardInterrupt`` lands in one whenever the signal arrives while the garbage collector
@@ -95,11 +102,12 @@ def ctrl_c_remembered(*, interrupt: bool = True) -> Iterator[CtrlC]:
     if threading.current_thread() is not threading.main_thread():
         yield pressed
         return
-    previous = signal.signal(signal.SIGINT, handler)
+    previous = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
     try:
         yield pressed
     finally:
-        signal.signal(signal.SIGINT, previous)
+        for sig, before in previous.items():
+            signal.signal(sig, before)
 
 
 def rerun_program() -> str:
@@ -108,6 +116,16 @@ def rerun_program() -> str:
     if found is None:
         raise ReplayError("the 'rerun' program of rerun-sdk was not found beside Python or on PATH")
     return found
+
+
+def rerun_command() -> str:
+    """How to run :func:`rerun_program` from this shell: ``rerun`` when that is what ``PATH``
+    finds, else its full path (a venv that is not activated)."""
+    program = rerun_program()
+    on_path = shutil.which("rerun")
+    if on_path is not None and Path(on_path).resolve() == Path(program).resolve():
+        return "rerun"
+    return program
 
 
 class WebServer:

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shlex
 import sys
 import warnings
 from collections.abc import Sequence
@@ -24,7 +25,8 @@ from rsstp_replay.recording import Recording, open_recording
 from rsstp_replay.table_files import TABLE_FORMATS, sidecar_path, write_table
 from rsstp_replay.tables import TABLES, recording_table
 from rsstp_sim.commandline import Parser, UsageError, add_no_cache, progress, run_command
-from rsstp_sim.files import irregular
+from rsstp_sim.files import check_output
+from rsstp_sim.words import counted
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -66,9 +68,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
         size = os.path.getsize(recording.path)
         chunks = recording.verify_chunks()  # a chunk that fails its CRC is an error, not "finished"
         state = (
-            f"finished, {chunks:,} chunks checked"
+            f"finished, {counted(chunks, 'chunk')} checked"
             if recording.finished
-            else f"NOT finished (recovered from its {chunks:,} complete chunks)"
+            else f"NOT finished (recovered from its {counted(chunks, 'complete chunk')})"
         )
         print(f"file: {recording.path} ({size:,} bytes, {state})")
         print(f"scenario: {record.name} ({record.description})")
@@ -92,7 +94,10 @@ def _cmd_info(args: argparse.Namespace) -> int:
             f"strategy: {recording.strategy} {params}; seed: {recording.seed}\n"
             f"  class: {strategy.import_path}" + (f" (from {origin})" if origin else "")
         )
-        print(f"steps: 0 to {recording.n_steps} (the reset, then {recording.n_steps:,} steps)")
+        print(
+            f"steps: 0 to {recording.n_steps:,} (the reset, then "
+            f"{counted(recording.n_steps, 'step')})"
+        )
         print("topics:")
         width = max(map(len, recording.topic_counts))
         for topic, count in recording.topic_counts.items():
@@ -103,8 +108,8 @@ def _cmd_info(args: argparse.Namespace) -> int:
             print(f"model: {_NO_MODEL}")
         else:
             print(
-                f"model at the end: version {model.version}, {len(model)} states, "
-                f"{len(model.transitions())} transitions, {kind}"
+                f"model at the end: version {model.version:,}, {counted(len(model), 'state')}, "
+                f"{counted(len(model.transitions()), 'transition')}, {kind}"
             )
         schemas = ", ".join(f"{name} {v}" for name, v in recording.schema_versions.items())
         print(f"schemas: {schemas}")
@@ -124,9 +129,9 @@ def _check_table_output(out: Path, *, force: bool) -> None:
             f"{out}: unknown table format {out.suffix or '(no suffix)'!r}: expected "
             f"{' or '.join(TABLE_FORMATS)}"
         )
-    _check_output(out, force=force)
+    check_output(out, force=force)
     if out.suffix.lower() == ".csv":
-        _check_output(sidecar_path(out), force=force)
+        check_output(sidecar_path(out), force=force)
 
 
 def _write_table(table: pd.DataFrame, out: Path) -> None:
@@ -175,8 +180,11 @@ _NO_MODEL = "none recorded (the agent kept no model; read as the one-state model
 def _cmd_audit(args: argparse.Namespace) -> int:
     from rsstp_replay.audits import audit_truth, run_audits
     from rsstp_replay.audits.loaded import load
+    from rsstp_replay.audits.physics import check_physics
 
     fail_on = set(args.fail_on or [])
+    if "contract" not in (args.allow or []):  # a broken rule fails the audit unless allowed
+        fail_on.add("contract")
     needs_truth = fail_on & set(_TRUTH_GATES)
     if needs_truth and not args.truth:
         raise UsageError(f"--fail-on {sorted(needs_truth)[0]} needs --truth")
@@ -189,6 +197,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         bar.to(1)
         bar.stage("auditing")
         report = run_audits(loaded)
+        physics = check_physics(recording)
         bar.to(2)
         truth = None
         if args.truth:
@@ -200,7 +209,11 @@ def _cmd_audit(args: argparse.Namespace) -> int:
             )
             bar.to(3)
     if args.json:
-        document = {"model_recorded": recording.has_model, **report.to_json()}
+        document = {
+            "model_recorded": recording.has_model,
+            **report.to_json(),
+            "physics": physics.to_json(),
+        }
         if truth is not None:
             document = {"verdict": truth.verdict.to_json(), **document, "truth": truth.to_json()}
         print(json.dumps(document, indent=2))
@@ -211,11 +224,17 @@ def _cmd_audit(args: argparse.Namespace) -> int:
             print(f"model: {_NO_MODEL}\n")
         text = report.to_text()
         print(text, end="" if text.endswith("\n") else "\n")
+        print(physics.to_text())
         if truth is not None:
             print("\n== truth ==")
             print(truth.to_text(verdict=False), end="")
     findings = {
-        "contract": (not report.contract.holds, "the steps break the recording contract"),
+        "contract": (
+            not report.contract.holds or not physics.holds,
+            "the steps break the recording contract"
+            if not report.contract.holds
+            else "the recorded world does not follow from its scenario and actions",
+        ),
         "contradiction": (
             report.has_contradiction,
             "the memory contradicts a state of the final model version",
@@ -243,20 +262,28 @@ def _cmd_audit(args: argparse.Namespace) -> int:
 
 def _cmd_check(args: argparse.Namespace) -> int:
     from rsstp_replay.audits import check_contract
+    from rsstp_replay.audits.physics import check_physics
 
     with _open(args.file) as recording:
         findings = check_contract(recording)  # reads and checks every step and model message
         events = len(recording.events())
         versions = len(recording.model_versions())
+        physics = check_physics(recording) if args.physics else None
     if args.json:
-        print(json.dumps(findings.to_json(), indent=2))
+        document = findings.to_json()
+        if physics is not None:
+            document = {**document, "physics": physics.to_json()}
+        print(json.dumps(document, indent=2))
     else:
         print(
-            f"{recording.path}: {recording.n_steps + 1:,} steps, {versions:,} model versions, "
-            f"{events:,} events: every chunk read and checked"
+            f"{recording.path}: {counted(recording.n_steps + 1, 'step')}, "
+            f"{counted(versions, 'model version')}, {counted(events, 'event')}: every chunk read "
+            "and checked"
         )
         print(findings.to_text())
-    return 0 if findings.holds else 1
+        if physics is not None:
+            print(physics.to_text())
+    return 0 if findings.holds and (physics is None or physics.holds) else 1
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
@@ -279,22 +306,13 @@ def _cmd_compare(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_output(out: Path, *, force: bool) -> None:
-    """One line for an output path we must not or cannot write."""
-    if out.is_dir():
-        raise UsageError(f"{out}: is a directory, not an output file")
-    kind = irregular(out)
-    if kind is not None:
-        raise UsageError(f"{out}: {kind}: only a regular file is ever written or replaced")
-    if out.exists() and not force:
-        raise UsageError(f"{out}: already exists (use --force to overwrite)")
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir():
-        raise UsageError(f"{out}: the output directory {parent} does not exist")
-
-
 def _cmd_view(args: argparse.Namespace) -> int:
-    from rsstp_replay._viewer_serve import check_port, ctrl_c_remembered, has_display
+    from rsstp_replay._viewer_serve import (
+        check_port,
+        ctrl_c_remembered,
+        has_display,
+        rerun_command,
+    )
     from rsstp_replay.viewer import ViewerWarning, ViewResult, view
 
     save = Path(args.save) if args.save is not None else None
@@ -305,7 +323,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
             "write a file with --save OUT.rrd, or serve the web viewer with --serve-web"
         )
     if save is not None:
-        _check_output(save, force=args.force)
+        check_output(save, force=args.force)
     if args.serve_web:  # before anything is read: a port in use is one line
         check_port(args.bind, args.web_port, option="--web-port")
         check_port(args.bind, args.grpc_port, option="--grpc-port")
@@ -336,7 +354,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
                 print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
             print(result.to_text())
             if save is not None:
-                print(f"open it with: rerun {save}")
+                print(f"open it with: {shlex.quote(rerun_command())} {shlex.quote(str(save))}")
             if args.serve_web:
                 print(f"serving on {args.bind} until Ctrl-C", flush=True)
                 result.serve_forever(pressed)
@@ -355,7 +373,7 @@ def _cmd_graph(args: argparse.Namespace) -> int:
     from rsstp_replay.viewer import render_graph
 
     out = Path(args.output)
-    _check_output(out, force=args.force)
+    check_output(out, force=args.force)
     with _open(args.file) as recording:
         written = render_graph(recording, args.step, out, on_world=args.on_world)
     where = "on the world" if args.on_world else "laid out as in every version"
@@ -373,7 +391,7 @@ def _cmd_export(args: argparse.Namespace) -> int:
         )
     if out.resolve() == Path(args.foxglove).resolve():
         raise UsageError(f"{out}: is the recording being exported: give another output")
-    _check_output(out, force=args.force)
+    check_output(out, force=args.force)
     with _open(args.foxglove) as recording:
         print(export_foxglove(recording, out).to_text())
     return 0
@@ -456,7 +474,14 @@ def _build_parser() -> Parser:
         "--fail-on",
         action="append",
         choices=_FAIL_ON,
-        help="exit with 1 when such a finding exists (repeatable)",
+        help="exit with 1 when such a finding exists (repeatable; a broken contract or "
+        "physics always does, unless allowed)",
+    )
+    p.add_argument(
+        "--allow",
+        action="append",
+        choices=("contract",),
+        help="exit with 0 even when the recording breaks the contract or its physics",
     )
     add_no_cache(p)
     p.set_defaults(func=_cmd_audit)
@@ -502,6 +527,12 @@ def _build_parser() -> Parser:
     )
     p.add_argument("file", help="the .mcap recording")
     p.add_argument("--json", action="store_true", help="print the findings as JSON")
+    p.add_argument(
+        "--physics",
+        action="store_true",
+        help="also re-simulate the world from the attached scenario and the recorded actions "
+        "and compare every ground-truth field at every step (no strategy code runs)",
+    )
     p.set_defaults(func=_cmd_check)
 
     p = sub.add_parser("compare", help="the thesis's compare of the sub-memories at N and M")

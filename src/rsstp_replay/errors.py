@@ -67,3 +67,13 @@ class BadStep(Exception):
         self.text = text
         self.index = index
         self.step = step
+
+
+class PhysicsDifference(Exception):
+    """The recorded world differs from the re-simulated one at ``step`` (None: the scenario),
+    in ``field``. Internal: :func:`rsstp_replay.audits.physics.check_physics` turns it into its
+    findings."""
+
+    def __init__(self, step: int | None, field: str, difference: str) -> None:
+        super().__init__(difference)
+        self.step, self.field, self.difference = step, field, difference

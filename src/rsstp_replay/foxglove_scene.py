@@ -65,6 +65,7 @@ from rsstp_replay.errors import ReplayError
 from rsstp_sim import __version__, palette
 from rsstp_sim.files import written_whole
 from rsstp_sim.recording.schemas import STEP_NS
+from rsstp_sim.words import counted
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -115,7 +116,8 @@ class SceneExport:
     def to_text(self) -> str:
         return (
             f"wrote {self.path} ({self.size:,} bytes): the arm at {self.arm_poses:,} of "
-            f"{self.steps:,} steps (where it moved), {self.logs:,} events as log messages"
+            f"{counted(self.steps, 'step')} (where it moved), {counted(self.logs, 'event')} as log "
+            "messages"
         )
 
 

@@ -52,6 +52,7 @@ from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
 from rsstp_sim.truth_cache import load_truth
+from rsstp_sim.words import counted
 
 __all__ = ["EVENT_KINDS", "Recording", "open_recording"]
 
@@ -86,7 +87,7 @@ def open_recording(path: str | os.PathLike[str]) -> Recording:
         warnings.warn(
             UnfinishedRecordingWarning(
                 f"{recording.path}: the file was not finished; recovered "
-                f"{recording.recovered_steps} steps from its complete chunks "
+                f"{counted(recording.recovered_steps, 'step')} from its complete chunks "
                 f"(read {recording._file.container.recovered_bytes} of "
                 f"{recording._file.container.size} bytes)"
             ),
@@ -285,7 +286,7 @@ class Recording:
                 self._models = (model_record(one_state, step=0, operations=()),)
                 return self._models
             models = self._records("/rsstp/model", keep=_SharedIds())
-            verify_chain(self.path, models)
+            verify_chain(self.path, models, last_step=self.n_steps)
             self._models = tuple(models)
         return self._models
 

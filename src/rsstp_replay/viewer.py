@@ -45,13 +45,14 @@ from rsstp_replay.audits.determinism import DeterminismFindings, audit_determini
 from rsstp_replay.audits.truth import step_true_classes
 from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
 from rsstp_sim import graph
-from rsstp_sim.errors import RsstpError
-from rsstp_sim.files import side_file
+from rsstp_sim.errors import OutputError, RsstpError
+from rsstp_sim.files import side_file, write_whole
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import compute_truth
+from rsstp_sim.words import counted
 
 __all__ = [
     "APPLICATION_ID",
@@ -158,8 +159,10 @@ class ViewResult:
         if self.web_url is not None:
             where.append(f"serving the web viewer at {self.web_url}")
         return (
-            f"steps {s.first_step}..{s.last_step}: {len(s.rows)} entities, "
-            f"{s.model_versions} model versions, {s.log_lines} log lines; read "
+            f"steps {s.first_step:,}..{s.last_step:,}: "
+            f"{counted(len(s.rows), 'entity', 'entities')}, "
+            f"{counted(s.model_versions, 'model version')}, {counted(s.log_lines, 'log line')}; "
+            "read "
             f"{s.seconds_read:.2f} s, audits and placing {s.seconds_prepare:.2f} s, Rerun "
             f"{self.seconds_rerun:.2f} s" + ("; " + ", ".join(where) if where else "")
         )
@@ -220,15 +223,22 @@ def view(
     target = save if folder is None else Path(folder.name) / "view.rrd"
     # The .rrd is written to a side file and renamed onto ``target`` only when whole: a full
     # disk or a file-size limit never leaves a truncated file under the name, nor destroys
-    # the file that was there.
+    # the file that was there. Without a viewer to feed, Rerun encodes into memory and the
+    # bytes are written here (:func:`rsstp_sim.files.write_whole`): Rerun's file-writer thread
+    # can hang its flush for good once a write of its fails, and no write of ours can.
     writing = None if target is None else side_file(target)
     loaded = _load(recording)
     stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
-    sinks: list[rr.FileSink | rr.GrpcSink] = []
-    if writing is not None:
-        sinks.append(rr.FileSink(writing))
+    blueprint = default_blueprint(recording.scenario, first=first, last=last)
     spawned = False
-    if spawn:
+    in_memory: rr.BinaryStream | None = None
+    if target is not None and not spawn:
+        in_memory = rr.binary_stream(recording=stream)
+        stream.send_blueprint(blueprint, make_active=False, make_default=True)
+    else:
+        sinks: list[rr.FileSink | rr.GrpcSink] = []
+        if writing is not None:
+            sinks.append(rr.FileSink(writing))
         try:
             stream.spawn(port=SPAWN_PORT, connect=False)
         except Exception as exc:  # the lenient adapter: no viewer, still save or serve
@@ -236,25 +246,37 @@ def view(
         else:
             sinks.append(rr.GrpcSink(f"rerun+http://127.0.0.1:{SPAWN_PORT}/proxy"))
             spawned = True
-    blueprint = default_blueprint(recording.scenario, first=first, last=last)
-    stream.set_sinks(*sinks, default_blueprint=blueprint)
+        stream.set_sinks(*sinks, default_blueprint=blueprint)
     summary = _log(recording, loaded, stream, first, last)
     began = time.perf_counter()
-    try:
-        stream.flush()
-    except RuntimeError as exc:
-        if writing is not None and not spawned:  # only the file sink can have failed
-            stream.disconnect()
-            writing.unlink(missing_ok=True)
+    if in_memory is not None:
+        assert target is not None
+        data = in_memory.read(flush=True)
+        stream.disconnect()
+        try:
+            write_whole(target, data or b"")
+        except OutputError:
             if folder is not None:
                 folder.cleanup()
-            raise ReplayError(f"{target}: cannot write the .rrd: {exc}") from None
-        # A spawned viewer that never listened (the file, if any, is checked below).
-        warnings.warn(ViewerWarning(f"the Rerun viewer could not be reached: {exc}"), stacklevel=2)
-        spawned = False
-    stream.disconnect()  # finishes the file (its footer) and the connection
-    if writing is not None and target is not None:
-        _finish_rrd(writing, target, folder)
+            raise
+    else:
+        try:
+            stream.flush()
+        except RuntimeError as exc:
+            if writing is not None and not spawned:  # only the file sink can have failed
+                stream.disconnect()
+                writing.unlink(missing_ok=True)
+                if folder is not None:
+                    folder.cleanup()
+                raise ReplayError(f"{target}: cannot write the .rrd: {exc}") from None
+            # A spawned viewer that never listened (the file, if any, is checked below).
+            warnings.warn(
+                ViewerWarning(f"the Rerun viewer could not be reached: {exc}"), stacklevel=2
+            )
+            spawned = False
+        stream.disconnect()  # finishes the file (its footer) and the connection
+        if writing is not None and target is not None:
+            _finish_rrd(writing, target, folder)
     seconds = summary.seconds_rerun + time.perf_counter() - began
     server = None
     if serve_web:

@@ -20,9 +20,12 @@ from rsstp_sim import graph
 from rsstp_sim.commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import RecordingWriteError
+from rsstp_sim.files import check_output
+from rsstp_sim.nesting import too_deep
 from rsstp_sim.scenario import MANY_OBSTACLES, Scenario, builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.words import counted
 
 __all__ = ["main"]
 
@@ -40,14 +43,15 @@ def _parse_params(items: Sequence[str]) -> dict[str, Any]:
         key, sep, raw = item.partition("=")
         if not sep or not key:
             raise UsageError(f"--param expects key=value, got {item!r}")
+        deep = too_deep(raw)
+        if deep is not None:
+            raise UsageError(f"--param {key}: {deep}")
         try:
             params[key] = json.loads(raw)
         except json.JSONDecodeError as exc:
             if raw.lstrip()[:1] in _JSON_STARTS:  # meant as JSON: say where it breaks
                 raise UsageError(f"--param {key}: not valid JSON ({exc}): {raw!r}") from None
             params[key] = raw
-        except RecursionError:
-            raise UsageError(f"--param {key}: JSON nested too deeply") from None
     return params
 
 
@@ -197,7 +201,11 @@ def _cmd_run(args: argparse.Namespace) -> int:
 
 
 def _cmd_graph(args: argparse.Namespace) -> int:
+    check_output(Path(args.output), force=args.force)
     if args.matrix is not None:
+        deep = too_deep(args.matrix)
+        if deep is not None:
+            raise UsageError(f"--matrix: {deep}")
         try:
             matrix = json.loads(args.matrix)
         except json.JSONDecodeError as exc:
@@ -212,13 +220,8 @@ def _cmd_graph(args: argparse.Namespace) -> int:
         runner.run(args.steps)
         model = runner.model
     out = Path(args.output)
-    if out.exists() and not args.force:
-        raise UsageError(f"{out}: already exists (use --force to overwrite)")
-    try:
-        written = graph.render(model, out)
-    except OSError as exc:
-        raise UsageError(f"{out}: cannot write: {exc.strerror or exc}") from None
-    print(f"wrote {written} ({len(model)} states)")
+    written = graph.render(model, out)
+    print(f"wrote {written} ({counted(len(model), 'state')})")
     return 0
 
 
@@ -253,16 +256,16 @@ def _cmd_record(args: argparse.Namespace) -> int:
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
-    counts = ", ".join(f"{topic} {count}" for topic, count in result.messages.items())
+    counts = ", ".join(f"{topic} {count:,}" for topic, count in result.messages.items())
     if result.interrupted:
         name = signal.Signals(received[0]).name if received else "a stop request"
         print(
-            f"{PROG}: interrupted by {name}: kept {result.steps} steps in {result.path} "
+            f"{PROG}: interrupted by {name}: kept {counted(result.steps, 'step')} in {result.path} "
             f"(file finished)",
             file=sys.stderr,
         )
         return 128 + received[0] if received else 1
-    print(f"recorded {result.steps} steps to {result.path} ({counts})")
+    print(f"recorded {counted(result.steps, 'step')} to {result.path} ({counts})")
     return 0
 
 

@@ -1,6 +1,7 @@
 """What both command-line programs share: one-line errors and their exit codes, progress.
 
-Bad input is one line on stderr and exit code 2, never a traceback; a reader
+Bad input is one line on stderr and exit code 2, never a traceback; an output that could
+not be written whole (a full disk, a file-size limit) is one line and exit code 1; a reader
 that goes away (``| head``) ends the program quietly; Ctrl-C is exit code 130.
 A long command shows a progress bar (tqdm) on stderr when stderr is a terminal,
 and nothing when it is piped or redirected, or with ``--quiet``.
@@ -14,7 +15,7 @@ import sys
 from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
 
-from rsstp_sim.errors import RsstpError, UsageError
+from rsstp_sim.errors import OutputError, RsstpError, UsageError
 
 __all__ = ["Parser", "Progress", "UsageError", "add_no_cache", "progress", "run_command"]
 
@@ -76,6 +77,9 @@ def run_command(prog: str, parser: argparse.ArgumentParser, argv: Sequence[str] 
         args = parser.parse_args(argv)
         func: Callable[[argparse.Namespace], int] = args.func
         return func(args)
+    except OutputError as exc:  # the disk failed, not the input
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return 1
     except RsstpError as exc:
         print(f"{prog}: error: {exc}", file=sys.stderr)
         return 2

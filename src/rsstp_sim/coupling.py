@@ -29,6 +29,7 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.strategies import AgentView, Strategy, StrategyBase
 from rsstp_sim.transition_system import Operation, TransitionSystem
+from rsstp_sim.words import counted
 from rsstp_sim.world import World
 
 __all__ = ["Event", "RunSummary", "Runner", "StepOutcome"]
@@ -73,13 +74,14 @@ class RunSummary:
     deterministic: bool = True
 
     def to_text(self) -> str:
-        seen = ", ".join(f"{str(k).lower()}: {v}" for k, v in sorted(self.sensations.items()))
+        seen = ", ".join(f"{str(k).lower()}: {v:,}" for k, v in sorted(self.sensations.items()))
         return (
-            f"steps: {self.steps}\n"
-            f"blocked moves: {self.blocked}\n"
-            f"steps with no transition in the model: {self.no_transition}\n"
+            f"steps: {self.steps:,}\n"
+            f"blocked moves: {self.blocked:,}\n"
+            f"steps with no transition in the model: {self.no_transition:,}\n"
             f"sensations seen: {seen}\n"
-            f"model: {self.model_states} states, {self.model_transitions} transitions, "
+            f"model: {counted(self.model_states, 'state')}, "
+            f"{counted(self.model_transitions, 'transition')}, "
             f"{'deterministic' if self.deterministic else 'nondeterministic'}"
         )
 

@@ -13,9 +13,16 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from rsstp_sim.errors import OutputError
+from rsstp_sim.errors import OutputError, UsageError
 
-__all__ = ["irregular", "side_file", "write_whole", "written_whole"]
+__all__ = [
+    "check_output",
+    "check_output_folder",
+    "irregular",
+    "side_file",
+    "write_whole",
+    "written_whole",
+]
 
 
 def irregular(path: str | os.PathLike[str]) -> str | None:
@@ -37,6 +44,30 @@ def irregular(path: str | os.PathLike[str]) -> str | None:
     if stat.S_ISSOCK(mode):
         return "a socket"
     return "not a regular file"
+
+
+def check_output(out: Path, *, force: bool) -> None:
+    """One line (:class:`~rsstp_sim.errors.UsageError`) for an output path a command must not
+    or cannot write, said before any work: a directory or a device, a file that exists
+    without ``force``, a folder that is missing or not writable."""
+    if out.is_dir():
+        raise UsageError(f"{out}: is a directory, not an output file")
+    kind = irregular(out)
+    if kind is not None:
+        raise UsageError(f"{out}: {kind}: only a regular file is ever written or replaced")
+    if out.exists() and not force:
+        raise UsageError(f"{out}: already exists (use --force to overwrite)")
+    check_output_folder(out)
+
+
+def check_output_folder(out: Path) -> None:
+    """One line when the folder ``out`` would be written in is missing or not writable."""
+    parent = out.parent if str(out.parent) else Path(".")
+    if not parent.is_dir():
+        found = "is not a directory" if parent.exists() else "does not exist"
+        raise UsageError(f"{out}: the output directory {parent} {found}")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise UsageError(f"{out}: the output directory {parent} is not writable")
 
 
 def side_file(path: str | os.PathLike[str]) -> Path:

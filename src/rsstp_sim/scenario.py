@@ -36,6 +36,7 @@ from typing import Literal
 from rsstp_sim import geometry
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.files import irregular
+from rsstp_sim.nesting import too_deep
 
 __all__ = [
     "Obstacle",
@@ -63,6 +64,9 @@ obstacle and records them, so a step's time and its record grow with their numbe
 1,000 three-joint steps a second at this bound, against 25,000 with two obstacles)."""
 MANY_OBSTACLES = 100
 """Above this many obstacles the command lines warn that steps slow down."""
+MAX_MAGNITUDE = 1e12
+"""The largest size of any number of a scenario (length, coordinate, radius, tolerance): the
+geometry squares and sums them in float64, which must stay finite with room to spare."""
 MAX_SCENARIO_BYTES = 1 << 20
 """Largest scenario file read (a thousand obstacles take about 50 KB)."""
 
@@ -154,6 +158,9 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
 
 def parse_scenario(text: str, *, origin: str = "<string>") -> Scenario:
     """Parse and validate a scenario from TOML text; ``origin`` names it in errors."""
+    deep = too_deep(text)
+    if deep is not None:
+        raise ScenarioError(f"{origin}: {deep}")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -203,6 +210,8 @@ class _Validator:
         number = float(value)
         if not math.isfinite(number):
             raise self.fail(key, "a finite number", value)
+        if abs(number) > MAX_MAGNITUDE:
+            raise self.fail(key, f"a number of size at most {MAX_MAGNITUDE:g}", value)
         if positive and number <= 0:
             raise self.fail(key, "a number > 0", value)
         return number

@@ -11,9 +11,12 @@ move checked alone.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
-from rsstp_sim._arrays import FloatArray
+import numpy as np
+
+from rsstp_sim._arrays import FloatArray, IntArray
 from rsstp_sim.errors import ActionError, UnknownPose
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.scenario import Scenario
@@ -172,6 +175,43 @@ class World:
             self._pose = pose if pose is not None else self._pose_at(row)
         blocker = self.last_blocker = self._blocker(blocker_code) if blocker_code else None
         return blocker
+
+    def walk(self, actions: Sequence[int]) -> tuple[IntArray, IntArray]:
+        """Take ``actions`` in order from the current pose (the arm moves as :meth:`move`
+        moves it); return the table row of the pose after each move and each move's blocker
+        code (0 when it moved; :meth:`blocker_of` decodes one). The row of a pose code is
+        ``table.codes[row]``. One array lookup per move, for re-simulating long runs."""
+        rows: list[int] = []
+        codes: list[int] = []
+        add_row, add_code = rows.append, codes.append
+        n_actions, nxt, blocker = self._n_actions, self._next, self._blocker_codes
+        index = self._actions
+        row = self._row
+        for action in actions:
+            k = index.get(action) if action.__class__ is not bool else None
+            if k is None:
+                raise ActionError(
+                    f"action {action!r} is not one of the scenario's actions {list(index)}"
+                )
+            at = row * n_actions + k
+            reached = nxt[at]
+            if reached < 0:
+                if self.per_move:
+                    reached = self.table.step(row, k)
+                else:
+                    self._expand(row)
+                    reached = nxt[at]
+            add_row(reached)
+            add_code(blocker[at])
+            row = reached
+        self._row = row
+        self._pose = self._pose_at(row)
+        self.last_blocker = self.blocker_of(codes[-1]) if codes else None
+        return np.array(rows, np.int64), np.array(codes, np.int64)
+
+    def blocker_of(self, blocker_code: int) -> Blocker | None:
+        """The :class:`~rsstp_sim.geometry.Blocker` of a blocker code (None for 0: it moved)."""
+        return self._blocker(blocker_code) if blocker_code else None
 
     def peek(self, action: int) -> tuple[Pose, Blocker | None]:
         """Where an action would lead from the current pose, without moving."""

@@ -111,6 +111,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 def _check_output(output: str) -> None:
     """An output that cannot be a folder is one line before the cluster starts."""
     import fsspec
+    from fsspec.implementations.local import LocalFileSystem
 
     from rsstp_sim.commandline import UsageError
 
@@ -118,6 +119,10 @@ def _check_output(output: str) -> None:
         fs, root = fsspec.core.url_to_fs(output)
         if fs.exists(root) and not fs.isdir(root):
             raise UsageError(f"{output}: exists and is not a folder")
+        parent = os.path.dirname(root.rstrip("/")) or "."  # the folder may be new, not its parent
+        local = isinstance(fs, LocalFileSystem)  # an object store has no folders to miss
+        if local and not fs.isdir(parent):
+            raise UsageError(f"{output}: the output directory {parent} does not exist")
         fs.makedirs(root, exist_ok=True)
         probe = f"{root.rstrip('/')}/.rsstp-write-test"
         with fs.open(probe, "wb") as file:

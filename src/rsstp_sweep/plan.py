@@ -33,6 +33,7 @@ from typing import Any
 
 from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import RsstpError
+from rsstp_sim.nesting import too_deep
 from rsstp_sim.scenario import Scenario, load_scenario
 from rsstp_sim.strategies import make_strategy
 from rsstp_sweep.errors import SweepError
@@ -98,6 +99,9 @@ def load_sweep(path: str | Path) -> Sweep:
 
 def parse_sweep(text: str, *, origin: str = "<string>", base: Path | None = None) -> Sweep:
     """Check a sweep from TOML text; scenario files are relative to ``base``."""
+    deep = too_deep(text)
+    if deep is not None:
+        raise SweepError(f"{origin}: {deep}")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

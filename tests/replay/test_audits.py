@@ -248,7 +248,7 @@ def test_summary_counts_what_the_live_run_did() -> None:
     assert frame["version"].iloc[-1] == runner.model.version
     assert frame["step"].iloc[0] == 0  # the split at reset is recorded at step 0
     text = summary.to_text()
-    assert f"steps: {live.steps}" in text
+    assert f"steps: {live.steps:,}" in text
     assert f"blocked moves: {live.blocked}" in text
     assert f"operations: {summary.splits} splits, {summary.merges} merges" in text
     data = summary.to_json()
@@ -279,7 +279,7 @@ def test_report_text_and_json() -> None:
         fake.runner.memory, fake.steps()["model_version"].to_numpy()
     )
     assert f"within each model version: {len(within.contradictions):,} states contradicted" in text
-    assert f"steps: {fake.n_steps}" in text
+    assert f"steps: {fake.n_steps:,}" in text
     assert "determinism: final model (version" in text
     data = report.to_json()
     assert json.loads(json.dumps(data)) == data
@@ -416,7 +416,7 @@ def test_compare_findings() -> None:
     }
     identical = compare(memory, 5, 3)
     assert identical.kind is CompareKind.IDENTICAL and identical.decided_at is None
-    assert "no difference over the 1 entries" in identical.to_text()
+    assert "no difference over the 1 entry of" in identical.to_text()
     assert compare(memory, 3, 4).to_text().startswith("compare(3, 4): unknown (the actions differ)")
     with pytest.raises(MemoryRangeError, match="the starts must differ"):
         compare(memory, 3, 3)

@@ -20,6 +20,7 @@ import pytest
 
 from rsstp_replay import open_recording, read_table
 from rsstp_replay.audits import audit_truth, compare, run_audits
+from rsstp_replay.audits.physics import check_physics
 from rsstp_replay.cli import main
 from rsstp_sim import AgentView, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording.recorder import record
@@ -81,9 +82,9 @@ def test_info_describes_the_recording(run: Path, capsys: pytest.CaptureFixture[s
     assert "obstacles: 2: centre (1.5, 1) radius 0.5; centre (1.5, -1.5) radius 0.5" in out
     assert "feedback: bool (tolerance 1e-06); collision: swept" in out
     assert "strategy: random {}; seed: 1\n" in out
-    assert "steps: 0 to 1500 (the reset, then 1,500 steps)" in out
+    assert "steps: 0 to 1,500 (the reset, then 1,500 steps)" in out
     assert re.search(r"\n  /rsstp/step +1,501\n", out)
-    assert "model at the end: version 0, 1 states, 6 transitions, deterministic" in out
+    assert "model at the end: version 0, 1 state, 6 transitions, deterministic" in out
 
 
 def test_info_on_an_unfinished_file_warns_in_one_line(run: Path, tmp_path: Path) -> None:
@@ -191,7 +192,9 @@ def test_audit_prints_the_report(run: Path, capsys: pytest.CaptureFixture[str]) 
     code, out, err = run_cli(capsys, "audit", str(run))
     assert (code, err) == (0, "")
     with open_recording(run) as recording:
-        assert out == run_audits(recording).to_text()
+        physics = check_physics(recording).to_text()
+        assert out == run_audits(recording).to_text() + physics + "\n"
+    assert physics.startswith("physics: the world follows from the scenario and the actions")
 
 
 def test_audit_json(run: Path, capsys: pytest.CaptureFixture[str]) -> None:
@@ -199,6 +202,7 @@ def test_audit_json(run: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert code == 0
     document = json.loads(out)
     assert document.pop("model_recorded") is True
+    assert document.pop("physics")["holds"] is True
     with open_recording(run) as recording:
         assert document == json.loads(json.dumps(run_audits(recording).to_json()))
 

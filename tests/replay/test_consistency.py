@@ -174,7 +174,7 @@ def test_consistent_when_states_are_true_positions() -> None:
     assert findings.consistent
     assert findings.first_contradiction_step is None
     assert findings.contradictions == ()
-    assert findings.to_text() == "consistent: no contradiction in 2000 steps"
+    assert findings.to_text() == "consistent: no contradiction in 2,000 steps"
     aliased = find_contradictions(actions, positions % 3, positions == 3)
     assert not aliased.consistent
 

@@ -327,7 +327,7 @@ def test_a_foreign_input_is_one_line(scene: Scene, tmp_path: Path) -> None:
 def test_a_file_size_limit_never_leaves_a_truncated_scene(
     recorded: Recorded, tmp_path: Path
 ) -> None:
-    """EFBIG while writing (RLIMIT_FSIZE in the child): one line, exit 2, the file that was
+    """EFBIG while writing (RLIMIT_FSIZE in the child): one line, exit 1, the file that was
     there untouched, no side file; the SDK's own warnings (one per message) stay quiet."""
     import resource
 
@@ -344,7 +344,7 @@ def test_a_file_size_limit_never_leaves_a_truncated_scene(
         env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": "/tmp",
              "PYTHONDONTWRITEBYTECODE": "1"},  # no .pyc cut short by the limit
     )  # fmt: skip
-    assert (done.returncode, done.stdout) == (2, "")
+    assert (done.returncode, done.stdout) == (1, "")
     assert done.stderr == f"rsstp-replay: error: {out}: cannot write: File too large\n"
     assert out.read_bytes() == b"keep me"
     assert [p.name for p in tmp_path.iterdir()] == [out.name]

@@ -198,7 +198,9 @@ def test_notes_are_few() -> None:
 def test_params() -> None:
     assert LearnerStrategy.name == "learner"
     assert LearnerStrategy(doubts=2).params() == {"doubts": 2}
-    with pytest.raises(StrategyError, match="doubts must be an integer >= 0, got -1"):
+    with pytest.raises(
+        StrategyError, match=r"parameter doubts: expected an integer >= 0 \(doubts=2\), got -1"
+    ):
         LearnerStrategy(doubts=-1)
     with pytest.raises(StrategyError, match="reset"):
         LearnerStrategy().labels()

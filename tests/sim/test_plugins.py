@@ -144,11 +144,16 @@ def test_a_failing_strategy_stops_in_one_line_and_keeps_a_valid_file(
         "rsstp_sim", "record", "thesis-roulette", "--strategy", f"my_strategies:{strategy}",
         "--steps", "50", "-o", str(out), path=mine,
     )  # fmt: skip
+    side = mine / "broken.mcap.partial"
     assert done.returncode == 2
-    assert done.stderr.strip() == f"rsstp-sim: error: {message}"
-    with open_recording(out) as recording:
+    assert done.stderr.strip() == (
+        f"rsstp-sim: error: {message}; the steps before it are in {side} (finished); {out} was "
+        "not touched"
+    )
+    assert not out.exists()
+    with open_recording(side) as recording:
         assert recording.finished and recording.n_steps == kept
-    assert cli("rsstp_replay", "check", str(out), path=mine).returncode == 0
+    assert cli("rsstp_replay", "check", str(side), path=mine).returncode == 0
 
 
 def test_the_readme_strategy_records_and_learns_its_world(tmp_path: Path) -> None:

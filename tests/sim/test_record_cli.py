@@ -187,8 +187,8 @@ def test_record_prints_a_summary_line_and_no_progress(tmp_path: Path) -> None:
     assert done.stderr == ""  # stderr is a pipe, not a TTY: no progress
     counts = step_counts(out)
     assert counts["/rsstp/step"] == 5001
-    expected = ", ".join(f"{topic} {count}" for topic, count in counts.items())
-    assert done.stdout == f"recorded 5000 steps to {out} ({expected})\n"
+    expected = ", ".join(f"{topic} {count:,}" for topic, count in counts.items())
+    assert done.stdout == f"recorded 5,000 steps to {out} ({expected})\n"
 
 
 def test_same_bytes_across_processes_and_hash_seeds(tmp_path: Path) -> None:
@@ -265,12 +265,12 @@ def test_sigint_and_sigterm_finish_the_file(tmp_path: Path, sig: signal.Signals)
     assert "Traceback" not in done.stderr
     assert done.stdout == ""
     match = re.fullmatch(
-        rf"rsstp-sim: interrupted by {sig.name}: kept (\d+) steps in {re.escape(str(out))} "
+        rf"rsstp-sim: interrupted by {sig.name}: kept ([\d,]+) steps? in {re.escape(str(out))} "
         r"\(file finished\)\n",
         done.stderr,
     )
     assert match, done.stderr
-    kept = int(match[1])
+    kept = int(match[1].replace(",", ""))
     assert kept > 0
     assert step_counts(out)["/rsstp/step"] == kept + 1
     with out.open("rb") as stream:

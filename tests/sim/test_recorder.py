@@ -546,13 +546,49 @@ class BadAfter(StrategyBase):
         return 99 if agent.step == 4 else agent.actions[0]
 
 
-def test_a_failing_strategy_still_finishes_the_file(tmp_path: Path) -> None:
+@pytest.mark.parametrize("old", [None, b"a good recording"])
+def test_a_failing_strategy_finishes_its_file_beside_the_output(
+    tmp_path: Path, old: bytes | None
+) -> None:
+    """The steps before the failure are finished in the side file; the output (an old
+    recording under ``force``) is never replaced by them, and the error says where they are."""
     path = tmp_path / "out.mcap"
-    with pytest.raises(StrategyError, match=r"bad-after"):
-        record(path, load_scenario("three-joint"), BadAfter(), steps=100, seed=1)
-    steps = [m for m in read_messages(path) if m.topic == "/rsstp/step"]
+    if old is not None:
+        path.write_bytes(old)
+    side = tmp_path / "out.mcap.partial"
+    said = f"the steps before it are in {side} (finished); {path} was not touched"
+    with pytest.raises(StrategyError, match=r"bad-after.*" + re.escape(said)):
+        record(path, load_scenario("three-joint"), BadAfter(), steps=100, seed=1, force=True)
+    steps = [m for m in read_messages(side) if m.topic == "/rsstp/step"]
     assert [json.loads(m.data)["step"] for m in steps] == [0, 1, 2, 3, 4]
-    assert topic_counts(read_summary(path))["/rsstp/step"] == 5
+    assert topic_counts(read_summary(side))["/rsstp/step"] == 5
+    assert (path.read_bytes() if path.exists() else None) == old
+
+
+class RunsOutOfMemory(Recorder):
+    """A recorder whose step 6 meets a MemoryError (what a run under a memory limit meets,
+    outside the strategy, which the runner names instead)."""
+
+    def _write_step(self, outcome: StepOutcome) -> None:
+        if outcome.step == 6:
+            raise MemoryError
+        super()._write_step(outcome)
+
+
+def test_a_memory_error_under_force_leaves_the_old_recording(tmp_path: Path) -> None:
+    path = tmp_path / "out.mcap"
+    scenario = load_scenario("three-joint")
+    record(path, scenario, make_strategy("random"), steps=50, seed=1)
+    good = path.read_bytes()
+    side = tmp_path / "out.mcap.partial"
+    said = (
+        f"out of memory at step 6; the steps before it are in {side} (finished); {path} was "
+        "not touched"
+    )
+    with pytest.raises(RecordingError, match=re.escape(said)):
+        RunsOutOfMemory(path, scenario, make_strategy("random"), seed=1, force=True).run(2_000)
+    assert path.read_bytes() == good
+    assert topic_counts(read_summary(side))["/rsstp/step"] == 6
 
 
 def test_request_stop_finishes_the_file_after_the_current_step(tmp_path: Path) -> None:

@@ -155,9 +155,13 @@ def test_roulette_parameters() -> None:
     assert isinstance(RouletteStrategy(), Strategy)
     assert json.loads(json.dumps(RouletteStrategy(action=0).params())) == {"action": 0}
     assert RouletteStrategy().params() == {"action": None}
-    with pytest.raises(StrategyError, match="action must be an integer >= 0, got -1"):
+    with pytest.raises(
+        StrategyError, match=r"parameter action: expected an integer >= 0 \(action=0\), got -1"
+    ):
         RouletteStrategy(action=-1)
-    with pytest.raises(StrategyError, match="action must be an integer >= 0, got True"):
+    with pytest.raises(
+        StrategyError, match=r"parameter action: expected an integer >= 0 \(action=0\), got True"
+    ):
         RouletteStrategy(action=True)
     with pytest.raises(StrategyError, match=r"action 3 is not among the scenario's actions \[0\]"):
         start("thesis-roulette", RouletteStrategy(action=3))
@@ -315,7 +319,7 @@ def test_splitter_parameters() -> None:
     assert json.loads(json.dumps(SplitterStrategy(horizon=5).params())) == {"horizon": 5}
     assert SplitterStrategy().params() == {"horizon": 8}
     for bad in (0, -2, True, 2.5):
-        with pytest.raises(StrategyError, match="horizon must be an integer >= 1"):
+        with pytest.raises(StrategyError, match="parameter horizon: expected an integer >= 1"):
             SplitterStrategy(horizon=bad)  # type: ignore[arg-type]
 
 

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 from rsstp_sim.memory import CompareKind, Memory
+from rsstp_sim.words import counted
 
 __all__ = ["CompareFindings", "HasMemory", "compare"]
 
@@ -70,10 +71,11 @@ class CompareFindings:
         head = f"compare({self.n}, {self.m}): {_KIND_TEXT[self.kind]}"
         where = self.decided_at
         if where is None:
-            return f"{head}: no difference over the {self.length} entries of both sub-memories"
+            entries = counted(self.length, "entry", "entries")
+            return f"{head}: no difference over the {entries} of both sub-memories"
         return (
             f"{head} at offset {self.offset} (steps {where[0]} and {where[1]}); "
-            f"sub-memories of {self.length} entries"
+            f"sub-memories of {counted(self.length, 'entry', 'entries')}"
         )
 
     def to_json(self) -> dict[str, Any]:

@@ -38,6 +38,7 @@ from rsstp_replay.audits._suffixes import (
 )
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.memory import Memory
+from rsstp_sim.words import counted
 
 __all__ = [
     "ConsistencyFindings",
@@ -107,7 +108,7 @@ class ConsistencyFindings:
     def to_text(self) -> str:
         """Human readable: one line per contradicted state, or one line saying it is consistent."""
         if not self.contradictions:
-            return f"consistent: no contradiction in {self.steps} steps"
+            return f"consistent: no contradiction in {counted(self.steps, 'step')}"
         lines = []
         for found in self.contradictions:
             witness = found.witness
@@ -115,8 +116,8 @@ class ConsistencyFindings:
             lines.append(
                 f"state {found.state}{version}: contradictory from step {found.first_step}; "
                 f"shortest witness: steps {witness.i} and {witness.j} then actions "
-                f"{list(witness.actions)} (k={witness.k}); {found.pairs} contradicting "
-                f"pair{'' if found.pairs == 1 else 's'}"
+                f"{list(witness.actions)} (k={witness.k}); "
+                f"{counted(found.pairs, 'contradicting pair')}"
             )
         return "\n".join(lines)
 

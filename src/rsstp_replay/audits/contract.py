@@ -39,6 +39,7 @@ import pandas as pd
 
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.recording.schemas import STEP_NS
+from rsstp_sim.words import counted
 
 __all__ = ["ContractFindings", "ContractSource", "Violation", "check_contract", "version_index"]
 
@@ -79,7 +80,7 @@ class ContractFindings:
 
     def to_text(self) -> str:
         if self.holds:
-            return f"contract: holds at every one of the {self.steps + 1:,} steps"
+            return f"contract: holds at every one of the {counted(self.steps + 1, 'step')}"
         lines = [f"contract: {len(self.violations)} rule(s) broken"]
         lines += [
             f"  {v.rule}: from step {v.step:,} ({v.count:,} {v.counted}(s)): {v.text}"

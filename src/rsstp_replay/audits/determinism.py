@@ -39,6 +39,7 @@ import pandas as pd
 from rsstp_sim.errors import ModelError
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import DeterminismReport, TransitionSystem
+from rsstp_sim.words import counted
 
 __all__ = [
     "DeterminismFindings",
@@ -290,9 +291,8 @@ def _pair_lines(title: str, items: list[str]) -> list[str]:
     return lines
 
 
-def _plural(count: int, noun: str) -> str:
-    return f"{count} {noun}{'' if count == 1 else 's'}"
+_plural = counted
 
 
 def _short(states: Sequence[int]) -> str:
-    return str(list(states)) if len(states) <= 20 else f"{len(states)} states"
+    return str(list(states)) if len(states) <= 20 else counted(len(states), "state")

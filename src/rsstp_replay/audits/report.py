@@ -36,6 +36,7 @@ from rsstp_replay.audits.contract import ContractFindings, check_contract
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.summary import AuditSource, SummaryFindings, audit_summary
+from rsstp_sim.words import counted
 
 __all__ = ["AuditReport", "run_audits"]
 
@@ -87,7 +88,8 @@ class AuditReport:
         final = self.determinism.final.version
         in_final = [f for f in within.contradictions if f.version == final]
         if within.consistent:
-            lines = [f"within each model version: no contradictory state in {within.steps} steps"]
+            steps = counted(within.steps, "step")
+            lines = [f"within each model version: no contradictory state in {steps}"]
         else:
             versions = len({found.version for found in within.contradictions})
             last = max(within.contradictions, key=lambda found: found.first_step)
@@ -105,8 +107,8 @@ class AuditReport:
             lines += [f"  {line}" for line in _short_text(ConsistencyFindings(tuple(shown), 0))]
         if history.consistent:
             lines.append(
-                f"accumulated over the whole history: no contradictory state in {history.steps} "
-                f"steps"
+                "accumulated over the whole history: no contradictory state in "
+                f"{counted(history.steps, 'step')}"
             )
         else:
             lines.append(
@@ -169,5 +171,4 @@ def _short_text(findings: ConsistencyFindings) -> list[str]:
     return lines
 
 
-def _plural(count: int, noun: str) -> str:
-    return f"{count:,} {noun}{'' if count == 1 else 's'}"
+_plural = counted

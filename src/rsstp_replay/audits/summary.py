@@ -31,6 +31,7 @@ from rsstp_replay.audits.determinism import HasModelVersions
 from rsstp_sim.errors import ModelError
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.words import counted
 
 __all__ = ["AuditSource", "ModelSize", "SummaryFindings", "audit_summary"]
 
@@ -120,7 +121,7 @@ class SummaryFindings:
             )
         return "\n".join(
             [
-                f"steps: {self.steps}",
+                f"steps: {self.steps:,}",
                 f"final model: {_plural(final.states, 'state')}, "
                 f"{_plural(final.transitions, 'transition')}, {verdict} (version "
                 f"{final.version}, from step {final.step}; "
@@ -129,7 +130,7 @@ class SummaryFindings:
                 f"{_plural(self.adds, 'add')}, {_plural(self.deletes, 'delete')}",
                 f"blocked moves: {self.blocked}",
                 f"steps with no transition in the model: {self.no_transition}",
-                f"sensations seen: true {self.sensations_true}, false {self.sensations_false}",
+                f"sensations seen: true {self.sensations_true:,}, false {self.sensations_false:,}",
                 f"contradictions: {contradictions}",
             ]
         )
@@ -218,5 +219,4 @@ def audit_summary(
     )
 
 
-def _plural(count: int, noun: str) -> str:
-    return f"{count} {noun}{'' if count == 1 else 's'}"
+_plural = counted

@@ -82,7 +82,9 @@ def open_side_file(path: Path, *, force: bool) -> io.FileIO:
     if not os.access(parent, os.W_OK | os.X_OK):
         raise RecordingError(f"{path}: the output directory {parent} is not writable")
     if path.exists() and not force:
-        raise RecordingError(f"{path}: already exists (use --force to overwrite)")
+        raise RecordingError(
+            f"{path}: already exists (use --force, or force=True in Python, to overwrite)"
+        )
     try:
         fd = os.open(partial, os.O_RDWR | os.O_CREAT | os.O_CLOEXEC, 0o644)
     except OSError as exc:
@@ -98,7 +100,7 @@ def open_side_file(path: Path, *, force: bool) -> io.FileIO:
         if os.fstat(fd).st_size and not force:
             raise RecordingError(
                 f"{partial}: left by an interrupted recording; read it with rsstp-replay, "
-                "move it away, or use --force to replace it"
+                "move it away, or use --force (force=True in Python) to replace it"
             )
         os.ftruncate(fd, 0)
         return io.FileIO(fd, "w", closefd=True)

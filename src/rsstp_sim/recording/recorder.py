@@ -22,6 +22,7 @@ properly.
 
 from __future__ import annotations
 
+import io
 import json
 import os
 import platform
@@ -35,7 +36,7 @@ import msgspec
 from mcap.writer import CompressionType, Writer
 
 from rsstp_sim.coupling import Event, Runner, StepOutcome
-from rsstp_sim.errors import RecordingError, RecordingWriteError
+from rsstp_sim.errors import RecordingError, RecordingWriteError, RsstpError
 from rsstp_sim.files import side_file
 from rsstp_sim.recording import builders, records
 from rsstp_sim.recording.output import WriteThrough, open_side_file
@@ -357,14 +358,41 @@ class Recorder:
     @contextmanager
     def _closed_on_failure(self) -> Iterator[None]:
         """A write error of the disk leaves the side file with its chunks and says what is
-        safe; any other failure (a strategy's, a signal's) finishes the file first."""
+        safe; any other failure (a strategy's, a MemoryError, Ctrl-C in Python) finishes the
+        side file but leaves it beside the output, never onto it, and the error says where."""
         try:
             yield
         except BaseException as exc:
             if isinstance(exc, OSError) and exc is self._file.error:
                 raise self._write_failed(exc) from None
-            self.close()
+            kept = self._finish_aside()
+            if isinstance(exc, MemoryError):
+                raise RecordingError(
+                    f"out of memory at step {self.runner.step_index:,}; {kept}"
+                ) from None
+            if isinstance(exc, RsstpError):
+                exc.args = (f"{exc}; {kept}",)
             raise
+
+    def _finish_aside(self) -> str:
+        """Finish the side file of a run stopped by an error, not renamed; say where it is."""
+        if self._closed:
+            return f"{self.path} was not touched"
+        try:
+            self._writer.finish()  # type: ignore[no-untyped-call]
+        except BaseException:  # a full disk, or still no memory: the chunks written stay
+            finished = "unfinished; rsstp-replay reads its complete chunks"
+        else:
+            finished = "finished"
+        finally:
+            self._closed = True
+            try:
+                self._file.close()
+            except OSError:
+                pass
+        return (
+            f"the steps before it are in {self.side_file} ({finished}); {self.path} was not touched"
+        )
 
     def close(self) -> None:
         """Finish the file (summary and indexes) and rename it onto the output; idempotent.
@@ -386,6 +414,7 @@ class Recorder:
             raise
         self._closed = True
         try:
+            _check_finished(self._raw, self._file.tell(), self.side_file)
             os.replace(self.side_file, self.path)  # still locked: nobody can take the file
         finally:
             self._file.close()
@@ -413,6 +442,21 @@ class Recorder:
     @property
     def counts(self) -> Mapping[str, int]:
         return dict(self._counts)
+
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+
+
+def _check_finished(raw: io.FileIO, size: int, side: Path) -> None:
+    """Before the output is replaced: the side file holds every byte written and ends as an
+    MCAP file ends (its closing magic)."""
+    found = os.fstat(raw.fileno()).st_size
+    end = os.pread(raw.fileno(), len(_MCAP_MAGIC), max(0, size - len(_MCAP_MAGIC)))
+    if found != size or end != _MCAP_MAGIC:
+        raise RecordingError(
+            f"{side}: the finished recording does not check ({found:,} bytes on disk of "
+            f"{size:,} written, ending {end!r}); it stays there, the output was not touched"
+        )
 
 
 def _check_steps(steps: object) -> None:

@@ -372,6 +372,8 @@ def decode(schema_name: str, data: bytes) -> MessageRecord:
         raise RecordFormatError(f"{schema_name}: {_format_error(exc)}") from None
     except msgspec.DecodeError as exc:
         raise RecordFormatError(f"{schema_name}: invalid JSON: {exc}") from None
+    except RecursionError:
+        raise RecordFormatError(f"{schema_name}: nested too deeply") from None
     record._check()
     return record
 
@@ -389,6 +391,8 @@ def decode_many(schema_name: str, parts: Sequence[bytes | memoryview]) -> list[M
         found: list[MessageRecord] = decoder.decode(b"[" + b",".join(parts) + b"]")
     except msgspec.DecodeError as exc:
         raise RecordFormatError(f"{schema_name}: a message of the batch: {exc}") from None
+    except RecursionError:
+        raise RecordFormatError(f"{schema_name}: a message of the batch nests too deeply") from None
     if len(found) != len(parts):  # a part that is several JSON values, or none
         raise RecordFormatError(f"{schema_name}: {len(parts)} messages decode as {len(found)}")
     for record in found:

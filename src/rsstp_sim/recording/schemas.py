@@ -144,6 +144,8 @@ def check_schema_version(name: str, data: bytes) -> tuple[int, int]:
         schema = json.loads(data)
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise RecordFormatError(f"{name}: the schema is not JSON: {exc}") from None
+    except RecursionError:
+        raise RecordFormatError(f"{name}: the schema nests too deeply") from None
     if not isinstance(schema, dict) or schema.get("title") != name:
         found = schema.get("title") if isinstance(schema, dict) else schema
         raise RecordFormatError(f"{name}: the schema's title: expected {name!r}, found {found!r}")

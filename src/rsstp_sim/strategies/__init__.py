@@ -73,6 +73,7 @@ def make_strategy(name: str, params: Mapping[str, Any] | None = None) -> Strateg
     """Build a strategy by name (built-in, entry point, or ``package.module:Class``) with
     keyword parameters; :class:`StrategyError` names what could not be found or built."""
     factory = _BUILTIN.get(name) or _plugin(name)
+    _check_parameter_names(name, factory, params or {})
     try:
         strategy = factory(**dict(params or {}))
     except TypeError as exc:
@@ -86,6 +87,30 @@ def make_strategy(name: str, params: Mapping[str, Any] | None = None) -> Strateg
             f"{', '.join(missing) or 'name'}; subclass rsstp_sim.StrategyBase)"
         )
     return strategy
+
+
+def _check_parameter_names(name: str, factory: Any, params: Mapping[str, Any]) -> None:
+    """One line naming a parameter the strategy does not take, and the ones it does."""
+    import inspect
+
+    try:
+        signature = inspect.signature(factory)
+    except (TypeError, ValueError):  # no signature to read: the call says what is wrong
+        return
+    kinds = {p.kind for p in signature.parameters.values()}
+    if inspect.Parameter.VAR_KEYWORD in kinds:
+        return
+    takes = [
+        p.name
+        for p in signature.parameters.values()
+        if p.kind in (inspect.Parameter.POSITIONAL_OR_KEYWORD, inspect.Parameter.KEYWORD_ONLY)
+    ]
+    for key in params:
+        if key not in takes:
+            accepted = ", ".join(f"{t}=VALUE" for t in takes) or "no parameters"
+            raise StrategyError(
+                f"strategy {name!r}: unknown parameter {key!r} (it takes {accepted})"
+            )
 
 
 @dataclass(frozen=True, slots=True)

@@ -56,7 +56,9 @@ class LearnerStrategy(StrategyBase):
 
     def __init__(self, *, doubts: int = 1) -> None:
         if isinstance(doubts, bool) or not isinstance(doubts, int) or doubts < 0:
-            raise StrategyError(f"learner: doubts must be an integer >= 0, got {doubts!r}")
+            raise StrategyError(
+                f"learner: parameter doubts: expected an integer >= 0 (doubts=2), got {doubts!r}"
+            )
         self._doubts = doubts
         self._learning: Learning | None = None
         self._plan: Plan | None = None

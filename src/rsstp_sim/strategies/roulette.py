@@ -59,7 +59,9 @@ class RouletteStrategy(StrategyBase):
         if action is not None and (
             isinstance(action, bool) or not isinstance(action, int) or action < 0
         ):
-            raise StrategyError(f"roulette: action must be an integer >= 0, got {action!r}")
+            raise StrategyError(
+                f"roulette: parameter action: expected an integer >= 0 (action=0), got {action!r}"
+            )
         self._action_param = action
         self._action = 0
         self._chain: list[int] = []

@@ -21,8 +21,13 @@ class ScriptStrategy(StrategyBase):
     name: ClassVar[str] = "script"
 
     def __init__(self, actions: Sequence[int] = ()) -> None:
-        if any(isinstance(a, bool) or not isinstance(a, int) or a < 0 for a in actions):
-            raise StrategyError(f"script: actions must be integers >= 0, got {list(actions)}")
+        if not isinstance(actions, list | tuple) or any(
+            isinstance(a, bool) or not isinstance(a, int) or a < 0 for a in actions
+        ):
+            raise StrategyError(
+                f"script: parameter actions: expected a list of integers >= 0 (actions=[0,1]), "
+                f"got {actions!r}"
+            )
         self._actions = tuple(actions)
         self._plan: tuple[int, ...] = ()
         self._index = 0

@@ -180,7 +180,10 @@ class SplitterStrategy(StrategyBase):
 
     def __init__(self, *, horizon: int = 8) -> None:
         if isinstance(horizon, bool) or not isinstance(horizon, int) or horizon < 1:
-            raise StrategyError(f"splitter: horizon must be an integer >= 1, got {horizon!r}")
+            raise StrategyError(
+                "splitter: parameter horizon: expected an integer >= 1 (horizon=3), got "
+                f"{horizon!r}"
+            )
         self._horizon = horizon
         self._explorer = RandomStrategy()
         self._histories = _Histories()
