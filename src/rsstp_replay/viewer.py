@@ -51,7 +51,7 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.transition_system import TransitionSystem
-from rsstp_sim.truth import compute_truth
+from rsstp_sim.truth_cache import load_truth
 from rsstp_sim.words import counted
 
 __all__ = [
@@ -524,7 +524,7 @@ def _roles(scenario: Scenario, steps: pd.DataFrame) -> model_part.Roles | None:
     """Every visited state's role per version by the truth audit, or None (with a warning)
     when the truth cannot be computed (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
     try:
-        truth = compute_truth(scenario, max_poses=TRUTH_MAX_POSES)
+        truth = load_truth(scenario, max_poses=TRUTH_MAX_POSES)
         classes = step_true_classes(steps, truth)
     except RsstpError as exc:
         warnings.warn(ViewerWarning(f"states not coloured by the truth audit: {exc}"), stacklevel=3)

@@ -46,6 +46,7 @@ __all__ = [
     "MAX_TRUTH_CHECKS",
     "GroundTruth",
     "TruthError",
+    "check_truth_size",
     "check_equivalence",
     "compute_truth",
     "format_truth",
@@ -255,16 +256,13 @@ Three joints at 5 degrees among 1,000 obstacles count 6.7 billion; they took 130
 before this bound."""
 
 
-def compute_truth(
+def check_truth_size(
     scenario: Scenario, *, max_poses: int = 2_000_000, max_checks: int = MAX_TRUTH_CHECKS
-) -> GroundTruth:
-    """Enumerate the reachable poses of ``scenario`` and minimise their Moore machine.
-
-    Refuses (:class:`TruthError`, before any work) when :func:`pose_space_size` exceeds
-    ``max_poses``, or when checking every move of every pose against every obstacle would
-    take more than ``max_checks`` link-obstacle checks (:data:`MAX_TRUTH_CHECKS`).
-    """
-    started = time.perf_counter()
+) -> None:
+    """Refuse (:class:`TruthError`) a world whose :func:`pose_space_size` exceeds
+    ``max_poses``, or whose every move of every pose checked against every obstacle would take
+    more than ``max_checks`` link-obstacle checks: before any work, and the same whether the
+    truth is computed or read from the cache."""
     bound = pose_space_size(scenario)
     if bound > max_poses:
         raise TruthError(
@@ -280,6 +278,19 @@ def compute_truth(
             f"{len(scenario.obstacles):,} obstacles), more than the {max_checks:,} (about "
             "20 s) the ground truth takes on"
         )
+
+
+def compute_truth(
+    scenario: Scenario, *, max_poses: int = 2_000_000, max_checks: int = MAX_TRUTH_CHECKS
+) -> GroundTruth:
+    """Enumerate the reachable poses of ``scenario`` and minimise their Moore machine.
+
+    Refuses (:class:`TruthError`, before any work) when :func:`pose_space_size` exceeds
+    ``max_poses``, or when checking every move of every pose against every obstacle would
+    take more than ``max_checks`` link-obstacle checks (:data:`MAX_TRUTH_CHECKS`).
+    """
+    started = time.perf_counter()
+    check_truth_size(scenario, max_poses=max_poses, max_checks=max_checks)
     table = WorldTable(scenario)
     table.complete()
     # The table's rows are in the order the poses were reached; the truth's are by code.

@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from rsstp_sim.scenario import Scenario
-from rsstp_sim.truth import GroundTruth, compute_truth
+from rsstp_sim.truth import GroundTruth, check_truth_size, compute_truth
 
 __all__ = ["CacheInfo", "cache_info", "truth_cache_dir", "load_truth", "truth_key"]
 
@@ -80,9 +80,11 @@ def load_truth(
 ) -> GroundTruth:
     """The ground truth of ``scenario``: read from the cache when a sound entry is there,
     else computed (:func:`~rsstp_sim.truth.compute_truth`) and kept. ``cache=False`` neither
-    reads nor writes the cache."""
+    reads nor writes the cache. A world over the size bounds is refused either way
+    (:func:`~rsstp_sim.truth.check_truth_size`)."""
     if not cache:
         return compute_truth(scenario, max_poses=max_poses)
+    check_truth_size(scenario, max_poses=max_poses)
     key = truth_key(scenario)
     path = truth_cache_dir() / f"{key}.npz"
     started = time.perf_counter()
