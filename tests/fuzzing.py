@@ -547,7 +547,10 @@ def _rewrite_message(data: bytes, case: Rewrite) -> bytes | None:
         new = old + case.value
     else:
         new = case.value
-    if type(new) is type(old) and new == old:
+    same_kind = type(new) is type(old) or (
+        isinstance(new, int | float) and isinstance(old, int | float) and type(new) is not bool
+    )
+    if same_kind and new == old:  # the same value (1 for 1.0 too): nothing to catch
         return None
     here[key] = new
     return json.dumps(message, separators=(",", ":")).encode()

@@ -92,6 +92,8 @@ def walk(tmp_path_factory: pytest.TempPathFactory) -> Path:
 @given(case=semantic_rewrites())
 @example(case=Rewrite(where=0.5, field="truth.joint_positions.1.x", value=1e-12, nudge=True))
 @example(case=Rewrite(where=0.3, field="agent.action", value=2**63, nudge=False))
+# Found by bench/fuzz.py (2026-11-26): 1 for a feedback of 1.0 is the same value, not a change.
+@example(case=Rewrite(where=0.08716464942245052, field="agent.feedback", value=1, nudge=False))
 def test_a_rewritten_truth_never_passes_the_physics_check(
     case: Rewrite, walk: Path, tmp_path: Path
 ) -> None:
