@@ -545,13 +545,11 @@ def _arc_gap(
     return best
 
 
-class _Unsure(Exception):
-    """A plain-float distance too near its threshold to decide against numpy's rounding."""
-
-
-def _meets(distance: float, threshold: float, margin: float) -> bool:
+def _meets(distance: float, threshold: float, margin: float) -> bool | None:
+    """Whether a contact is met; None when the plain-float distance is within ``margin`` of
+    its threshold, too near to decide against numpy's rounding."""
     if abs(distance - threshold) <= margin:
-        raise _Unsure
+        return None
     return distance <= threshold
 
 
@@ -569,10 +567,10 @@ def move_blocker(
     and numpy could round to different sides, is left to :func:`move_blockers` itself, so
     the answer is always numpy's.
     """
-    try:
-        return _move_blocker(geo, angles_deg, points, joint, delta_deg)
-    except _Unsure:
+    code = _move_blocker(geo, angles_deg, points, joint, delta_deg)
+    if code is None:  # too near a threshold: numpy decides
         return int(move_blockers(geo, [list(angles_deg)], [joint], [delta_deg])[0])
+    return code
 
 
 _UNSURE = 1e-11
@@ -582,7 +580,8 @@ _UNSURE = 1e-11
 
 def _move_blocker(
     geo: ArmGeometry, angles_deg: Sequence[int], points: Sequence[float], joint: int, delta_deg: int
-) -> int:
+) -> int | None:
+    """:func:`move_blocker` in plain floats; None when a distance is too near its threshold."""
     n, m, halves, eps = geo.n, geo.m, geo.half_lengths, geo.eps
     unsure = eps * (_UNSURE / CONTACT_EPS)
     hypot = math.hypot
@@ -629,8 +628,9 @@ def _move_blocker(
                 distance = _arc_gap(px, py, cx, cy, -delta, (ax, ay, bx, by))
             else:
                 distance = _gap(cx, cy, ax, ay, bx, by)
-            if _meets(distance, radius + eps, unsure):
-                return n + j * m + o
+            met = _meets(distance, radius + eps, unsure)
+            if met is None or met:
+                return None if met is None else n + j * m + o
     for i in range(joint if swept else n):
         fixed = points[2 * i : 2 * i + 4]
         fx, fy = 0.5 * (fixed[0] + fixed[2]), 0.5 * (fixed[1] + fixed[3])
@@ -652,15 +652,10 @@ def _move_blocker(
                 )
             else:
                 distance = _segments_gap(fixed, seg)
-            if _meets(distance, eps, unsure):
-                return n + n * m + i * n + j
+            met = _meets(distance, eps, unsure)
+            if met is None or met:
+                return None if met is None else n + n * m + i * n + j
     return 0
-
-
-def _exact_move_blocker(
-    geo: ArmGeometry, angles_deg: Sequence[int], joint: int, delta_deg: int
-) -> int:
-    return int(move_blockers(geo, [list(angles_deg)], [joint], [delta_deg])[0])
 
 
 def feedback(
