@@ -102,6 +102,7 @@ def _commands(folder: Path) -> list[tuple[Callable[[list[str]], int], list[str]]
             (replay_main, ["info", path]),
             (replay_main, ["check", path]),
             (replay_main, ["audit", path, "--quiet"]),
+            (replay_main, ["audit", path, "--truth", "--quiet"]),
             (replay_main, ["compare", path, "0", "1"]),
             (replay_main, ["table", path, "-o", str(out / "t.csv"), "--force"]),
             (replay_main, ["events", path, "-o", str(out / "e.parquet"), "--force"]),

@@ -47,6 +47,7 @@ from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.truth import GroundTruth
 from rsstp_sim.truth_cache import load_truth
+from rsstp_sim.words import counted
 
 __all__ = ["TruthFindings", "TruthSource", "audit_truth", "step_true_classes", "truth_table"]
 
@@ -201,11 +202,12 @@ class TruthFindings:
         table = self.versions
         lines = [
             *([self.verdict.to_text()] if verdict else []),
-            f"truth: {self.scenario}: {self.reachable_poses:,} reachable poses, minimal model "
-            f"{self.minimal_states} states; the run visited {self.classes_visited} classes in "
-            f"{self.steps:,} steps",
-            f"within each model version ({len(table):,} versions; a state id means what its "
-            f"version says):",
+            f"truth: {self.scenario}: {counted(self.reachable_poses, 'reachable pose')}, minimal "
+            f"model {counted(self.minimal_states, 'state')}; the run visited "
+            f"{counted(self.classes_visited, 'class', 'classes')} in "
+            f"{counted(self.steps, 'step')}",
+            f"within each model version ({counted(len(table), 'version')}; a state id means "
+            f"what its version says):",
         ]
         for column, what in (
             ("aliased_states", "a state stood for several true classes"),
@@ -214,13 +216,12 @@ class TruthFindings:
         ):
             lines.append(f"  {what}: {_versions_with(table, column)}")
         for state, classes in sorted(self.final_aliased.items())[:10]:
-            lines.append(f"    final version: state {state} stood for classes {_short(classes)}")
+            lines.append(f"    final version: state {state:,} stood for classes {_short(classes)}")
         for cls, states in sorted(self.final_redundant.items())[:10]:
-            lines.append(f"    final version: class {cls} was in states {_short(states)}")
+            lines.append(f"    final version: class {cls:,} was in states {_short(states)}")
         equivalent = table.loc[table["equivalent"]]
         lines.append(
-            f"  equivalent to the truth: {len(equivalent):,} "
-            f"version{'' if len(equivalent) == 1 else 's'}"
+            f"  equivalent to the truth: {counted(len(equivalent), 'version')}"
             + (
                 f", the first at step {int(equivalent['step'].iloc[0]):,}"
                 if len(equivalent)
@@ -233,17 +234,18 @@ class TruthFindings:
             "counts what it meant in every version):"
         )
         lines.append(
-            f"  aliasing: {len(aliased)} internal states stood for several true classes"
-            + (f", first at step {self.first_aliasing_step}" if aliased else "")
+            f"  aliasing: {counted(len(aliased), 'internal state')} stood for several true classes"
+            + (f", first at step {self.first_aliasing_step:,}" if aliased else "")
         )
         lines.append(
-            f"  redundancy: {len(redundant)} true classes were split over several internal states"
-            + (f", first at step {self.first_redundancy_step}" if redundant else "")
+            f"  redundancy: {counted(len(redundant), 'true class', 'true classes')} were split "
+            f"over several internal states"
+            + (f", first at step {self.first_redundancy_step:,}" if redundant else "")
         )
         if self.first_mismatch_step is None:
             lines.append("  the internal states matched the true classes one to one at every step")
         else:
-            lines.append(f"  first mismatch at step {self.first_mismatch_step}")
+            lines.append(f"  first mismatch at step {self.first_mismatch_step:,}")
         return "\n".join(lines) + "\n"
 
     def to_json(self) -> dict[str, Any]:
@@ -287,15 +289,15 @@ def _versions_with(table: pd.DataFrame, column: str) -> str:
     last = hit.iloc[-1]
     final = int(table[column].iloc[-1])
     return (
-        f"in {len(hit):,} of {len(table):,} versions, the last version {int(last['version'])} "
-        f"(steps {int(last['step']):,}..{int(last['last_step']):,})"
-        + ("; none in the final version" if final == 0 else f"; {final} in the final version")
+        f"in {len(hit):,} of {counted(len(table), 'version')}, the last version "
+        f"{int(last['version']):,} (steps {int(last['step']):,}..{int(last['last_step']):,})"
+        + ("; none in the final version" if final == 0 else f"; {final:,} in the final version")
     )
 
 
 def _short(values: tuple[int, ...], limit: int = 12) -> str:
-    shown = ", ".join(map(str, values[:limit]))
-    return f"[{shown}{', ...' if len(values) > limit else ''}] ({len(values)})"
+    shown = ", ".join(f"{v:,}" for v in values[:limit])
+    return f"[{shown}{', ...' if len(values) > limit else ''}] ({len(values):,})"
 
 
 def audit_truth(

@@ -44,6 +44,7 @@ from rsstp_replay.audits._equivalence import (
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence
+from rsstp_sim.words import counted
 
 __all__ = ["Confinement", "Counterexample", "Verdict", "judge_versions"]
 
@@ -89,10 +90,10 @@ class Counterexample:
             if self.last_changed_step is None
             else f"last changed at step {self.last_changed_step:,}"
         )
-        states = ["-" if s is None else str(s) for s in self.model_states]
+        states = ["-" if s is None else f"{s:,}" for s in self.model_states]
         return (
-            f"counterexample: from state {self.from_state} at step {self.from_step:,} (true "
-            f"class {self.true_class}), actions {_runs(map(str, self.actions))}: the model goes "
+            f"counterexample: from state {self.from_state:,} at step {self.from_step:,} (true "
+            f"class {self.true_class:,}), actions {_runs(map(str, self.actions))}: the model goes "
             f"through states {_runs(states)} and predicts "
             f"{_runs(map(_sensation, self.predicted))}, the world senses "
             f"{_runs(map(_sensation, self.actual))} ({self.disagreement}); the transitions on "
@@ -184,14 +185,14 @@ class Verdict:
             return (
                 f"not learned: since {self.confinement.move()} the arm cannot return to where "
                 f"it started; the run is confined to {self.reachable_classes:,} of the "
-                f"{_count(self.minimal_states, 'true class', 'true classes')}, {part} "
-                f"({_count(self.final_states, 'state')}), and no state of the final model is "
+                f"{counted(self.minimal_states, 'true class', 'true classes')}, {part} "
+                f"({counted(self.final_states, 'state')}), and no state of the final model is "
                 f"equivalent to the start pose"
             )
         head = (
-            f"not learned: {_count(self.final_states, 'state')} for "
-            f"{_count(self.minimal_states, 'true class', 'true classes')} after "
-            f"{_count(self.steps, 'step')}; "
+            f"not learned: {counted(self.final_states, 'state')} for "
+            f"{counted(self.minimal_states, 'true class', 'true classes')} after "
+            f"{counted(self.steps, 'step')}; "
         )
         if self.growth_per_step > 0:
             return head + f"the model grows by about {self.growth_per_step:.2g} states a step"
@@ -529,10 +530,6 @@ def _growth(versions: Sequence[ModelRecord], steps: int) -> float:
     sizes = np.fromiter((len(record.states) for record in versions), np.int64, len(versions))
     size_middle = int(sizes[int(np.searchsorted(at, middle, side="right")) - 1])
     return round((int(sizes[-1]) - size_middle) / (steps - middle), 4)
-
-
-def _count(n: int, one: str, many: str | None = None) -> str:
-    return f"{n:,} {one if n == 1 else many or one + 's'}"
 
 
 def _runs(values: Iterable[str]) -> str:
