@@ -11,8 +11,9 @@ step's internal state and ``step_classes[t]`` the true class of its pose
   for;
 - **unvisited** (:data:`UNVISITED`): the version was never in that state at a step.
 
-A version equivalent to the truth has only exact and unvisited states on the steps it was in
-force. The viewer colours the model's states by role (:mod:`rsstp_replay._viewer_model`).
+A version equivalent to the truth (:mod:`rsstp_replay.audits.verdict`) has no aliased state on
+the steps it was in force; a redundant one is allowed (a correct model need not be minimal).
+The viewer colours the model's states by role (:mod:`rsstp_replay._viewer_model`).
 """
 
 from __future__ import annotations
