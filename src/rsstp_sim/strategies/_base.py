@@ -23,12 +23,19 @@ class AgentView:
     - ``actions``: the actions the agent may take.
     - ``rng``: the run's seeded generator; the only source of randomness allowed.
     - ``note(text)``: a strategy note, recorded as an event at the current step.
+    - ``enter(phase)``: the strategy's phase from the current step on (``"explore"``,
+      ``"home"``...), recorded as a note event whose data says the phase; the audit summary
+      gives the share of steps spent in each phase. Entering the phase it is in does nothing.
+    - ``stop(reason)``: the strategy ends the run after the current step (its work is done,
+      or it cannot go on); the run's ``--steps`` is then a budget it did not use up. The
+      runner takes no further step; a recording ends with an event saying why. ``stopped``
+      is the reason given, or None.
 
     Ground truth (angles, positions, blocked moves, obstacle distances) is
     deliberately absent: a strategy learns from actions and sensations only.
     """
 
-    __slots__ = ("memory", "model", "actions", "rng", "_notes")
+    __slots__ = ("memory", "model", "actions", "rng", "stopped", "phase", "_notes", "_phases")
 
     def __init__(
         self,
@@ -37,12 +44,16 @@ class AgentView:
         actions: tuple[int, ...],
         rng: np.random.Generator,
         notes: Callable[[str], None],
+        phases: Callable[[str], None] | None = None,
     ) -> None:
         self.memory = memory
         self.model = model
         self.actions = actions
         self.rng = rng
+        self.stopped: str | None = None
+        self.phase: str | None = None
         self._notes = notes
+        self._phases = phases
 
     @property
     def state(self) -> int:
@@ -57,6 +68,21 @@ class AgentView:
     def note(self, text: str) -> None:
         self._notes(text)
 
+    def enter(self, phase: str) -> None:
+        """From the current step on, the strategy is in ``phase`` (one word, not empty)."""
+        if phase == self.phase:
+            return
+        if not phase or not phase.isidentifier():
+            raise ValueError(f"a phase is one word, got {phase!r}")
+        self.phase = phase
+        if self._phases is not None:
+            self._phases(phase)
+
+    def stop(self, reason: str) -> None:
+        """End the run after the current step, for ``reason`` (one line)."""
+        if self.stopped is None:
+            self.stopped = " ".join(reason.split()) or "no reason given"
+
 
 @runtime_checkable
 class Strategy(Protocol):
@@ -64,7 +90,9 @@ class Strategy(Protocol):
 
     The runner calls ``initial_model`` and ``reset`` once, then each step
     ``choose_action`` before the move and ``refine`` after the memory entry of
-    that step has been written.
+    that step has been written. A strategy ends the run by calling
+    :meth:`AgentView.stop` (in ``reset`` or ``refine``): the runner then takes no further
+    step. A strategy that never calls it runs the whole budget of steps, as before.
     """
 
     name: ClassVar[str]

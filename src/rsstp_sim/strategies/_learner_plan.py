@@ -21,8 +21,9 @@ class Learning(Identifier):
     ``done``: every transition is confirmed, tested and the hypothesis is minimal.
     """
 
-    def __init__(self, agent: AgentView, *, doubts: int) -> None:
+    def __init__(self, agent: AgentView, *, doubts: int, stop: bool = True) -> None:
         super().__init__(agent, doubts=doubts)
+        self.stop = stop
         self.start_sensation = bool(agent.memory.sensations[0])
         self.found = False
         self.first_landmark = 0
@@ -101,9 +102,13 @@ class Learning(Identifier):
             return
         if not self.done:
             self.done = True
-            self.agent.note(f"done: {len(h.labels)} states, every transition confirmed")
+            done = f"done: {len(h.labels)} states, every transition confirmed and tested"
+            if self.stop:
+                self.agent.stop(done)
+            else:
+                self.agent.note(done)
         self.phase = "wander"
-        while True:
+        while True:  # every prediction checked
             yield from self.move(self.random_action(), check=True)
 
     def goal(self) -> tuple[list[int], tuple[int, int] | None] | None:
