@@ -367,6 +367,7 @@ def _log(
     shown, times = _versions_in(loaded.versions, first, last)
     rows |= model_part.log_model(stream, shown, times, loaded.places)
     rows |= plots_part.log_model_size(stream, shown, times, last)
+    rows |= plots_part.log_phases(stream, loaded.events, first, last)
     rows[model_part.CURRENT] = model_part.log_current_state(
         stream,
         window.index.to_numpy(np.int64),

@@ -24,6 +24,8 @@ from rsstp_sim import (
 )
 from rsstp_sim.cli import main as sim_main
 from rsstp_sim.recording.recorder import Recorder, record
+from rsstp_sim.strategies._learner_walk import PHASES
+from rsstp_sim.strategies.learner import LearnerStrategy
 
 SCHEDULE = {1: "first", 11: "second", 31: "first"}
 """The phase :class:`Phased` enters at each step; it stops at :data:`LAST`."""
@@ -164,3 +166,30 @@ def test_a_phase_is_one_word() -> None:
     runner = Runner(load_scenario("three-joint"), Phased(), seed=0)
     with pytest.raises(ValueError, match="a phase is one word, got 'two words'"):
         runner.agent.enter("two words")
+
+
+@pytest.mark.parametrize("name", ["one-joint-10", "thesis-algo"])
+def test_the_learners_phases_are_events_and_their_shares_are_its_step_counts(
+    tmp_path: Path, name: str
+) -> None:
+    # thesis-algo starts away from its feedback pose: the run begins with a search (home).
+    path = tmp_path / "learner.mcap"
+    learner = LearnerStrategy()
+    result = record(path, load_scenario(name), learner, steps=1_000_000, seed=0)
+    assert result.stopped is not None and learner.done
+    # The learner's own counters, by phase (each counter names the phase it belongs to).
+    counted: dict[str, int] = {}
+    for key, n in learner.stats().items():
+        if key.startswith("steps_"):
+            phase = PHASES[key.removeprefix("steps_")]
+            counted[phase] = counted.get(phase, 0) + n
+    with open_recording(path) as recording:
+        events = recording.events()
+        notes = events[events["kind"] == "note"]
+        phased = notes[notes["data"].str.startswith('{"phase"')]
+        assert set(phased["text"]) == {f"phase: {p}" for p in counted}
+        assert phased["step"].is_monotonic_increasing and phased["step"].iloc[0] == 1
+        summary = run_audits(load(recording)).summary
+    assert {p.phase: p.steps for p in summary.phases} == counted
+    assert sum(counted.values()) == result.steps
+    assert set(counted) <= {"home", "explore", "identify"}

@@ -46,6 +46,7 @@ __all__ = [
     "Stop",
     "SummaryFindings",
     "audit_summary",
+    "phase_changes",
     "phase_shares",
     "strategy_stop",
 ]
@@ -275,18 +276,27 @@ def audit_summary(
 
 def _note_data(events: pd.DataFrame, key: str) -> list[tuple[int, dict[str, Any]]]:
     """The notes whose data has ``key``: (step, data), in order."""
-    notes = events[(events["kind"] == "note") & events["data"].str.contains(f'"{key}"')]
+    notes = events[events["kind"] == "note"]
     found = []
-    for step, text in zip(notes["step"].tolist(), notes["data"].tolist(), strict=True):
-        data = json.loads(text)
-        if key in data:
+    quoted = f'"{key}"'
+    for step, data in zip(notes["step"].tolist(), notes["data"].tolist(), strict=True):
+        if isinstance(data, str):  # JSON text, as Recording.events gives it
+            if quoted not in data:
+                continue
+            data = json.loads(data)
+        if isinstance(data, dict) and key in data:
             found.append((int(step), data))
     return found
 
 
+def phase_changes(events: pd.DataFrame) -> list[tuple[int, str]]:
+    """The strategy's phase notes: (step, the phase entered there), in order."""
+    return [(step, str(data["phase"])) for step, data in _note_data(events, "phase")]
+
+
 def phase_shares(events: pd.DataFrame, steps: int) -> tuple[PhaseShare, ...]:
     """The steps ``1 .. steps`` by the phase the strategy's phase notes put them in."""
-    changes = [(step, str(data["phase"])) for step, data in _note_data(events, "phase")]
+    changes = phase_changes(events)
     if not changes or steps <= 0:
         return ()
     starts = np.array([max(step, 1) for step, _ in changes] + [steps + 1], dtype=np.int64)

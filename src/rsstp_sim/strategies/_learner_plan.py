@@ -9,7 +9,7 @@ import numpy as np
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR
 from rsstp_sim.strategies._learner_identify import Identifier
-from rsstp_sim.strategies._learner_walk import Plan, Refuted
+from rsstp_sim.strategies._learner_walk import PHASES, Plan, Refuted
 
 __all__ = ["Learning"]
 
@@ -34,8 +34,10 @@ class Learning(Identifier):
     def plan(self) -> Plan:
         agent = self.agent
         while not self.start_sensation:  # search for the landmark
+            sensation = yield self.random_action()
             self.count("steps_search")
-            if (yield self.random_action()):
+            agent.enter(PHASES["search"])
+            if sensation:
                 self.first_landmark = agent.step
                 break
         self.found = True
@@ -169,8 +171,9 @@ class Learning(Identifier):
 
     def explore(self, q: int, a: int) -> Plan:
         """Take ``a`` from ``q`` (located there) and identify the state it leads to."""
-        self.phase = "test"
+        self.phase = "take"
         sensation = yield from self.move(a)
+        self.phase = "test"
         if sensation:
             self.confirm(q, a, self.h.landmark)
             return

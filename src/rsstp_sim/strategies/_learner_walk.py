@@ -14,10 +14,26 @@ import numpy as np
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR, Hypothesis
 
-__all__ = ["LONGEST_RUN", "Plan", "Refuted", "Walker"]
+__all__ = ["LONGEST_RUN", "PHASES", "Plan", "Refuted", "Walker"]
 
 LONGEST_RUN = 16
 """The longest run of one action in a random search."""
+
+PHASES = {
+    "search": "home",
+    "home": "home",
+    "navigate": "explore",
+    "take": "explore",
+    "test": "identify",
+    "return": "identify",
+    "analyse": "identify",
+    "verify": "identify",
+    "wander": "done",
+}
+"""The phase recorded (``agent.enter``) for each step counter of :attr:`Walker.stats`: *home*
+(searching for the landmark), *explore* (walking to the next transition, and taking it), *identify*
+(telling where a transition led: tests, returns, counterexamples, verification), *done*
+(walking the finished model, with ``stop=False``)."""
 
 Plan = Generator[int, bool, None]
 """A plan: yields the next action, receives the sensation that followed it."""
@@ -65,6 +81,7 @@ class Walker:
         confirmed transition raises :class:`Refuted` (else the agent is just lost)."""
         sensation = yield action
         self.count(f"steps_{self.phase}")
+        self.agent.enter(PHASES[self.phase])
         self.word.append(action)
         self.trace.append(sensation)
         h = self.h
