@@ -3,6 +3,7 @@
     PYTHONPATH=src python bench/learning.py                 # everything, a few minutes
     PYTHONPATH=src python bench/learning.py --aalpy-seconds 30
     PYTHONPATH=src python bench/learning.py --no-aalpy
+    PYTHONPATH=src python bench/learning.py --spread 10     # steps to learn over seeds 0-9
 
 For each built-in scenario: the ground truth's minimal model (N states); the ``learner``
 strategy run until it is done (or its step budget is spent), its steps, seconds and whether its
@@ -20,6 +21,10 @@ class: run_hW is not asked for its initial state (that would need a reset).
 
 Targets: equivalent on every scenario; at most 4 x N^2 steps on the one-joint cycles and 50,000
 on two-joint-30; each learner run under a minute.
+
+``--spread K``: the learner alone on each scenario with seeds ``0 .. K-1``, the steps to learn
+(least, median, most, and as multiples of N^2) and how many runs ended equivalent: the seed
+reaches every choice the learner makes among equals, so the runs differ.
 
 AALpy is the ``bench`` extra (``pip install aalpy``); without it the AALpy columns say so.
 """
@@ -333,18 +338,52 @@ def _format(rows: list[Row]) -> str:
     return "\n".join(lines)
 
 
+def spread(names: Sequence[str], seeds: int) -> bool:
+    """The learner on each scenario with seeds ``0 .. seeds-1``; prints one line per scenario,
+    returns whether every run ended equivalent within its budget."""
+    head = (
+        f"{'scenario':16s} {'N':>5s} {'seeds':>5s} | {'least':>9s} {'median':>9s} {'most':>9s} "
+        f"| {'x N^2':>17s} | equivalent  distinct runs"
+    )
+    print(head)
+    print("-" * len(head))
+    good = True
+    for name in names:
+        scenario = load_scenario(name)
+        truth = compute_truth(scenario)
+        budget = budget_for(name, truth)
+        rows = [run_learner(scenario, truth, budget, seed) for seed in range(seeds)]
+        steps = np.array([r.steps for r in rows])
+        n2 = truth.n_classes**2
+        equivalent = sum(r.equivalent and r.done for r in rows)
+        good &= equivalent == len(rows)
+        low, mid, high = int(steps.min()), float(np.median(steps)), int(steps.max())
+        print(
+            f"{name:16s} {truth.n_classes:>5d} {seeds:>5d} | {low:>9,} {mid:>9,.0f} {high:>9,} "
+            f"| {low / n2:>5.2f} {mid / n2:>5.2f} {high / n2:>5.2f} | {equivalent:>4d} of "
+            f"{len(rows):<4d} {len(set(steps.tolist())):>5d}",
+            flush=True,
+        )
+    return good
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--aalpy-seconds", type=float, default=240.0)
     parser.add_argument("--aalpy-memory-gib", type=float, default=8.0)
     parser.add_argument("--no-aalpy", action="store_true")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--spread", type=int, metavar="K", help="the learner over seeds 0..K-1")
     parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
     parser.add_argument("scenarios", nargs="*", default=list(SCENARIOS))
     args = parser.parse_args(argv)
     if args.hw_child:
         _hw_child(args.hw_child, args.aalpy_seconds, args.seed, args.aalpy_memory_gib)
         return 0
+    if args.spread is not None:
+        if args.spread < 1:
+            parser.error(f"--spread must be >= 1, got {args.spread}")
+        return 0 if spread(args.scenarios, args.spread) else 1
 
     aalpy = None if args.no_aalpy else _aalpy_version()
     if not args.no_aalpy and aalpy is None:

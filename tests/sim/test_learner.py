@@ -208,6 +208,31 @@ def test_same_seed_same_run_and_the_seed_matters() -> None:
     assert len({str(trajectory(seed)[0]) for seed in range(4)}) > 1
 
 
+def test_the_seed_reaches_the_choices_after_the_landmark() -> None:
+    # two-joint-30 senses its start pose: no search, so every difference between two seeds
+    # comes from the choices among equals (which path, which nearest state, which action).
+    scenario = load_scenario("two-joint-30")
+    truth = compute_truth(scenario)
+
+    def operations(seed: int) -> list[Operation]:
+        learner = LearnerStrategy()
+        logged: list[Operation] = []
+        runner = Runner(
+            scenario, learner, seed=seed, on_model_change=lambda _s, o: logged.extend(o)
+        )
+        runner.run(50_000)
+        assert learner.stats().get("steps_search", 0) == 0
+        assert_minimal_and_equivalent(learner, runner.model, truth)
+        return logged
+
+    first, second = operations(0), operations(1)
+    common = next(
+        (i for i, (a, b) in enumerate(zip(first, second, strict=False)) if a != b),
+        min(len(first), len(second)),
+    )
+    assert common < min(len(first), len(second)) // 2  # not one model history, twice
+
+
 def test_notes_are_few() -> None:
     scenario = load_scenario("two-joint-30")
     learner = LearnerStrategy()

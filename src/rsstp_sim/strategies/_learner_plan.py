@@ -143,14 +143,14 @@ class Learning(Identifier):
             actions = open_pairs[s]
             made_by = self.made_by.get(s)
             if made_by is None:
-                return actions[0]
+                return self.pick(actions)
             undo = inverse.get(made_by)
             if undo is not None:
-                return undo if undo in actions else actions[0]
+                return undo if undo in actions else self.pick(actions)
             # Not known yet: an action that undoes no other one, and not the same one.
             taken = set(inverse.values())
             likely = [b for b in actions if b not in taken and b != made_by]
-            return likely[0] if likely else actions[0]
+            return self.pick(likely or actions)
 
         outside = [s for s in open_pairs if distance[s] == FAR]
         if outside:

@@ -63,7 +63,9 @@ class Walker:
 
     def __init__(self, agent: AgentView) -> None:
         self.agent = agent
-        self.h = Hypothesis(agent.model, agent.actions, landmark=agent.model.current)
+        self.h = Hypothesis(
+            agent.model, agent.actions, landmark=agent.model.current, rng=agent.rng
+        )
         self.word: list[int] = []
         self.trace: list[bool] = []
         self.beliefs: list[int] = []
@@ -109,6 +111,12 @@ class Walker:
         self.word.clear()
         self.trace.clear()
         self.beliefs.clear()
+
+    def pick(self, among: list[int]) -> int:
+        """One of ``among`` (not empty), chosen by the run's generator: a choice among equals."""
+        if len(among) == 1:
+            return among[0]
+        return among[int(self.agent.rng.integers(len(among)))]
 
     def random_action(self) -> int:
         """Runs of one action of random lengths (P(length >= n) = 1/n, at most
