@@ -160,7 +160,7 @@ def log_phases(
     inside = (steps > first) & (steps <= last)
     times = np.r_[first, steps[inside], last]
     # The phase at each time: the last change at or before it (none before the first).
-    at = np.searchsorted(steps, times, side="right") - 1
+    at: npt.NDArray[np.int64] = np.searchsorted(steps, times, side="right").astype(np.int64) - 1
     values = np.zeros((len(times), len(names)), np.float64)
     known = at >= 0
     values[np.flatnonzero(known), column[at[known]]] = 1.0
