@@ -158,9 +158,9 @@ def log_phases(
     steps = np.array([step for step, _ in changes], np.int64)
     column = np.array([names.index(phase) for _, phase in changes], np.int64)
     inside = (steps > first) & (steps <= last)
-    times = np.r_[first, steps[inside], last]
+    times: npt.NDArray[np.int64] = np.concatenate([[first], steps[inside], [last]]).astype(np.int64)
     # The phase at each time: the last change at or before it (none before the first).
-    at: npt.NDArray[np.int64] = np.searchsorted(steps, times, side="right").astype(np.int64) - 1
+    at = np.asarray(np.searchsorted(steps, times, side="right"), np.int64) - 1
     values = np.zeros((len(times), len(names)), np.float64)
     known = at >= 0
     values[np.flatnonzero(known), column[at[known]]] = 1.0
