@@ -20,6 +20,7 @@ from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
 from rsstp_sim.world import World
+from scenarios import arm_toml
 
 LEARNER_SOURCES = sorted(
     (Path(__file__).parents[2] / "src" / "rsstp_sim" / "strategies").glob("*learner*.py")
@@ -231,6 +232,43 @@ def test_the_seed_reaches_the_choices_after_the_landmark() -> None:
         min(len(first), len(second)),
     )
     assert common < min(len(first), len(second)) // 2  # not one model history, twice
+
+
+def test_a_one_way_world_ends_the_run_with_the_part_it_is_confined_to() -> None:
+    # Joint 0 only turns counter-clockwise: the arm ends jammed against the obstacle, in a
+    # part of the world it cannot leave and where the sensation never comes again.
+    scenario = parse_scenario(
+        arm_toml(
+            [2, 1],
+            [0, 0],
+            30,
+            [((0.0, 2.5), 0.5)],
+            actions=[0, 1, 2],
+            name="one-way",
+            feedback={"target_deg": [0, 90]},
+        )
+    )
+    truth = compute_truth(scenario)
+    notes: list[str] = []
+    learner = LearnerStrategy()
+    runner = Runner(scenario, learner, seed=0, on_event=lambda e: notes.append(e.text))
+    summary = runner.run(40_000)
+    assert runner.stopped is not None and runner.stopped.startswith("confined from step ")
+    assert summary.steps < 40_000 // 4
+    assert any(n.startswith("confined from step ") and "is 1 state" in n for n in notes)
+    # From where the arm is, nothing it can do is ever sensed, as the model predicts.
+    here = truth.class_of(list(runner.world.current.angles_deg))
+    reachable = {here}
+    frontier = [here]
+    while frontier:
+        c = frontier.pop()
+        for d in truth.class_next[c].tolist():
+            if d not in reachable:
+                reachable.add(d)
+                frontier.append(d)
+    assert not truth.class_sensation[sorted(reachable)].any()
+    assert learner.labels()[runner.model.current] is False
+    assert check_equivalence(runner.model, learner.labels(), truth, start_class=here) is None
 
 
 def test_notes_are_few() -> None:

@@ -332,6 +332,26 @@ class Hypothesis:
         self._changed()
         return new
 
+    def add_silent(self) -> int:
+        """A new state for a part of the world that never senses: it predicts false, and every
+        action leads back to it (confirmed). Made by splitting the landmark, its copied
+        transitions then deleted."""
+        model = self.model
+        new = model.split(self.landmark)
+        for u, a, v in model.transitions():
+            if new in (u, v):
+                model.delete(u, v, a)
+        for a in self.actions:
+            model.add(new, new, a)
+        self._grow(new)
+        self.alive[new] = True
+        self.label[new] = False
+        self.labels[new] = False
+        self.access[new] = ()
+        self.next[new] = new
+        self._changed()
+        return new
+
     def merge(self, keep: int, gone: int) -> None:
         """``gone`` is the same world state as ``keep``: the model's merge, then the arrays."""
         self.model.merge(keep, gone)

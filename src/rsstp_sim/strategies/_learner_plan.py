@@ -9,7 +9,7 @@ import numpy as np
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR
 from rsstp_sim.strategies._learner_identify import Identifier
-from rsstp_sim.strategies._learner_walk import PHASES, Plan, Refuted
+from rsstp_sim.strategies._learner_walk import PHASES, Confined, Plan, Refuted
 
 __all__ = ["Learning"]
 
@@ -60,6 +60,11 @@ class Learning(Identifier):
                     agent.note("the model was refuted: learning resumes")
                 self.done = False
                 pending = refuted
+            except Confined as confined:
+                self.confine(confined.since)
+                if self.stop:
+                    while True:  # (the run ends here)
+                        yield from self.move(self.random_action())
 
     def advance(self) -> Plan:
         """One exploration, or the end game: forced deferrals, clean-up, minimisation,
@@ -178,6 +183,27 @@ class Learning(Identifier):
             self.confirm(q, a, self.h.landmark)
             return
         yield from self.identify(q, a, sensation, tuple(self.word), here=True)
+
+    def confine(self, since: int) -> None:
+        """A one-way world: no sensation since step ``since``, and the search for the landmark
+        has lasted longer than the run before it. The part the agent is confined to never
+        senses, so one state predicting false, every action a self-loop, is its exact model:
+        the agent is there now. Say so, and end the run (unless ``stop`` is false)."""
+        state = self.h.add_silent()
+        self.confined = state
+        self.belief = state
+        self.word.clear()
+        self.trace.clear()
+        self.beliefs.clear()
+        self.phase = "confined"
+        searched = self.agent.step - since
+        text = (
+            f"confined from step {since}: no sensation in the {searched:,} steps since, no way "
+            f"back found; the part it is confined to is 1 state (state {state}, never sensing)"
+        )
+        self.agent.note(text)
+        if self.stop:
+            self.agent.stop(text)
 
     def forget(self, gone: int, keep: int | None) -> None:
         """State ``gone`` merged into ``keep`` (or discarded): move or drop what names it."""

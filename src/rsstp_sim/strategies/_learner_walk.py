@@ -14,7 +14,7 @@ import numpy as np
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR, Hypothesis
 
-__all__ = ["LONGEST_RUN", "PHASES", "Plan", "Refuted", "Walker"]
+__all__ = ["CONFINED_STEPS", "LONGEST_RUN", "PHASES", "Confined", "Plan", "Refuted", "Walker"]
 
 LONGEST_RUN = 16
 """The longest run of one action in a random search."""
@@ -29,11 +29,15 @@ PHASES = {
     "analyse": "identify",
     "verify": "identify",
     "wander": "done",
+    "confined": "done",
 }
 """The phase recorded (``agent.enter``) for each step counter of :attr:`Walker.stats`: *home*
 (searching for the landmark), *explore* (walking to the next transition, and taking it), *identify*
 (telling where a transition led: tests, returns, counterexamples, verification), *done*
 (walking the finished model, with ``stop=False``)."""
+
+CONFINED_STEPS = 2048
+"""The shortest search for the landmark after which the agent may conclude it is confined."""
 
 Plan = Generator[int, bool, None]
 """A plan: yields the next action, receives the sensation that followed it."""
@@ -52,6 +56,16 @@ class Refuted(Exception):
         self.trace = trace
 
 
+class Confined(Exception):
+    """The search for the landmark has lasted :data:`CONFINED_STEPS` steps or more, and longer
+    than the whole run before it: the agent takes it that no way leads back (a one-way
+    world), and that the part it is confined to never senses."""
+
+    def __init__(self, since: int) -> None:
+        super().__init__(f"no sensation since step {since}")
+        self.since = since
+
+
 class Walker:
     """The agent walking its hypothesis.
 
@@ -63,9 +77,7 @@ class Walker:
 
     def __init__(self, agent: AgentView) -> None:
         self.agent = agent
-        self.h = Hypothesis(
-            agent.model, agent.actions, landmark=agent.model.current, rng=agent.rng
-        )
+        self.h = Hypothesis(agent.model, agent.actions, landmark=agent.model.current, rng=agent.rng)
         self.word: list[int] = []
         self.trace: list[bool] = []
         self.beliefs: list[int] = []
@@ -74,6 +86,9 @@ class Walker:
         self.stats: dict[str, int] = {}
         self._run_action = 0
         self._run_left = 0
+        self.last_seen = agent.step
+        self.confined: int | None = None
+        self._confinement = CONFINED_STEPS
 
     def count(self, key: str, n: int = 1) -> None:
         self.stats[key] = self.stats.get(key, 0) + n
@@ -108,6 +123,7 @@ class Walker:
     def at_landmark(self) -> None:
         """The sensation is true: the agent is at the landmark, whatever it believed."""
         self.belief = self.h.landmark
+        self.last_seen = self.agent.step
         self.word.clear()
         self.trace.clear()
         self.beliefs.clear()
@@ -173,6 +189,15 @@ class Walker:
             if sensation:
                 self.phase = phase
                 return
+            searched = self.agent.step - self.last_seen
+            if searched >= self._confinement and self.confined is None:
+                # Longer than the run before it, and than runs of every action from every state.
+                bound = max(
+                    CONFINED_STEPS, self.last_seen + 1, LONGEST_RUN * len(h.labels) * len(h.actions)
+                )
+                if searched >= bound:
+                    raise Confined(self.last_seen)
+                self._confinement = bound
             moved = h.next[ids, h.column[action]]
             keep = moved >= 0
             keep[keep] = h.label[moved[keep]] == sensation
