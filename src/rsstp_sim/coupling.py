@@ -141,7 +141,13 @@ class Runner:
         self.memory = Memory()
         self.memory.reset(self.model.current, pose.sensation, pose.feedback)
         self.agent = AgentView(
-            self.memory, self.model, self.scenario.actions, self.rng, self._note, self._phase
+            self.memory,
+            self.model,
+            self.scenario.actions,
+            self.rng,
+            self._note,
+            self._phase,
+            float_feedback=self.scenario.feedback_mode == "float",
         )
         self.blocked = 0
         self.no_transition = 0

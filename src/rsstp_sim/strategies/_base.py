@@ -22,6 +22,10 @@ class AgentView:
       is the internal state, which a strategy may also set (re-localisation).
     - ``actions``: the actions the agent may take.
     - ``rng``: the run's seeded generator; the only source of randomness allowed.
+    - ``float_feedback``: whether the scenario gives the agent its float feedback
+      (``mode = "float"``): then ``memory.feedback`` (closeness to the feedback pose, in
+      ``[0, 1]``, 1 there) is the agent's to use; else only the boolean sensations are, the
+      float being recorded for the analysis only.
     - ``note(text)``: a strategy note, recorded as an event at the current step.
     - ``enter(phase)``: the strategy's phase from the current step on (``"explore"``,
       ``"home"``...), recorded as a note event whose data says the phase; the audit summary
@@ -35,7 +39,17 @@ class AgentView:
     deliberately absent: a strategy learns from actions and sensations only.
     """
 
-    __slots__ = ("memory", "model", "actions", "rng", "stopped", "phase", "_notes", "_phases")
+    __slots__ = (
+        "memory",
+        "model",
+        "actions",
+        "rng",
+        "float_feedback",
+        "stopped",
+        "phase",
+        "_notes",
+        "_phases",
+    )
 
     def __init__(
         self,
@@ -45,11 +59,14 @@ class AgentView:
         rng: np.random.Generator,
         notes: Callable[[str], None],
         phases: Callable[[str], None] | None = None,
+        *,
+        float_feedback: bool = False,
     ) -> None:
         self.memory = memory
         self.model = model
         self.actions = actions
         self.rng = rng
+        self.float_feedback = float_feedback
         self.stopped: str | None = None
         self.phase: str | None = None
         self._notes = notes

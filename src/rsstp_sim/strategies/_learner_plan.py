@@ -33,7 +33,10 @@ class Learning(Identifier):
 
     def plan(self) -> Plan:
         agent = self.agent
-        while not self.start_sensation:  # search for the landmark
+        if not self.start_sensation and agent.float_feedback:
+            yield from self.climb()  # (it ends when the sensation is true)
+            self.first_landmark = agent.step
+        while not self.start_sensation and not self.first_landmark:  # search for the landmark
             sensation = yield self.random_action()
             self.count("steps_search")
             agent.enter(PHASES["search"])
