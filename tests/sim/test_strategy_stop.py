@@ -164,7 +164,7 @@ def test_record_cli_says_the_budget_was_not_used_up(
 
 def test_a_phase_is_one_word() -> None:
     runner = Runner(load_scenario("three-joint"), Phased(), seed=0)
-    with pytest.raises(ValueError, match="a phase is one word, got 'two words'"):
+    with pytest.raises(StrategyError, match="a phase is one word, got 'two words'"):
         runner.agent.enter("two words")
 
 

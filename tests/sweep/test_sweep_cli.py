@@ -237,6 +237,7 @@ def test_ctrl_c_keeps_every_finished_run(folder: Path, tmp_path: Path) -> None:
     sweep = tmp_path / "long.toml"
     sweep.write_text(
         'steps = 4000\nseeds = 40\nscenarios = ["one-joint-10"]\n[[strategy]]\nname = "learner"\n'
+        "params = { stop = false }\n"  # each run its whole 4,000 steps, done or not
     )
     out = tmp_path / "out"
     process = subprocess.Popen(

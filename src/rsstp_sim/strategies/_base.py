@@ -7,6 +7,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
+from rsstp_sim.errors import StrategyError
 from rsstp_sim.memory import Memory
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -90,7 +91,7 @@ class AgentView:
         if phase == self.phase:
             return
         if not phase or not phase.isidentifier():
-            raise ValueError(f"a phase is one word, got {phase!r}")
+            raise StrategyError(f"a phase is one word, got {phase!r}")
         self.phase = phase
         if self._phases is not None:
             self._phases(phase)

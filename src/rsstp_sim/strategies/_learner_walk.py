@@ -58,7 +58,7 @@ class Refuted(Exception):
 
 
 class Confined(Exception):
-    """The search for the landmark has lasted :data:`CONFINED_STEPS` steps or more, and four
+    """The search for the landmark has lasted :data:`CONFINED_STEPS` steps or more, and 16
     times as long as the whole run before it: the agent takes it that no way leads back (a one-way
     world), and that the part it is confined to never senses."""
 
@@ -215,7 +215,7 @@ class Walker:
 
     def check_confined(self) -> None:
         """After a step of a search for the landmark: raise :class:`Confined` when the search
-        has lasted four times as long as the run before it, :data:`CONFINED_STEPS`, and a run of
+        has lasted 16 times as long as the run before it, :data:`CONFINED_STEPS`, and a run of
         :data:`LONGEST_RUN` steps per state and action of the hypothesis. A heuristic: from
         sensations alone, a part of the world that never senses cannot be told from a search
         that has not yet found the sensed pose."""
@@ -224,7 +224,7 @@ class Walker:
             return
         h = self.h
         bound = max(
-            CONFINED_STEPS, 4 * self.last_seen, LONGEST_RUN * len(h.labels) * len(h.actions)
+            CONFINED_STEPS, 16 * self.last_seen, LONGEST_RUN * len(h.labels) * len(h.actions)
         )
         if searched >= bound:
             raise Confined(self.last_seen)
