@@ -3,6 +3,8 @@
     PYTHONPATH=src python bench/learning.py                 # everything, a few minutes
     PYTHONPATH=src python bench/learning.py --aalpy-seconds 30
     PYTHONPATH=src python bench/learning.py --no-aalpy
+    PYTHONPATH=src python bench/learning.py --spread 10     # steps to learn over seeds 0-9
+    PYTHONPATH=src python bench/learning.py --curve --max-n 1200 --no-aalpy   # steps / N^2
 
 For each built-in scenario: the ground truth's minimal model (N states); the ``learner``
 strategy run until it is done (or its step budget is spent), its steps, seconds and whether its
@@ -20,6 +22,18 @@ class: run_hW is not asked for its initial state (that would need a reset).
 
 Targets: equivalent on every scenario; at most 4 x N^2 steps on the one-joint cycles and 50,000
 on two-joint-30; each learner run under a minute.
+
+``--curve``: steps to learn as a multiple of N^2 against N, on worlds of about 36, 119, 360,
+1,200 and 5,000 classes (:data:`CURVE`: the built-in one-joint-10, two-joint-30 and
+thesis-algo, then two links (2, 1) with one obstacle at 10 and at 5 degrees), each in its
+boolean form and its float twin (``mode = "float"``: the learner climbs the closeness), with
+AALpy's run_hW beside the boolean one unless ``--no-aalpy``; ``--max-n`` leaves out larger
+worlds. The budget is 4 N^2 steps; the seconds are the learner's own, warm (the truth is
+computed first).
+
+``--spread K``: the learner alone on each scenario with seeds ``0 .. K-1``, the steps to learn
+(least, median, most, and as multiples of N^2) and how many runs ended equivalent: the seed
+reaches every choice the learner makes among equals, so the runs differ.
 
 AALpy is the ``bench`` extra (``pip install aalpy``); without it the AALpy columns say so.
 """
@@ -40,7 +54,7 @@ from typing import Any
 import numpy as np
 
 from rsstp_sim.coupling import Runner
-from rsstp_sim.scenario import Scenario, load_scenario
+from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
 from rsstp_sim.world import World
@@ -107,7 +121,7 @@ def run_learner(scenario: Scenario, truth: GroundTruth, budget: int, seed: int) 
     step = runner.step
     started = time.perf_counter()
     steps = 0
-    while not learner.done and steps < budget:
+    while not learner.done and runner.stopped is None and steps < budget:
         step()
         steps += 1
     seconds = time.perf_counter() - started
@@ -333,18 +347,125 @@ def _format(rows: list[Row]) -> str:
     return "\n".join(lines)
 
 
+def _two_links(step_deg: int, *, float_mode: bool = False) -> Scenario:
+    """Links (2, 1) from (0, 0), one obstacle at (0, 2.5) of radius 0.5, sensed at (0, 0)."""
+    mode = '\nmode = "float"' if float_mode else ""
+    return parse_scenario(
+        f'name = "two-links-{step_deg}"\n[arm]\nlengths = [2.0, 1.0]\ninitial_deg = [0, 0]\n'
+        f"step_deg = {step_deg}\n[[obstacles]]\ncenter = [0.0, 2.5]\nradius = 0.5\n"
+        f"[feedback]\ntarget_deg = [0, 0]{mode}\n"
+    )
+
+
+def _twin(scenario: Scenario) -> Scenario:
+    """``scenario`` with ``mode = "float"``."""
+    if "[feedback]\n" in scenario.source:
+        source = scenario.source.replace("[feedback]\n", '[feedback]\nmode = "float"\n', 1)
+    else:
+        source = scenario.source + '\n[feedback]\nmode = "float"\n'
+    return parse_scenario(source)
+
+
+CURVE: tuple[tuple[str, Any], ...] = (
+    ("one-joint-10", lambda: load_scenario("one-joint-10")),
+    ("two-joint-30", lambda: load_scenario("two-joint-30")),
+    ("thesis-algo", lambda: load_scenario("thesis-algo")),
+    ("two-links-10", lambda: _two_links(10)),
+    ("two-links-5", lambda: _two_links(5)),
+)
+"""The worlds of ``--curve``, smallest first."""
+
+
+def curve(max_n: int, seed: int, aalpy: bool, seconds: float, memory_gib: float) -> bool:
+    """Steps to learn / N^2 against N (see the module docstring); one line per world."""
+    head = (
+        f"{'world':14s} {'N':>6s} | {'bool steps':>10s} {'x N^2':>6s} {'s':>7s} {'eq':>3s} | "
+        f"{'float steps':>11s} {'x N^2':>6s} {'s':>7s} {'eq':>3s} | AALpy hW"
+    )
+    print(head)
+    print("-" * len(head))
+    good = True
+    for name, make in CURVE:
+        scenario = make()
+        truth = compute_truth(scenario)
+        n = truth.n_classes
+        if n > max_n:
+            print(f"{name:14s} {n:>6,} | left out (--max-n {max_n:,})")
+            continue
+        budget = 4 * n**2
+        cells = []
+        for world in (scenario, _twin(scenario)):
+            row = run_learner(world, truth, budget, seed)
+            good &= row.equivalent and row.done
+            cells.append(
+                f"{row.steps:>{10 if not cells else 11},} {row.steps / n**2:>6.2f} "
+                f"{row.seconds:>7.1f} {'yes' if row.equivalent else 'NO':>3s}"
+            )
+        hw = "not run"
+        if aalpy and name in SCENARIOS:  # run_hW rebuilds the world by its built-in name
+            found = run_hw(name, seconds, seed, memory_gib)
+            hw = f"{found.get('steps') or 0:,} steps, {found.get('seconds')} s: {found['result']}"
+        print(f"{name:14s} {n:>6,} | {cells[0]} | {cells[1]} | {hw}", flush=True)
+    return good
+
+
+def spread(names: Sequence[str], seeds: int) -> bool:
+    """The learner on each scenario with seeds ``0 .. seeds-1``; prints one line per scenario,
+    returns whether every run ended equivalent within its budget."""
+    head = (
+        f"{'scenario':16s} {'N':>5s} {'seeds':>5s} | {'least':>9s} {'median':>9s} {'most':>9s} "
+        f"| {'x N^2':>17s} | equivalent  distinct runs"
+    )
+    print(head)
+    print("-" * len(head))
+    good = True
+    for name in names:
+        scenario = load_scenario(name)
+        truth = compute_truth(scenario)
+        budget = budget_for(name, truth)
+        rows = [run_learner(scenario, truth, budget, seed) for seed in range(seeds)]
+        steps = np.array([r.steps for r in rows])
+        n2 = truth.n_classes**2
+        equivalent = sum(r.equivalent and r.done for r in rows)
+        good &= equivalent == len(rows)
+        low, mid, high = int(steps.min()), float(np.median(steps)), int(steps.max())
+        print(
+            f"{name:16s} {truth.n_classes:>5d} {seeds:>5d} | {low:>9,} {mid:>9,.0f} {high:>9,} "
+            f"| {low / n2:>5.2f} {mid / n2:>5.2f} {high / n2:>5.2f} | {equivalent:>4d} of "
+            f"{len(rows):<4d} {len(set(steps.tolist())):>5d}",
+            flush=True,
+        )
+    return good
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--aalpy-seconds", type=float, default=240.0)
     parser.add_argument("--aalpy-memory-gib", type=float, default=8.0)
     parser.add_argument("--no-aalpy", action="store_true")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--spread", type=int, metavar="K", help="the learner over seeds 0..K-1")
+    parser.add_argument("--curve", action="store_true", help="steps / N^2 against N")
+    parser.add_argument("--max-n", type=int, default=10_000, help="--curve: the largest N")
     parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
     parser.add_argument("scenarios", nargs="*", default=list(SCENARIOS))
     args = parser.parse_args(argv)
     if args.hw_child:
         _hw_child(args.hw_child, args.aalpy_seconds, args.seed, args.aalpy_memory_gib)
         return 0
+    if args.curve:
+        ok = curve(
+            args.max_n,
+            args.seed,
+            not args.no_aalpy and _aalpy_version() is not None,
+            args.aalpy_seconds,
+            args.aalpy_memory_gib,
+        )
+        return 0 if ok else 1
+    if args.spread is not None:
+        if args.spread < 1:
+            parser.error(f"--spread must be >= 1, got {args.spread}")
+        return 0 if spread(args.scenarios, args.spread) else 1
 
     aalpy = None if args.no_aalpy else _aalpy_version()
     if not args.no_aalpy and aalpy is None:

@@ -8,9 +8,10 @@ from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src"
 BUILT_IN = {"Exception", "ValueError", "TypeError", "KeyError", "IndexError", "RuntimeError"}
-SIGNALS = {"Refuted"}
+SIGNALS = {"Refuted", "Confined"}
 """Exceptions used as control flow inside one module, never raised to a caller outside it:
-the learner's walk tells its planner that the hypothesis was refuted."""
+the learner's walk tells its planner that the hypothesis was refuted, or that the agent is
+confined to a part of the world that never senses."""
 
 
 def _modules() -> list[tuple[Path, ast.Module]]:

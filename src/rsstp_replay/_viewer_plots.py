@@ -2,7 +2,8 @@
 
 Series (``rr.Scalars``, drawn as step functions with a row only where the value changes): the
 sensation (0 or 1), the float feedback, the obstacle sensor readings (one entity, a series per
-tip and obstacle), and the model's size.
+tip and obstacle), the model's size, and the strategy's phase (a series per phase, 1 while the
+strategy is in it, 0 otherwise: a timeline of its phase notes).
 
 The log (``rr.TextLog`` at ``log/audit``) holds, at their steps: every contradiction the
 consistency audit finds within a model version (the state, its shortest witness, the number of
@@ -26,6 +27,7 @@ import rerun as rr
 from rsstp_replay._viewer_chunks import TIMELINE, send_rows
 from rsstp_replay.audits.consistency import ConsistencyFindings, StateContradiction
 from rsstp_replay.audits.determinism import DeterminismFindings
+from rsstp_replay.audits.summary import phase_changes
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.words import counted
 
@@ -35,12 +37,14 @@ __all__ = [
     "LOG",
     "MODEL_STATES",
     "MODEL_TRANSITIONS",
+    "PHASE",
     "SENSATION",
     "LogLine",
     "audit_lines",
     "distance_name",
     "log_lines",
     "log_model_size",
+    "log_phases",
     "log_series",
 ]
 
@@ -49,6 +53,7 @@ FEEDBACK = "plots/agent/feedback"
 DISTANCE = "plots/distance"
 MODEL_STATES = "plots/model/states"
 MODEL_TRANSITIONS = "plots/model/transitions"
+PHASE = "plots/strategy/phase"
 LOG = "log/audit"
 
 
@@ -141,6 +146,29 @@ def log_model_size(
             columns=rr.Scalars.columns(scalars=np.asarray(values, np.float64)),
         )
     return {path: len(times) for path in counts}
+
+
+def log_phases(
+    stream: rr.RecordingStream, events: pd.DataFrame, first: int, last: int
+) -> dict[str, int]:
+    """The strategy's phase over steps ``first .. last``, from its phase notes: a series per
+    phase, 1 from the step it is entered until the next phase's, else 0 (nothing when the
+    strategy recorded no phase); returns rows per path."""
+    changes = phase_changes(events)
+    if not changes:
+        return {}
+    names = list(dict.fromkeys(phase for _, phase in changes))
+    steps = np.array([step for step, _ in changes], np.int64)
+    column = np.array([names.index(phase) for _, phase in changes], np.int64)
+    inside = (steps > first) & (steps <= last)
+    times: npt.NDArray[np.int64] = np.concatenate([[first], steps[inside], [last]]).astype(np.int64)
+    # The phase at each time: the last change at or before it (none before the first).
+    at = np.asarray(np.searchsorted(steps, times, side="right"), np.int64) - 1
+    values = np.zeros((len(times), len(names)), np.float64)
+    known = at >= 0
+    values[np.flatnonzero(known), column[at[known]]] = 1.0
+    stream.log(PHASE, rr.SeriesLines(names=names, interpolation_mode="StepAfter"), static=True)
+    return {PHASE: send_rows(stream, PHASE, times, _scalars(values))}
 
 
 @dataclass(frozen=True, slots=True)

@@ -62,6 +62,8 @@ def _open(path: str) -> Recording:
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
+    from rsstp_replay.audits.summary import strategy_stop
+
     with _open(args.file) as recording:
         record = recording.scenario_record
         scenario = recording.scenario
@@ -98,6 +100,9 @@ def _cmd_info(args: argparse.Namespace) -> int:
             f"steps: 0 to {recording.n_steps:,} (the reset, then "
             f"{counted(recording.n_steps, 'step')})"
         )
+        stop = strategy_stop(recording.events())
+        if stop is not None:
+            print(f"  {stop.to_text()}")
         print("topics:")
         width = max(map(len, recording.topic_counts))
         for topic, count in recording.topic_counts.items():

@@ -404,6 +404,7 @@ def _log(
         stream, shown, times, loaded.places, roles=loaded.roles, labelled=loaded.labelled
     )
     rows |= plots_part.log_model_size(stream, shown, times, last)
+    rows |= plots_part.log_phases(stream, loaded.events, first, last)
     every_line = plots_part.audit_lines(
         loaded.versions,
         loaded.within,

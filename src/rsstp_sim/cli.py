@@ -18,7 +18,7 @@ from typing import Any
 
 from rsstp_sim import graph
 from rsstp_sim.commandline import Parser, UsageError, add_no_cache, progress, run_command
-from rsstp_sim.coupling import Runner
+from rsstp_sim.coupling import Runner, stop_text
 from rsstp_sim.errors import RecordingWriteError
 from rsstp_sim.files import check_output
 from rsstp_sim.nesting import too_deep
@@ -77,7 +77,7 @@ def _add_run_arguments(parser: argparse.ArgumentParser, *, steps_default: int) -
         "--steps",
         type=_non_negative,
         default=steps_default,
-        help=f"steps to run (default {steps_default})",
+        help=f"the budget of steps (default {steps_default}; a strategy may stop earlier)",
     )
     parser.add_argument("--seed", type=_non_negative, default=0, help="seed (default 0)")
 
@@ -265,6 +265,8 @@ def _cmd_record(args: argparse.Namespace) -> int:
             file=sys.stderr,
         )
         return 128 + received[0] if received else 1
+    if result.stopped is not None:
+        print(f"{stop_text(result.steps, result.budget)}: {result.stopped}")
     print(f"recorded {counted(result.steps, 'step')} to {result.path} ({counts})")
     return 0
 

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Literal, NamedTuple
+from typing import Any, Literal, NamedTuple
 
 import numpy as np
 
@@ -32,7 +32,7 @@ from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.words import counted
 from rsstp_sim.world import World
 
-__all__ = ["Event", "RunSummary", "Runner", "StepOutcome"]
+__all__ = ["Event", "RunSummary", "Runner", "StepOutcome", "stop_text"]
 
 EventKind = Literal["no_transition", "note"]
 
@@ -56,11 +56,16 @@ class StepOutcome(NamedTuple):
 
 @dataclass(frozen=True, slots=True)
 class Event:
-    """Something worth a line in the log: a step with no transition, or a strategy note."""
+    """Something worth a line in the log: a step with no transition, or a strategy note.
+
+    A note's ``data`` is empty, or ``{"phase": p}`` when the strategy entered phase ``p``
+    at this step (:meth:`~rsstp_sim.strategies.AgentView.enter`).
+    """
 
     step: int
     kind: EventKind
     text: str
+    data: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True, slots=True)
@@ -72,11 +77,18 @@ class RunSummary:
     model_states: int = 0
     model_transitions: int = 0
     deterministic: bool = True
+    stopped: str | None = None
+    budget: int | None = None
 
     def to_text(self) -> str:
         seen = ", ".join(f"{str(k).lower()}: {v:,}" for k, v in sorted(self.sensations.items()))
+        stop = (
+            ""
+            if self.stopped is None
+            else f"{stop_text(self.steps, self.budget)}: {self.stopped}\n"
+        )
         return (
-            f"steps: {self.steps:,}\n"
+            stop + f"steps: {self.steps:,}\n"
             f"blocked moves: {self.blocked:,}\n"
             f"steps with no transition in the model: {self.no_transition:,}\n"
             f"sensations seen: {seen}\n"
@@ -86,12 +98,21 @@ class RunSummary:
         )
 
 
+def stop_text(step: int, budget: int | None) -> str:
+    """How a run the strategy ended is told (the recording's stop event, info, the audit)."""
+    of = "" if budget is None else f" of a budget of {budget:,}"
+    return f"stopped by the strategy at step {step:,}{of}"
+
+
 class Runner:
     """Runs a strategy in a scenario with one seeded generator per run.
 
     ``on_event`` receives every :class:`Event`; ``on_model_change`` receives the
     model operations applied during a step (or at reset) as soon as the step
     ends. Both are how a recorder observes the run from outside.
+
+    A strategy that calls :meth:`~rsstp_sim.strategies.AgentView.stop` ends the run:
+    :attr:`stopped` is then its reason, :meth:`run` returns early and :meth:`step` refuses.
     """
 
     def __init__(
@@ -121,7 +142,15 @@ class Runner:
         self.model.drain_operations()
         self.memory = Memory()
         self.memory.reset(self.model.current, pose.sensation, pose.feedback)
-        self.agent = AgentView(self.memory, self.model, self.scenario.actions, self.rng, self._note)
+        self.agent = AgentView(
+            self.memory,
+            self.model,
+            self.scenario.actions,
+            self.rng,
+            self._note,
+            self._phase,
+            float_feedback=self.scenario.feedback_mode == "float",
+        )
         self.blocked = 0
         self.no_transition = 0
         self._step = 0
@@ -141,9 +170,18 @@ class Runner:
         """Steps taken since the reset."""
         return self._step
 
+    @property
+    def stopped(self) -> str | None:
+        """Why the strategy ended the run (at :attr:`step_index`), or None: it has not."""
+        return self.agent.stopped
+
     def _note(self, text: str) -> None:
         if self._on_event is not None:
             self._on_event(Event(self._step, "note", text))
+
+    def _phase(self, phase: str) -> None:
+        if self._on_event is not None:
+            self._on_event(Event(self._step, "note", f"phase: {phase}", {"phase": phase}))
 
     def _flush_model(self) -> None:
         ops = self.model.drain_operations()
@@ -154,6 +192,11 @@ class Runner:
     def step(self) -> StepOutcome:
         """One coupled step (see the module docstring)."""
         model = self.model
+        if self.agent.stopped is not None:
+            raise StrategyError(
+                f"strategy {self.strategy.name!r} ended the run at step {self._step} "
+                f"({self.agent.stopped}): no further step"
+            )
         try:
             action = self._choose(self.agent)
         except Exception as exc:  # the strategy's own code: name it, and the step
@@ -217,21 +260,23 @@ class Runner:
         the steps done every 65,536 steps."""
         if isinstance(steps, bool) or not isinstance(steps, int) or steps < 0:
             raise StrategyError(f"steps must be an integer >= 0, got {steps!r}")
-        step = self.step
-        if progress is None:
-            for _ in range(steps):
-                step()
-            return self.summary()
+        step, agent = self.step, self.agent
+        budget = self._step + steps
         done = 0
-        while done < steps:
+        while done < steps and agent.stopped is None:
             block = min(1 << 16, steps - done)
             for _ in range(block):
                 step()
-            done += block
-            progress(done)
-        return self.summary()
+                done += 1
+                if agent.stopped is not None:
+                    break
+            if progress is not None:
+                progress(done)
+        return self.summary(budget=budget)
 
-    def summary(self) -> RunSummary:
+    def summary(self, *, budget: int | None = None) -> RunSummary:
+        """The run so far; ``budget``: the steps it was given (said when the strategy
+        stopped it)."""
         sensations = self.memory.sensations
         true = int(np.count_nonzero(sensations))
         seen = {False: len(sensations) - true, True: true}
@@ -243,4 +288,6 @@ class Runner:
             model_states=len(self.model),
             model_transitions=len(self.model.transitions()),
             deterministic=self.model.is_deterministic(),
+            stopped=self.agent.stopped,
+            budget=budget if self.agent.stopped is not None else None,
         )

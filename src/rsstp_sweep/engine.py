@@ -167,6 +167,7 @@ def runs_frame(rows: list[dict[str, Any]]) -> pd.DataFrame:
         "seconds_record": "Float64",
         "seconds_audit": "Float64",
         "recorded_steps": "Int64",
+        "stopped_at_step": "Int64",
         "model_versions": "Int64",
         "final_states": "Int64",
         "final_transitions": "Int64",

@@ -48,6 +48,7 @@ ROW_FIELDS = (
     "seconds_record",
     "seconds_audit",
     "recorded_steps",
+    "stopped_at_step",
     "model_versions",
     "final_states",
     "final_transitions",
@@ -166,6 +167,7 @@ def _audit(path: Path) -> dict[str, Any]:
     final = report.determinism.final.version
     return {
         "recorded_steps": summary.steps,
+        "stopped_at_step": None if summary.stop is None else summary.stop.step,
         "model_versions": len(summary.sizes),
         "final_states": summary.final_size.states,
         "final_transitions": summary.final_size.transitions,
@@ -243,7 +245,7 @@ def _check(path: Path, run: Run) -> str:
                     return "broken"
                 recording.verify_chunks()
                 same = (
-                    recording.n_steps == run.steps
+                    _steps_of(recording) == run.steps
                     and recording.seed == run.seed
                     and recording.strategy_params == dict(run.recorded_params)
                     and recording.metadata.get("scenario_sha256") == run.scenario_sha256
@@ -252,6 +254,17 @@ def _check(path: Path, run: Run) -> str:
                 return "valid" if same else "other"
     except (RsstpError, OSError):
         return "broken"
+
+
+def _steps_of(recording: Any) -> int:
+    """The steps a finished recording was given: its last step, or its budget when the strategy
+    ended the run before it (its stop event says so)."""
+    from rsstp_replay.audits.summary import strategy_stop
+
+    stop = strategy_stop(recording.events())
+    if stop is None or stop.budget is None or stop.step != recording.n_steps:
+        return int(recording.n_steps)
+    return stop.budget
 
 
 def _scratch() -> str | None:

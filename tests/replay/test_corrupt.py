@@ -264,7 +264,7 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
 
     def version1(name: str, data: bytes) -> bytes:
         return (
-            data.replace(b'"version": "2.0"', b'"version": "1.0"') if name == "rsstp.Step" else data
+            data.replace(b'"version": "2.1"', b'"version": "1.0"') if name == "rsstp.Step" else data
         )
 
     rewrite(original, files["version1"], schema=version1)
@@ -334,7 +334,7 @@ def test_api_raises_a_one_line_error(name: str, damaged: dict[str, Path]) -> Non
 
 def test_a_later_minor_version_with_new_fields_is_read(original: Path, tmp_path: Path) -> None:
     def minor(name: str, data: bytes) -> bytes:
-        return data.replace(b'"version": "2.0"', b'"version": "2.3"')
+        return data.replace(b'"version": "2.1"', b'"version": "2.3"')
 
     def extra_fields(topic: str, log_time: int, data: bytes) -> bytes:
         value = json.loads(data)

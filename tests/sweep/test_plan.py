@@ -92,8 +92,8 @@ def test_a_missing_sweep_file_is_named(tmp_path: Path) -> None:
 def test_the_readme_sweep_file_is_valid(tmp_path: Path) -> None:
     """The README's example sweep checks (with a scenario file of its own beside it)."""
     readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    text = next(block for block in readme.split("```toml\n")[1:] if "seeds" in block)
-    text = text.split("```")[0]
+    blocks = [block.split("```")[0] for block in readme.split("```toml\n")[1:]]
+    text = next(block for block in blocks if "seeds" in block)
     scenario = Path("src/rsstp_sim/scenarios/two-joint-30.toml").read_text()
     (tmp_path / "my-arm.toml").write_text(scenario.replace("two-joint-30", "my-arm"))
     (tmp_path / "sweep.toml").write_text(text)

@@ -112,7 +112,12 @@ def test_every_run_is_a_row_and_a_failing_run_does_not_stop_the_others(
     learner = runs[(runs["strategy"] == "learner") & (runs["scenario"] == "thesis-roulette")]
     assert learner["equivalent"].all() and (learner["learned_at_step"] > 0).all()
     assert (learner["minimal_states"] == 4).all() and (learner["final_states"] == 4).all()
+    # The learner stops when done: its steps used, of the sweep's budget; a script never stops.
+    assert (learner["stopped_at_step"] == learner["recorded_steps"]).all()
+    assert (learner["recorded_steps"] < learner["steps"]).all()
     script = runs[runs["strategy"] == "script"]
+    assert script["stopped_at_step"].isna().all()
+    assert (script["recorded_steps"] == script["steps"]).all()
     assert not script["equivalent"].any() and script["learned_at_step"].isna().all()
     assert (runs.loc[runs["status"] == "done", "seconds"] > 0).all()
     assert (out / "sweep.toml").read_text() == SWEEP
@@ -235,6 +240,7 @@ def test_ctrl_c_keeps_every_finished_run(folder: Path, tmp_path: Path) -> None:
     sweep = tmp_path / "long.toml"
     sweep.write_text(
         'steps = 4000\nseeds = 40\nscenarios = ["one-joint-10"]\n[[strategy]]\nname = "learner"\n'
+        "params = { stop = false }\n"  # each run its whole 4,000 steps, done or not
     )
     out = tmp_path / "out"
     process = subprocess.Popen(

@@ -45,6 +45,7 @@ class LoadedRecording:
             columns=["blocked_kind", *detail], errors="ignore"
         )
         self._models = tuple(source.model_versions())
+        self._events: pd.DataFrame | None = None
         table = self._steps
         self._memory = memory = Memory.from_arrays(
             table["action"].to_numpy(np.int64, na_value=-1),
@@ -94,7 +95,9 @@ class LoadedRecording:
         return self.source.step_log_times()
 
     def events(self) -> pd.DataFrame:
-        return self.source.events()
+        if self._events is None:
+            self._events = self.source.events()
+        return self._events
 
 
 def load(source: _Source) -> LoadedRecording:

@@ -12,10 +12,16 @@ message, the first included: a strategy may reshape the model at reset); a no-op
 (``changed: false``) is not counted. Blocked moves and steps with no transition come from the
 steps table, sensations from the memory (every entry ``0 .. T``, the reset's included, as in
 the live run summary). Contradictions come from the consistency audit.
+
+A strategy's phases and its stop come from its notes (``rsstp.Event`` 2.1): a note with
+``{phase}`` starts that phase at its step, for every step until the next one (the steps before
+the first are in none); the share of a phase is its steps over the run's. A note with
+``{stop, budget}`` says the strategy ended the run at its step.
 """
 
 from __future__ import annotations
 
+import json
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -28,12 +34,23 @@ import pandas as pd
 from rsstp_replay.audits.compare import HasMemory
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
 from rsstp_replay.audits.determinism import HasModelVersions
+from rsstp_sim.coupling import stop_text
 from rsstp_sim.errors import ModelError
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.words import counted
 
-__all__ = ["AuditSource", "ModelSize", "SummaryFindings", "audit_summary"]
+__all__ = [
+    "AuditSource",
+    "ModelSize",
+    "PhaseShare",
+    "Stop",
+    "SummaryFindings",
+    "audit_summary",
+    "phase_changes",
+    "phase_shares",
+    "strategy_stop",
+]
 
 
 class AuditSource(HasMemory, HasModelVersions, Protocol):
@@ -64,12 +81,37 @@ class ModelSize:
 
 
 @dataclass(frozen=True, slots=True)
+class PhaseShare:
+    """The steps a strategy spent in ``phase`` (``steps`` of them, a ``share`` of the run's
+    steps in ``[0, 1]``)."""
+
+    phase: str
+    steps: int
+    share: float
+
+
+@dataclass(frozen=True, slots=True)
+class Stop:
+    """The strategy ended the run at ``step``, of ``budget`` steps (None: not recorded), for
+    ``reason``."""
+
+    step: int
+    budget: int | None
+    reason: str
+
+    def to_text(self) -> str:
+        return f"{stop_text(self.step, self.budget)}: {self.reason}"
+
+
+@dataclass(frozen=True, slots=True)
 class SummaryFindings:
     """The numbers of a run (see the module docstring).
 
     ``sizes`` has one entry per model version; ``first_contradiction_step`` is the first step at
     which the memory contradicted any state, ``last_contradiction_step`` the latest step at
     which a state became contradictory (the largest ``first_step`` of the consistency audit).
+    ``phases``: the steps per phase the strategy recorded, in the order first entered (empty if
+    it recorded none); ``stop``: how the strategy ended the run, or None.
     """
 
     steps: int
@@ -86,6 +128,8 @@ class SummaryFindings:
     first_contradiction_step: int | None
     last_contradiction_step: int | None
     final_deterministic: bool
+    phases: tuple[PhaseShare, ...] = ()
+    stop: Stop | None = None
 
     @property
     def final_size(self) -> ModelSize:
@@ -119,8 +163,12 @@ class SummaryFindings:
                 f"{self.first_contradiction_step}, last new one at step "
                 f"{self.last_contradiction_step}"
             )
+        phases = ", ".join(
+            f"{p.phase} {100 * p.share:.1f} % ({p.steps:,} steps)" for p in self.phases
+        )
         return "\n".join(
-            [
+            ([] if self.stop is None else [self.stop.to_text()])
+            + [
                 f"steps: {self.steps:,}",
                 f"final model: {_plural(final.states, 'state')}, "
                 f"{_plural(final.transitions, 'transition')}, {verdict} (version "
@@ -133,6 +181,7 @@ class SummaryFindings:
                 f"sensations seen: true {self.sensations_true:,}, false {self.sensations_false:,}",
                 f"contradictions: {contradictions}",
             ]
+            + ([f"phases: {phases}"] if self.phases else [])
         )
 
     def to_json(self) -> dict[str, Any]:
@@ -161,6 +210,10 @@ class SummaryFindings:
                 "first_step": self.first_contradiction_step,
                 "last_step": self.last_contradiction_step,
             },
+            "phases": {p.phase: {"steps": p.steps, "share": p.share} for p in self.phases},
+            "stopped": None
+            if self.stop is None
+            else {"step": self.stop.step, "budget": self.stop.budget, "reason": self.stop.reason},
             "sizes": [
                 {
                     "version": size.version,
@@ -196,6 +249,7 @@ def audit_summary(
     final = records[-1]
     final_model = TransitionSystem.from_snapshot(final.snapshot(), version=final.version)
     contradictions = consistency.contradictions
+    events = source.events()
     return SummaryFindings(
         steps=memory.steps,
         sizes=tuple(
@@ -216,7 +270,52 @@ def audit_summary(
             max(found.first_step for found in contradictions) if contradictions else None
         ),
         final_deterministic=final_model.is_deterministic(),
+        phases=phase_shares(events, memory.steps),
+        stop=strategy_stop(events),
     )
+
+
+def _note_data(events: pd.DataFrame, key: str) -> list[tuple[int, dict[str, Any]]]:
+    """The notes whose data has ``key``: (step, data), in order."""
+    notes = events[events["kind"] == "note"]
+    found = []
+    quoted = f'"{key}"'
+    for step, data in zip(notes["step"].tolist(), notes["data"].tolist(), strict=True):
+        if isinstance(data, str):  # JSON text, as Recording.events gives it
+            if quoted not in data:
+                continue
+            data = json.loads(data)
+        if isinstance(data, dict) and key in data:
+            found.append((int(step), data))
+    return found
+
+
+def phase_changes(events: pd.DataFrame) -> list[tuple[int, str]]:
+    """The strategy's phase notes: (step, the phase entered there), in order."""
+    return [(step, str(data["phase"])) for step, data in _note_data(events, "phase")]
+
+
+def phase_shares(events: pd.DataFrame, steps: int) -> tuple[PhaseShare, ...]:
+    """The steps ``1 .. steps`` by the phase the strategy's phase notes put them in."""
+    changes = phase_changes(events)
+    if not changes or steps <= 0:
+        return ()
+    starts = np.array([max(step, 1) for step, _ in changes] + [steps + 1], dtype=np.int64)
+    spans = np.diff(np.minimum(starts, steps + 1))
+    totals: dict[str, int] = {}
+    for (_, phase), span in zip(changes, spans.tolist(), strict=True):
+        totals[phase] = totals.get(phase, 0) + int(span)
+    return tuple(PhaseShare(phase, n, n / steps) for phase, n in totals.items())
+
+
+def strategy_stop(events: pd.DataFrame) -> Stop | None:
+    """How the strategy ended the run (its stop note), or None: it did not."""
+    stops = _note_data(events, "stop")
+    if not stops:
+        return None
+    step, data = stops[-1]
+    budget = data.get("budget")
+    return Stop(step, None if budget is None else int(budget), str(data["stop"]))
 
 
 _plural = counted

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
+from rsstp_sim.coupling import stop_text
 from rsstp_sim.errors import RecordFormatError
 from rsstp_sim.recording.records import (
     AgentRecord,
@@ -240,9 +241,19 @@ def no_transition_event(step: int, *, state: int, action: int) -> EventRecord:
     )
 
 
-def note_event(step: int, text: str) -> EventRecord:
-    """A strategy ``note`` (line breaks become spaces: an event is one line)."""
-    return _event(step, "note", _one_line(text), {})
+def note_event(step: int, text: str, data: Mapping[str, Any] | None = None) -> EventRecord:
+    """A strategy ``note`` (line breaks become spaces: an event is one line); ``data`` is
+    ``{}``, ``{"phase": p}`` (the strategy entered phase ``p``) or a :func:`stop_event`'s."""
+    return _event(step, "note", _one_line(text), dict(data or {}))
+
+
+def stop_event(step: int, *, reason: str, budget: int | None) -> EventRecord:
+    """The last event of a run the strategy ended at ``step`` (of ``budget`` steps, when the
+    run had one): a note with data ``{"stop": reason, "budget": budget}``."""
+    data: dict[str, Any] = {"stop": _one_line(reason)}
+    if budget is not None:
+        data["budget"] = int(budget)
+    return note_event(step, f"{stop_text(step, budget)}: {reason}", data)
 
 
 def event_record(
@@ -254,7 +265,7 @@ def event_record(
     runner's event only says them in its text); a ``note`` needs nothing more.
     """
     if event.kind == "note":
-        return note_event(event.step, event.text)
+        return note_event(event.step, event.text, event.data)
     if state is None or action is None:
         raise RecordFormatError(
             f"rsstp.Event: a {event.kind} event needs state and action, "

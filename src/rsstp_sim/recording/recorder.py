@@ -94,6 +94,8 @@ class RecordResult:
     steps: int
     messages: dict[str, int]
     interrupted: bool
+    stopped: str | None = None
+    budget: int | None = None
 
 
 class Recorder:
@@ -135,6 +137,7 @@ class Recorder:
         if versions is not None:
             self._versions.update({k: v for k, v in versions.items() if k in _VERSION_KEYS})
         self._stop = False
+        self._budget: int | None = None
         self._pose_parts: dict[int, tuple[bytes, bytes]] = {}
         self._counts = dict.fromkeys(self._topics, 0)
         self.side_file = side_file(self.path)
@@ -163,7 +166,7 @@ class Recorder:
         # Steps with no transition are recorded from the step outcome (it has the
         # state and the action); the runner's events add the strategy notes.
         if event.kind == "note":
-            self._pending_events.append(builders.note_event(event.step, event.text))
+            self._pending_events.append(builders.note_event(event.step, event.text, event.data))
 
     def _on_model_change(self, step: int, operations: Sequence[Operation]) -> None:
         if "/rsstp/model" not in self._topics:
@@ -313,14 +316,17 @@ class Recorder:
         """Take and record ``steps`` steps, then finish the file.
 
         ``progress`` is called with the number of steps done every 4096 steps.
-        Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`.
+        Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`. When
+        the strategy ends the run (:attr:`Runner.stopped <rsstp_sim.coupling.Runner.stopped>`),
+        the file ends with an event saying so, at that step, of a budget of ``steps``.
         """
         _check_steps(steps)
-        step, write = self.runner.step, self._write_step
+        step, write, agent = self.runner.step, self._write_step, self.runner.agent
+        self._budget = self.runner.step_index + steps
         done = 0
         try:
             with self._closed_on_failure():
-                while done < steps and not self._stop:
+                while done < steps and not self._stop and agent.stopped is None:
                     write(step())
                     done += 1
                     if progress is not None and not done & 4095:
@@ -329,6 +335,14 @@ class Recorder:
             self._counts["/rsstp/step"] += done
         self.close()
         return self.result()
+
+    def _write_stop(self) -> None:
+        """The event that ends a run the strategy stopped: its last message."""
+        reason = self.runner.agent.stopped
+        if reason is not None:
+            t = self.runner.step_index
+            event = builders.stop_event(t, reason=reason, budget=self._budget)
+            self._add("/rsstp/event", t, records.encode(event))
 
     def step(self) -> StepOutcome:
         """Take and record one step; the file stays open until :meth:`close`."""
@@ -339,8 +353,16 @@ class Recorder:
         return outcome
 
     def result(self) -> RecordResult:
-        """What has been recorded so far."""
-        return RecordResult(self.path, self.runner.step_index, dict(self._counts), self._stop)
+        """What has been recorded so far (``stopped``: the strategy's reason for ending the
+        run, or None)."""
+        return RecordResult(
+            self.path,
+            self.runner.step_index,
+            dict(self._counts),
+            self._stop,
+            self.runner.agent.stopped,
+            self._budget,
+        )
 
     def _write_step(self, outcome: StepOutcome) -> None:
         t = outcome.step
@@ -401,6 +423,7 @@ class Recorder:
         if self._closed:
             return
         try:
+            self._write_stop()
             self._writer.finish()  # type: ignore[no-untyped-call]
         except OSError as exc:
             if exc is not self._file.error:

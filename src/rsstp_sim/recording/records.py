@@ -311,7 +311,8 @@ class EventRecord(_Record, frozen=True, kw_only=True):
     - ``no_transition``: ``{state, action}``;
     - ``split``, ``merge``, ``add``, ``delete``: ``{args}`` and ``result`` when the operation
       created a state, as in :class:`OperationRecord`;
-    - ``note``: ``{}``;
+    - ``note``: ``{}``, or ``{phase}`` (the strategy entered that phase), or ``{stop, budget}``
+      (the strategy ended the run: its reason, and the steps it was given when known);
     - ``contradiction``: ``{state, i, j, actions}``.
     """
 
@@ -446,7 +447,9 @@ class _NoTransitionData(msgspec.Struct):
 
 
 class _NoteData(msgspec.Struct):
-    pass
+    phase: str | None = None
+    stop: str | None = None
+    budget: int | None = None
 
 
 class _OperationData(msgspec.Struct):

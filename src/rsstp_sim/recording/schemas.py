@@ -49,7 +49,7 @@ __all__ = [
     "version_refusal",
 ]
 
-SCHEMA_VERSION = "2.0"
+SCHEMA_VERSION = "2.1"
 """The version (``major.minor``) of the schemas this package writes."""
 
 SCHEMA_NAMES = ("rsstp.Scenario", "rsstp.Step", "rsstp.Model", "rsstp.Event")

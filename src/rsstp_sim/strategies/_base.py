@@ -7,6 +7,7 @@ from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
+from rsstp_sim.errors import StrategyError
 from rsstp_sim.memory import Memory
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -22,13 +23,34 @@ class AgentView:
       is the internal state, which a strategy may also set (re-localisation).
     - ``actions``: the actions the agent may take.
     - ``rng``: the run's seeded generator; the only source of randomness allowed.
+    - ``float_feedback``: whether the scenario gives the agent its float feedback
+      (``mode = "float"``): then ``memory.feedback`` (closeness to the feedback pose, in
+      ``[0, 1]``, 1 there) is the agent's to use; else only the boolean sensations are, the
+      float being recorded for the analysis only.
     - ``note(text)``: a strategy note, recorded as an event at the current step.
+    - ``enter(phase)``: the strategy's phase from the current step on (``"explore"``,
+      ``"home"``...), recorded as a note event whose data says the phase; the audit summary
+      gives the share of steps spent in each phase. Entering the phase it is in does nothing.
+    - ``stop(reason)``: the strategy ends the run after the current step (its work is done,
+      or it cannot go on); the run's ``--steps`` is then a budget it did not use up. The
+      runner takes no further step; a recording ends with an event saying why. ``stopped``
+      is the reason given, or None.
 
     Ground truth (angles, positions, blocked moves, obstacle distances) is
     deliberately absent: a strategy learns from actions and sensations only.
     """
 
-    __slots__ = ("memory", "model", "actions", "rng", "_notes")
+    __slots__ = (
+        "memory",
+        "model",
+        "actions",
+        "rng",
+        "float_feedback",
+        "stopped",
+        "phase",
+        "_notes",
+        "_phases",
+    )
 
     def __init__(
         self,
@@ -37,12 +59,19 @@ class AgentView:
         actions: tuple[int, ...],
         rng: np.random.Generator,
         notes: Callable[[str], None],
+        phases: Callable[[str], None] | None = None,
+        *,
+        float_feedback: bool = False,
     ) -> None:
         self.memory = memory
         self.model = model
         self.actions = actions
         self.rng = rng
+        self.float_feedback = float_feedback
+        self.stopped: str | None = None
+        self.phase: str | None = None
         self._notes = notes
+        self._phases = phases
 
     @property
     def state(self) -> int:
@@ -57,6 +86,21 @@ class AgentView:
     def note(self, text: str) -> None:
         self._notes(text)
 
+    def enter(self, phase: str) -> None:
+        """From the current step on, the strategy is in ``phase`` (one word, not empty)."""
+        if phase == self.phase:
+            return
+        if not phase or not phase.isidentifier():
+            raise StrategyError(f"a phase is one word, got {phase!r}")
+        self.phase = phase
+        if self._phases is not None:
+            self._phases(phase)
+
+    def stop(self, reason: str) -> None:
+        """End the run after the current step, for ``reason`` (one line)."""
+        if self.stopped is None:
+            self.stopped = " ".join(reason.split()) or "no reason given"
+
 
 @runtime_checkable
 class Strategy(Protocol):
@@ -64,7 +108,9 @@ class Strategy(Protocol):
 
     The runner calls ``initial_model`` and ``reset`` once, then each step
     ``choose_action`` before the move and ``refine`` after the memory entry of
-    that step has been written.
+    that step has been written. A strategy ends the run by calling
+    :meth:`AgentView.stop` (in ``reset`` or ``refine``): the runner then takes no further
+    step. A strategy that never calls it runs the whole budget of steps, as before.
     """
 
     name: ClassVar[str]

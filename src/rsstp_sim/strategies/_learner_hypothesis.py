@@ -38,10 +38,24 @@ class Hypothesis:
     predicting ``True``. ``access[s]`` is the action word that led from the landmark to the
     world state ``s`` was created for: a fact of the trajectory, which defines ``s``.
     ``next[s, k]`` is the confirmed successor of ``s`` by ``actions[k]``, or -1.
+
+    ``rng`` (the run's generator) draws, once, the order in which the actions are tried
+    when several shortest paths or several nearest states tie: a path keeps one preference
+    all run long (a coherent sweep of the world; drawn anew at every search, the walks
+    wander and take twice the steps), and the seed chooses it. None: the actions' order.
     """
 
-    def __init__(self, model: TransitionSystem, actions: tuple[int, ...], landmark: int) -> None:
+    def __init__(
+        self,
+        model: TransitionSystem,
+        actions: tuple[int, ...],
+        landmark: int,
+        rng: np.random.Generator | None = None,
+    ) -> None:
         self.model = model
+        order = np.arange(len(actions)) if rng is None else rng.permutation(len(actions))
+        self._columns: list[int] = [int(k) for k in order]
+        self._ordered = [actions[k] for k in self._columns]
         self.actions = actions
         self.column = {a: k for k, a in enumerate(actions)}
         capacity = max(64, 2 * model.next_id)
@@ -119,7 +133,9 @@ class Hypothesis:
             n = len(self.label)
             distance = np.full(n, FAR, dtype=np.int64)
             toward = np.full(n, -1, dtype=np.int64)
-            sources, columns = np.nonzero(self.next >= 0)
+            # By source, then in the run's action order: the first path found is kept.
+            sources, columns = np.nonzero(self.next[:, self._columns] >= 0)
+            columns = np.asarray(self._columns, dtype=np.int64)[columns]
             incoming: dict[int, list[tuple[int, int]]] = {}
             for s, k in zip(sources.tolist(), columns.tolist(), strict=True):
                 incoming.setdefault(int(self.next[s, k]), []).append((s, k))
@@ -158,6 +174,7 @@ class Hypothesis:
         parent: dict[int, tuple[int, int]] = {}
         seen = {source}
         queue = deque([source])
+        columns, actions = self._columns, self._ordered
         while queue:
             s = queue.popleft()
             if is_goal(s):
@@ -168,10 +185,11 @@ class Hypothesis:
                     word.append(action)
                 word.reverse()
                 return word, s
-            for k, t in enumerate(self.next[s].tolist()):
+            row = self.next[s, columns].tolist()
+            for action, t in zip(actions, row, strict=True):
                 if t >= 0 and t not in seen:
                     seen.add(t)
-                    parent[t] = (s, self.actions[k])
+                    parent[t] = (s, action)
                     queue.append(t)
         return None
 
@@ -311,6 +329,26 @@ class Hypothesis:
         if self.next[s, k] < 0:
             self.unconfirmed -= 1
         self.next[s, k] = new
+        self._changed()
+        return new
+
+    def add_silent(self) -> int:
+        """A new state for a part of the world that never senses: it predicts false, and every
+        action leads back to it (confirmed). Made by splitting the landmark, its copied
+        transitions then deleted."""
+        model = self.model
+        new = model.split(self.landmark)
+        for u, a, v in model.transitions():
+            if new in (u, v):
+                model.delete(u, v, a)
+        for a in self.actions:
+            model.add(new, new, a)
+        self._grow(new)
+        self.alive[new] = True
+        self.label[new] = False
+        self.labels[new] = False
+        self.access[new] = ()
+        self.next[new] = new
         self._changed()
         return new
 

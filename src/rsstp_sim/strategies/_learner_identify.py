@@ -129,7 +129,8 @@ class Identifier(Walker):
                             frozenset(candidates), access, label, h.version
                         )
                         return
-                    first = min(untried, key=lambda c: (distance[c], c))
+                    nearest = min(distance[c] for c in untried)
+                    first = self.pick(sorted(c for c in untried if distance[c] == nearest))
                 if first is not None:
                     tried.add(first)
             if not here:
@@ -192,7 +193,8 @@ class Identifier(Walker):
                 y = int(h.next[r, kb])
                 if y in candidates:
                     votes[y] = votes.get(y, 0) + 1
-        return sorted(votes, key=lambda c: (-votes[c], c))
+        tie = {c: i for i, c in enumerate(self.agent.rng.permutation(sorted(votes)).tolist())}
+        return sorted(votes, key=lambda c: (-votes[c], tie[c]))
 
     def session(
         self,
@@ -234,7 +236,8 @@ class Identifier(Walker):
                     usable = np.flatnonzero(tracked & (distance < FAR))
                     if not len(usable):
                         break
-                    index = int(usable[np.argmin(distance[usable])])
+                    nearest = distance[usable] == distance[usable].min()
+                    index = self.pick(usable[nearest].tolist())
                     chosen = int(ids[index])
                 action = h.actions[int(h.toward[position[index]])]
             sensation = yield from self.move(action)

@@ -9,7 +9,7 @@ import numpy as np
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR
 from rsstp_sim.strategies._learner_identify import Identifier
-from rsstp_sim.strategies._learner_walk import Plan, Refuted
+from rsstp_sim.strategies._learner_walk import PHASES, Confined, Plan, Refuted
 
 __all__ = ["Learning"]
 
@@ -21,8 +21,9 @@ class Learning(Identifier):
     ``done``: every transition is confirmed, tested and the hypothesis is minimal.
     """
 
-    def __init__(self, agent: AgentView, *, doubts: int) -> None:
+    def __init__(self, agent: AgentView, *, doubts: int, stop: bool = True) -> None:
         super().__init__(agent, doubts=doubts)
+        self.stop = stop
         self.start_sensation = bool(agent.memory.sensations[0])
         self.found = False
         self.first_landmark = 0
@@ -32,9 +33,14 @@ class Learning(Identifier):
 
     def plan(self) -> Plan:
         agent = self.agent
-        while not self.start_sensation:  # search for the landmark
+        if not self.start_sensation and agent.float_feedback:
+            yield from self.climb()  # (it ends when the sensation is true)
+            self.first_landmark = agent.step
+        while not self.start_sensation and not self.first_landmark:  # search for the landmark
+            sensation = yield self.random_action()
             self.count("steps_search")
-            if (yield self.random_action()):
+            agent.enter(PHASES["search"])
+            if sensation:
                 self.first_landmark = agent.step
                 break
         self.found = True
@@ -57,6 +63,11 @@ class Learning(Identifier):
                     agent.note("the model was refuted: learning resumes")
                 self.done = False
                 pending = refuted
+            except Confined as confined:
+                self.confine(confined.since)
+                if self.stop:
+                    while True:  # (the run ends here)
+                        yield from self.move(self.random_action())
 
     def advance(self) -> Plan:
         """One exploration, or the end game: forced deferrals, clean-up, minimisation,
@@ -101,9 +112,13 @@ class Learning(Identifier):
             return
         if not self.done:
             self.done = True
-            self.agent.note(f"done: {len(h.labels)} states, every transition confirmed")
+            done = f"done: {len(h.labels)} states, every transition confirmed and tested"
+            if self.stop:
+                self.agent.stop(done)
+            else:
+                self.agent.note(done)
         self.phase = "wander"
-        while True:
+        while True:  # every prediction checked
             yield from self.move(self.random_action(), check=True)
 
     def goal(self) -> tuple[list[int], tuple[int, int] | None] | None:
@@ -136,14 +151,14 @@ class Learning(Identifier):
             actions = open_pairs[s]
             made_by = self.made_by.get(s)
             if made_by is None:
-                return actions[0]
+                return self.pick(actions)
             undo = inverse.get(made_by)
             if undo is not None:
-                return undo if undo in actions else actions[0]
+                return undo if undo in actions else self.pick(actions)
             # Not known yet: an action that undoes no other one, and not the same one.
             taken = set(inverse.values())
             likely = [b for b in actions if b not in taken and b != made_by]
-            return likely[0] if likely else actions[0]
+            return self.pick(likely or actions)
 
         outside = [s for s in open_pairs if distance[s] == FAR]
         if outside:
@@ -164,12 +179,34 @@ class Learning(Identifier):
 
     def explore(self, q: int, a: int) -> Plan:
         """Take ``a`` from ``q`` (located there) and identify the state it leads to."""
-        self.phase = "test"
+        self.phase = "take"
         sensation = yield from self.move(a)
+        self.phase = "test"
         if sensation:
             self.confirm(q, a, self.h.landmark)
             return
         yield from self.identify(q, a, sensation, tuple(self.word), here=True)
+
+    def confine(self, since: int) -> None:
+        """A one-way world: no sensation since step ``since``, and the search for the landmark
+        has lasted longer than the run before it. The part the agent is confined to never
+        senses, so one state predicting false, every action a self-loop, is its exact model:
+        the agent is there now. Say so, and end the run (unless ``stop`` is false)."""
+        state = self.h.add_silent()
+        self.confined = state
+        self.belief = state
+        self.word.clear()
+        self.trace.clear()
+        self.beliefs.clear()
+        self.phase = "confined"
+        searched = self.agent.step - since
+        text = (
+            f"confined from step {since}: no sensation in the {searched:,} steps since, no way "
+            f"back found; the part it is confined to is 1 state (state {state}, never sensing)"
+        )
+        self.agent.note(text)
+        if self.stop:
+            self.agent.stop(text)
 
     def forget(self, gone: int, keep: int | None) -> None:
         """State ``gone`` merged into ``keep`` (or discarded): move or drop what names it."""

@@ -14,10 +14,31 @@ import numpy as np
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR, Hypothesis
 
-__all__ = ["LONGEST_RUN", "Plan", "Refuted", "Walker"]
+__all__ = ["CONFINED_STEPS", "LONGEST_RUN", "PHASES", "Confined", "Plan", "Refuted", "Walker"]
 
 LONGEST_RUN = 16
 """The longest run of one action in a random search."""
+
+PHASES = {
+    "search": "home",
+    "home": "home",
+    "navigate": "explore",
+    "take": "explore",
+    "test": "identify",
+    "return": "identify",
+    "analyse": "identify",
+    "verify": "identify",
+    "wander": "done",
+    "confined": "done",
+}
+"""The phase recorded (``agent.enter``) for each step counter of :attr:`Walker.stats`: *home*
+(searching for the landmark), *explore* (walking to the next transition, and taking it), *identify*
+(telling where a transition led: tests, returns, counterexamples, verification), *done*
+(walking the finished model, with ``stop=False``)."""
+
+CONFINED_STEPS = 16_384
+"""The shortest search for the landmark after which the agent may conclude it is confined (a
+world of a thousand classes, lost early, can take thousands of steps to find it again)."""
 
 Plan = Generator[int, bool, None]
 """A plan: yields the next action, receives the sensation that followed it."""
@@ -36,6 +57,16 @@ class Refuted(Exception):
         self.trace = trace
 
 
+class Confined(Exception):
+    """The search for the landmark has lasted :data:`CONFINED_STEPS` steps or more, and 16
+    times as long as the whole run before it: the agent takes it that no way leads back (a one-way
+    world), and that the part it is confined to never senses."""
+
+    def __init__(self, since: int) -> None:
+        super().__init__(f"no sensation since step {since}")
+        self.since = since
+
+
 class Walker:
     """The agent walking its hypothesis.
 
@@ -47,7 +78,7 @@ class Walker:
 
     def __init__(self, agent: AgentView) -> None:
         self.agent = agent
-        self.h = Hypothesis(agent.model, agent.actions, landmark=agent.model.current)
+        self.h = Hypothesis(agent.model, agent.actions, landmark=agent.model.current, rng=agent.rng)
         self.word: list[int] = []
         self.trace: list[bool] = []
         self.beliefs: list[int] = []
@@ -56,6 +87,10 @@ class Walker:
         self.stats: dict[str, int] = {}
         self._run_action = 0
         self._run_left = 0
+        self.last_seen = agent.step
+        self.seen = False
+        self.confined: int | None = None
+        self._confinement = CONFINED_STEPS
 
     def count(self, key: str, n: int = 1) -> None:
         self.stats[key] = self.stats.get(key, 0) + n
@@ -65,6 +100,7 @@ class Walker:
         confirmed transition raises :class:`Refuted` (else the agent is just lost)."""
         sensation = yield action
         self.count(f"steps_{self.phase}")
+        self.agent.enter(PHASES[self.phase])
         self.word.append(action)
         self.trace.append(sensation)
         h = self.h
@@ -89,9 +125,17 @@ class Walker:
     def at_landmark(self) -> None:
         """The sensation is true: the agent is at the landmark, whatever it believed."""
         self.belief = self.h.landmark
+        self.last_seen = self.agent.step
+        self.seen = True
         self.word.clear()
         self.trace.clear()
         self.beliefs.clear()
+
+    def pick(self, among: list[int]) -> int:
+        """One of ``among`` (not empty), chosen by the run's generator: a choice among equals."""
+        if len(among) == 1:
+            return among[0]
+        return among[int(self.agent.rng.integers(len(among)))]
 
     def random_action(self) -> int:
         """Runs of one action of random lengths (P(length >= n) = 1/n, at most
@@ -133,6 +177,7 @@ class Walker:
         if near is None:
             self.phase = phase
             return
+        climbing = self.agent.float_feedback
         sensation = self.trace[-1] if self.trace else True
         ids = np.asarray([s for s in near if h.labels[s] == sensation], dtype=np.int64)
         widened = not len(ids)
@@ -142,12 +187,21 @@ class Walker:
             usable = np.flatnonzero(h.distance[ids] < FAR)
             if len(usable) and self._run_left <= 0:
                 action = h.actions[int(h.toward[ids[usable[0]]])]
+            elif climbing:  # climb the feedback for a while, instead of a random run
+                if (yield from self.climb(LONGEST_RUN * len(h.actions))):
+                    self.phase = phase
+                    return
+                self._run_left = 0
+                widened = True
+                ids = np.asarray(h.with_label(False), dtype=np.int64)
+                continue
             else:
                 action = self.random_action()
             sensation = yield from self.move(action)
             if sensation:
                 self.phase = phase
                 return
+            self.check_confined()
             moved = h.next[ids, h.column[action]]
             keep = moved >= 0
             keep[keep] = h.label[moved[keep]] == sensation
@@ -158,6 +212,70 @@ class Walker:
                     self._run_left += 1
                 widened = True
                 ids = np.asarray(h.with_label(sensation), dtype=np.int64)
+
+    def check_confined(self) -> None:
+        """After a step of a search for the landmark: raise :class:`Confined` when the search
+        has lasted 16 times as long as the run before it, :data:`CONFINED_STEPS`, and a run of
+        :data:`LONGEST_RUN` steps per state and action of the hypothesis. A heuristic: from
+        sensations alone, a part of the world that never senses cannot be told from a search
+        that has not yet found the sensed pose."""
+        searched = self.agent.step - self.last_seen
+        if searched < self._confinement or self.confined is not None or not self.seen:
+            return
+        h = self.h
+        bound = max(
+            CONFINED_STEPS, 16 * self.last_seen, LONGEST_RUN * len(h.labels) * len(h.actions)
+        )
+        if searched >= bound:
+            raise Confined(self.last_seen)
+        self._confinement = bound
+
+    def climb(self, steps: int | None = None) -> Generator[int, bool, bool]:
+        """With float feedback: climb the closeness to the sensed pose until it is sensed (True)
+        or ``steps`` steps are taken (False; None: no limit).
+
+        Coordinate ascent: keep taking an action while the feedback grows; when it falls, undo
+        the action (when the confirmed transitions say which action undoes it) and try another;
+        when no action makes it grow (a local maximum: an obstacle in the way), a random run
+        of one action, then climb again.
+        """
+        memory = self.agent.memory
+        inverse = self.h.inverses()
+        actions = list(self.agent.actions)
+        end = None if steps is None else self.agent.step + steps
+        tried: set[int] = set()
+        action: int | None = None
+        while end is None or self.agent.step < end:
+            if action is None:
+                untried = [b for b in actions if b not in tried]
+                if not untried:  # a local maximum: leave it at random, then climb again
+                    self._run_left = 0
+                    run = [self.random_action()]
+                    while self._run_left > 0:
+                        run.append(self.random_action())
+                    for step_action in run:
+                        if (yield from self.move(step_action)):
+                            return True
+                        self.check_confined()
+                    tried.clear()
+                    continue
+                action = self.pick(untried)
+            before = float(memory.feedback[-1])  # (the memory's arrays are views: read anew)
+            if (yield from self.move(action)):
+                return True
+            self.check_confined()
+            after = float(memory.feedback[-1])
+            undo = inverse.get(action)
+            if after > before:
+                tried = set() if undo is None else {undo}
+                continue
+            tried.add(action)
+            if after < before and undo is not None:
+                if (yield from self.move(undo)):
+                    return True
+                self.check_confined()
+            action = None
+        return False
 
     def retrace(self) -> Generator[int, bool, list[int] | None]:
         """Undo the actions since the last known state; the states the agent is likely at.

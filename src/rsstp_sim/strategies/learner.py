@@ -37,14 +37,18 @@ class LearnerStrategy(StrategyBase):
     which finds the wrong transition.
     When every transition is confirmed the hypothesis is minimised (``merge``), the tests kept
     for each transition are replayed against it and the doubtful ones taken again; then
-    :attr:`done` is set, and the agent walks its model at random, every prediction checked (a
-    refutation resumes learning). ``model.current`` is where the agent believes it is.
+    :attr:`done` is set and the learner ends the run (``agent.stop``): the recording ends
+    there, with an event saying so. With ``stop=False`` it goes on instead, walking its model
+    at random, every prediction checked (a refutation resumes learning). ``model.current`` is
+    where the agent believes it is.
 
     Parameters:
 
     - ``doubts`` (>= 0, default 1): after the way back showed a state is new as far as the
       confirmed transitions tell, how many remaining candidates are still tested one by one;
       more than that and the state is taken as new (merged later if it was not).
+    - ``stop`` (default true): end the run when done; false: walk the model and check it
+      until the budget of steps is spent.
 
     Assumptions: the world is deterministic and strongly connected (every state reaches every
     other, as the arm's reachable poses do, a blocked move being a self-loop), and at most one
@@ -54,25 +58,30 @@ class LearnerStrategy(StrategyBase):
 
     name: ClassVar[str] = "learner"
 
-    def __init__(self, *, doubts: int = 1) -> None:
+    def __init__(self, *, doubts: int = 1, stop: bool = True) -> None:
         if isinstance(doubts, bool) or not isinstance(doubts, int) or doubts < 0:
             raise StrategyError(
                 f"learner: parameter doubts: expected an integer >= 0 (doubts=2), got {doubts!r}"
             )
+        if not isinstance(stop, bool):
+            raise StrategyError(
+                f"learner: parameter stop: expected true or false (stop=true), got {stop!r}"
+            )
         self._doubts = doubts
+        self._stop = stop
         self._learning: Learning | None = None
         self._plan: Plan | None = None
         self._next = 0
 
     def params(self) -> Mapping[str, Any]:
-        return {"doubts": self._doubts}
+        return {"doubts": self._doubts, "stop": self._stop}
 
     def initial_model(self, actions: tuple[int, ...]) -> TransitionSystem:
         """One state with a self-loop per action: the conjecture that nothing ever changes."""
         return TransitionSystem.universal(actions)
 
     def reset(self, agent: AgentView) -> None:
-        self._learning = Learning(agent, doubts=self._doubts)
+        self._learning = Learning(agent, doubts=self._doubts, stop=self._stop)
         self._plan = self._learning.plan()
         self._next = next(self._plan)
 
