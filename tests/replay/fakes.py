@@ -75,6 +75,8 @@ class FakeRecording:
             }
         ]
         for _ in range(steps):
+            if runner.stopped is not None:  # the strategy ended the run
+                break
             outcome = runner.step()
             pose = runner.world.current
             if outcome.blocker is not None:

@@ -10,6 +10,7 @@ from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR
 from rsstp_sim.strategies._learner_identify import Identifier
 from rsstp_sim.strategies._learner_walk import PHASES, Confined, Plan, Refuted
+from rsstp_sim.words import counted
 
 __all__ = ["Learning"]
 
@@ -112,7 +113,7 @@ class Learning(Identifier):
             return
         if not self.done:
             self.done = True
-            done = f"done: {len(h.labels)} states, every transition confirmed and tested"
+            done = f"done: {counted(len(h.labels), 'state')}, every transition confirmed and tested"
             if self.stop:
                 self.agent.stop(done)
             else:
