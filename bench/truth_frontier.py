@@ -33,6 +33,7 @@ from pathlib import Path
 
 from _cold import measure
 from _recordings import recorded
+from viewer import FRONTIER_TOML  # the issue's frontier world, one home for both benches
 
 BIN = Path(sys.executable).parent
 FRONTIER = """name = "three-joint-30"
@@ -47,17 +48,7 @@ radius = 0.8
 target_deg = [0, 30, 30]
 """
 WORLDS = {
-    "two-joint-10": """name = "two-joint-10"
-[arm]
-lengths = [2.0, 1.0]
-initial_deg = [0, 0]
-step_deg = 10
-[[obstacles]]
-center = [0.0, 2.5]
-radius = 0.5
-[feedback]
-target_deg = [0, 0]
-""",
+    "two-joint-10": FRONTIER_TOML,
     "three-joint-30": FRONTIER,
 }
 LARGE = (
