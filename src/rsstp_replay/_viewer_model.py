@@ -13,8 +13,8 @@ several poses) gets a thin line to the tip of each, the :data:`POSE_LINES` most 
 Logging: one entity per state, ``world/model/state/{id}``, with a row only at the steps where
 that state appears, its transitions change (found by replaying each version's operations
 and marking the states they touch) or its role changes, and an :class:`rr.Clear` when it is
-deleted; so the data
-grows with the number of changes, not with versions times model size. At a row:
+deleted; so the data grows with the number of changes, not with versions times model size. At
+a row:
 
 - ``Points2D``: the state, coloured by its role in the version in force (what the truth audit
   says it stood for: :mod:`rsstp_replay.audits.state_roles`, colours :data:`ROLE_COLORS`;
@@ -326,7 +326,7 @@ def log_legend(stream: rr.RecordingStream, *, reach: float) -> None:
     stream.log(
         LEGEND,
         rr.Points2D(
-            [(-0.92 * reach, (0.92 - 0.08 * k) * reach) for k in range(len(order))],
+            [(-0.92 * reach, (0.92 - 0.12 * k) * reach) for k in range(len(order))],
             colors=[ROLE_COLORS[r] for r in order],
             labels=[f"{ROLE_NAMES[r]} state" for r in order],
             radii=rr.Radius.ui_points(5.0),

@@ -17,6 +17,7 @@ from rsstp_replay.audits.state_roles import (
     UNVISITED,
     state_roles,
 )
+from rsstp_sim.errors import MemoryRangeError
 
 
 def brute_force(steps: list[tuple[int, int, int]], queries: list[tuple[int, int]]) -> list[str]:
@@ -80,7 +81,7 @@ def test_a_worked_example() -> None:
 
 
 def test_arrays_of_different_lengths_are_an_error() -> None:
-    with pytest.raises(ValueError, match="different lengths: 2, 1, 1"):
+    with pytest.raises(MemoryRangeError, match="different lengths: 2, 1, 1"):
         state_roles([1, 2], [1], [1], versions=[], states=[])
-    with pytest.raises(ValueError, match="2 versions for 1 states"):
+    with pytest.raises(MemoryRangeError, match="2 versions for 1 states"):
         state_roles([1], [1], [1], versions=[1, 2], states=[1])

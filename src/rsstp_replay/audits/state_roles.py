@@ -21,6 +21,8 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from rsstp_sim.errors import MemoryRangeError
+
 __all__ = ["ALIASED", "EXACT", "REDUNDANT", "ROLE_NAMES", "UNVISITED", "state_roles"]
 
 UNVISITED = 0
@@ -43,17 +45,18 @@ def state_roles(
 ) -> npt.NDArray[np.int8]:
     """The role code of state ``states[k]`` in version ``versions[k]``, for every ``k``, over
     the steps described by the three equal-length ``step_*`` arrays (see the module
-    docstring). Raises ``ValueError`` when the step arrays differ in length."""
+    docstring). Raises :class:`~rsstp_sim.errors.MemoryRangeError` when the arrays differ in
+    length."""
     step_v, step_s, step_c = (
         np.asarray(a, np.int64).ravel() for a in (step_versions, step_states, step_classes)
     )
     if not len(step_v) == len(step_s) == len(step_c):
-        raise ValueError(
+        raise MemoryRangeError(
             f"step arrays of different lengths: {len(step_v)}, {len(step_s)}, {len(step_c)}"
         )
     query_v, query_s = np.asarray(versions, np.int64).ravel(), np.asarray(states, np.int64).ravel()
     if len(query_v) != len(query_s):
-        raise ValueError(f"{len(query_v)} versions for {len(query_s)} states")
+        raise MemoryRangeError(f"{len(query_v)} versions for {len(query_s)} states")
     roles = np.full(len(query_v), UNVISITED, np.int8)
     if not len(step_v) or not len(query_v):
         return roles
