@@ -30,7 +30,7 @@ ROOT = Path(__file__).resolve().parents[1]
         ),
         (
             ["--strategy", "learner", "--param", "budget=3"],
-            "strategy 'learner': unknown parameter 'budget' (it takes doubts=VALUE)",
+            "strategy 'learner': unknown parameter 'budget' (it takes doubts=VALUE, stop=VALUE)",
         ),
         (
             ["--strategy", "roulette", "--param", "action=x"],
