@@ -7,8 +7,9 @@ cache on a world of about 340,000 poses.
     python bench/truth_frontier.py --world three-joint-30 --only frontier
     python bench/truth_frontier.py --only cache
 
-The frontier run is ``rsstp-sim record WORLD --strategy learner --seed 0``, recorded once into
-the temporary folder, on one of two worlds: ``two-joint-10`` (links (2, 1) at 10 degrees, one
+The frontier run is ``rsstp-sim record WORLD --strategy learner --param stop=false --seed 0``
+(the learner keeps walking and checking once it is done, so the run has every step of its
+budget), recorded once into the temporary folder, on one of two worlds: ``two-joint-10`` (links (2, 1) at 10 degrees, one
 obstacle: 1,183 true classes; the issue's case) or ``three-joint-30`` (links (3, 2, 1) at 30
 degrees, one obstacle: 1,337 true classes, and a learner model of up to 1,700 states whose
 every version the file holds whole).
@@ -76,8 +77,9 @@ def scenario_file(text: str) -> Path:
 def frontier(name: str, steps: int) -> None:
     world = scenario_file(WORLDS[name])
     mcap = recorded(
-        f"{name}-learner-{steps}", str(world), "--strategy", "learner", "--steps", str(steps)
-    )
+        f"{name}-learner-{steps}", str(world), "--strategy", "learner", "--param", "stop=false",
+        "--steps", str(steps),
+    )  # fmt: skip
     print(f"{mcap}: {mcap.stat().st_size / 1e6:.1f} MB; load average {os.getloadavg()[0]:.2f}")
     replay = str(BIN / "rsstp-replay")
     with tempfile.TemporaryDirectory() as home:
