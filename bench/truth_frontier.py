@@ -9,10 +9,10 @@ cache on a world of about 340,000 poses.
 
 The frontier run is ``rsstp-sim record WORLD --strategy learner --param stop=false --seed 0``
 (the learner keeps walking and checking once it is done, so the run has every step of its
-budget), recorded once into the temporary folder, on one of two worlds: ``two-joint-10`` (links (2, 1) at 10 degrees, one
-obstacle: 1,183 true classes; the issue's case) or ``three-joint-30`` (links (3, 2, 1) at 30
-degrees, one obstacle: 1,337 true classes, and a learner model of up to 1,700 states whose
-every version the file holds whole).
+budget), recorded once into the temporary folder, on one of two worlds: ``two-joint-10``
+(links (2, 1) at 10 degrees, one obstacle: 1,183 true classes; the issue's case) or
+``three-joint-30`` (links (3, 2, 1) at 30 degrees, one obstacle: 1,337 true classes, and a
+learner model of up to 1,700 states whose every version the file holds whole).
 Each command runs in a fresh process (wall time includes Python's start and imports; peak
 memory is the child's maximum RSS). The truth cache lives in a temporary ``XDG_CACHE_HOME``:
 the first ``audit --truth`` computes the truth and keeps it, the second (another recording of
