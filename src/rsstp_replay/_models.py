@@ -1,7 +1,7 @@
 """The chain of model messages: each snapshot must follow from the previous one.
 
 Every ``/rsstp/model`` message carries the whole model (a sparse snapshot) and the operations
-applied since the previous message. :func:`verify_chain` rebuilds each version from the
+applied since the previous message. :class:`ChainCheck` rebuilds each version from the
 previous snapshot with :meth:`TransitionSystem.apply` and checks that it gives the message's own
 snapshot, so a model at any step is known to be the one the run had.
 """
@@ -10,15 +10,16 @@ from __future__ import annotations
 
 import bisect
 import itertools
-from collections.abc import Sequence
 from pathlib import Path
+
+import msgspec
 
 from rsstp_replay.errors import CorruptRecording
 from rsstp_sim.errors import ModelError
 from rsstp_sim.recording.records import ModelRecord, TransitionsRecord
 from rsstp_sim.transition_system import TransitionSystem
 
-__all__ = ["build_model", "verify_chain"]
+__all__ = ["ChainCheck", "build_model"]
 
 
 def build_model(path: Path, record: ModelRecord) -> TransitionSystem:
@@ -29,39 +30,49 @@ def build_model(path: Path, record: ModelRecord) -> TransitionSystem:
         raise CorruptRecording(f"{path}: {_name(record)}: invalid snapshot: {exc}") from None
 
 
-def verify_chain(path: Path, records: Sequence[ModelRecord], *, last_step: int) -> None:
-    """Check the model messages in file order; :class:`CorruptRecording` names the version.
-    No message may come after ``last_step``, the recording's last step.
+class ChainCheck:
+    """Check the model messages in file order, one at a time as they are decoded (call it
+    with each, then :meth:`finish`); :class:`CorruptRecording` names the version. No message
+    may come after ``last_step``, the recording's last step.
 
     The first snapshot is built; every later message's operations are applied to the model
     rebuilt so far, and the result is compared with the message's snapshot field by field, so
     a snapshot is never built twice. The transitions are compared through what the operations
     touched: the previous snapshot, with the rows of every state whose transitions an
     operation may have changed replaced by the rebuilt model's, must be the message's
-    snapshot (whole tuples compared at C speed, Python only for the touched rows). A snapshot
-    that differs (or lists its transitions out of order) is then compared in full, which
-    names the difference.
+    snapshot (whole tuples compared at C speed, Python only for the touched rows). The record
+    handed back then holds those patched tuples, whose ints are the previous record's: a run's
+    thousands of snapshots, which repeat most of their transitions, share one int object per
+    state id instead of one per transition end. A snapshot that differs (or lists its
+    transitions out of order) is compared in full, which names the difference.
     """
-    if not records:
-        raise CorruptRecording(f"{path}: no /rsstp/model message (expected one at step 0)")
-    if records[0].step != 0:
-        raise CorruptRecording(
-            f"{path}: the first model message is at step {records[0].step}, expected step 0"
-        )
-    previous = records[0]
-    model = build_model(path, previous)
-    _check_flags(path, previous, model)
-    for record in records[1:]:
-        touched: set[int] = set()
-        if record.step > last_step:
+
+    def __init__(self, path: Path, *, last_step: int) -> None:
+        self._path, self._last_step = path, last_step
+        self._previous: ModelRecord | None = None
+        self._model: TransitionSystem | None = None
+
+    def __call__(self, record: ModelRecord) -> ModelRecord:
+        path, previous, model = self._path, self._previous, self._model
+        if previous is None or model is None:
+            if record.step != 0:
+                raise CorruptRecording(
+                    f"{path}: the first model message is at step {record.step}, expected step 0"
+                )
+            self._model = model = build_model(path, record)
+            _check_flags(path, record, model)
+            self._previous = record
+            return record
+        if record.step > self._last_step:
             raise CorruptRecording(
-                f"{path}: {_name(record)} comes after the last step, {last_step:,}"
+                f"{path}: {_name(record)} comes after the last step, {self._last_step:,}"
             )
         if record.step < previous.step:
             raise CorruptRecording(
                 f"{path}: {_name(record)} comes after the model message of step "
                 f"{previous.step}: expected the steps in order"
             )
+        touched: set[int] = set()
         for k, operation in enumerate(record.operations):
             try:
                 touched |= model.sources_changed_by(operation.kind, operation.args)
@@ -72,7 +83,18 @@ def verify_chain(path: Path, records: Sequence[ModelRecord], *, last_step: int) 
                     f"{list(operation.args)}) does not apply to version {previous.version}: {exc}"
                 ) from None
         model.drain_operations()
-        difference = _difference(model, record, previous, touched)
+        patched = _patched(previous.transitions, model, touched)
+        t = record.transitions
+        if patched == (t.source, t.action, t.target):
+            record = msgspec.structs.replace(
+                record,
+                transitions=TransitionsRecord(
+                    source=patched[0], action=patched[1], target=patched[2]
+                ),
+            )
+            difference = _difference(model, record)
+        else:
+            difference = _difference(model, record, full=True)
         if difference:
             raise CorruptRecording(
                 f"{path}: {_name(record)}: its operations applied to version "
@@ -85,7 +107,15 @@ def verify_chain(path: Path, records: Sequence[ModelRecord], *, last_step: int) 
             )
         model.current = record.current
         _check_flags(path, record, model)
-        previous = record
+        self._previous = record
+        return record
+
+    def finish(self) -> None:
+        """After the last message: there must have been one."""
+        if self._previous is None:
+            raise CorruptRecording(
+                f"{self._path}: no /rsstp/model message (expected one at step 0)"
+            )
 
 
 def _patched(
@@ -114,9 +144,9 @@ def _patched(
     )
 
 
-def _difference(
-    rebuilt: TransitionSystem, record: ModelRecord, previous: ModelRecord, touched: set[int]
-) -> str:
+def _difference(rebuilt: TransitionSystem, record: ModelRecord, *, full: bool = False) -> str:
+    """What differs between the rebuilt model and the message's snapshot ("" for nothing);
+    the transitions are compared only with ``full`` (the caller compared them already)."""
     if rebuilt.version != record.version:
         return f"they make version {rebuilt.version}"
     if rebuilt.states != tuple(record.states):
@@ -125,8 +155,7 @@ def _difference(
         return f"next id {rebuilt.next_id}, the snapshot has {record.next_id}"
     if rebuilt.actions != tuple(record.actions):
         return f"actions {list(rebuilt.actions)}, the snapshot has {list(record.actions)}"
-    t = record.transitions
-    if _patched(previous.transitions, rebuilt, touched) == (t.source, t.action, t.target):
+    if not full:
         return ""
     made = tuple(rebuilt.transitions())
     found = record.triples()

@@ -35,7 +35,7 @@ from rsstp_replay._chunks import message_times
 from rsstp_replay._container import ChunkRef, open_container
 from rsstp_replay._contract import CheckedFile, check_file
 from rsstp_replay._decode import StepColumns
-from rsstp_replay._models import build_model, verify_chain
+from rsstp_replay._models import ChainCheck, build_model
 from rsstp_replay.errors import (
     BadStep,
     CorruptRecording,
@@ -47,7 +47,7 @@ from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
-from rsstp_sim.recording.records import EventRecord, ModelRecord, TransitionsRecord
+from rsstp_sim.recording.records import EventRecord, ModelRecord
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
@@ -285,8 +285,9 @@ class Recording:
                 one_state = TransitionSystem.universal(self.scenario_record.actions)
                 self._models = (model_record(one_state, step=0, operations=()),)
                 return self._models
-            models = self._records("/rsstp/model", keep=_SharedIds())
-            verify_chain(self.path, models, last_step=self.n_steps)
+            chain = ChainCheck(self.path, last_step=self.n_steps)
+            models = self._records("/rsstp/model", keep=chain)
+            chain.finish()
             self._models = tuple(models)
         return self._models
 
@@ -435,29 +436,6 @@ class Recording:
                 if row is not None:
                     return row
         raise CorruptRecording(f"{self.path}: the message of step {step} is missing")
-
-
-class _SharedIds:
-    """A model record whose transitions hold one int object per distinct state id across
-    every record it was given. Consecutive snapshots repeat most of their transitions (a run
-    of the splitter with 1,695 versions holds 4.7 million); CPython shares the ints up to 256
-    by itself, and this shares the larger ids, which would otherwise be an object (28 bytes)
-    per transition end."""
-
-    def __init__(self) -> None:
-        self._shared: dict[int, int] = {}
-
-    def __call__(self, record: ModelRecord) -> ModelRecord:
-        t = record.transitions
-        if not t.source or max(max(t.source), max(t.target)) <= 256:
-            return record
-        keep = self._shared.setdefault
-        shared = TransitionsRecord(
-            source=tuple(map(keep, t.source, t.source)),
-            action=t.action,
-            target=tuple(map(keep, t.target, t.target)),
-        )
-        return msgspec.structs.replace(record, transitions=shared)
 
 
 class _AgentRow(NamedTuple):
