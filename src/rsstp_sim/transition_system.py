@@ -247,12 +247,19 @@ class TransitionSystem:
         nondeterministic: list[tuple[int, int, tuple[int, ...]]] = []
         empty: list[tuple[int, int]] = []
         for s in self.states:
-            out = self._out[s]
-            for a in sorted(out):
-                if len(out[a]) > 1:
-                    nondeterministic.append((s, a, out[a]))
-            empty.extend((s, a) for a in self.actions if a not in out)
+            several, none = self.determinism_of(s)
+            nondeterministic += several
+            empty += none
         return DeterminismReport(tuple(nondeterministic), tuple(empty))
+
+    def determinism_of(
+        self, s: int
+    ) -> tuple[list[tuple[int, int, tuple[int, ...]]], list[tuple[int, int]]]:
+        """State ``s``'s part of :meth:`determinism_report`: its (state, action, successors)
+        with several successors and its (state, action) with none, by action."""
+        out = self._out[s]
+        several = [(s, a, out[a]) for a in sorted(out) if len(out[a]) > 1]
+        return several, [(s, a) for a in self.actions if a not in out]
 
     def transitions(self) -> list[tuple[int, int, int]]:
         """Every transition as ``(source, action, target)``, sorted."""

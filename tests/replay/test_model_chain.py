@@ -4,11 +4,14 @@ tracked successor table (kept through the touched states, equal to one built afr
 
 from __future__ import annotations
 
+from fakes import FakeRecording, RandomRefiner
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rsstp_replay._models import _patched
 from rsstp_replay.audits._equivalence import ModelTable, TrackedTable
+from rsstp_replay.audits.determinism import audit_determinism
+from rsstp_sim import load_scenario
 from rsstp_sim.recording.records import TransitionsRecord
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -61,3 +64,20 @@ def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(
         assert fresh.states.tolist() == kept.states.tolist()
         assert fresh.successor.tolist() == kept.successor.tolist()
         assert fresh.label.tolist() == kept.label.tolist()
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**16), split=st.sampled_from([0.05, 0.2, 0.5]))
+def test_the_determinism_audit_kept_through_touched_states_is_every_versions_own(
+    seed: int, split: float
+) -> None:
+    """Each version's pairs with several successors and with none, kept per state through
+    what the operations touched, are the ones its own model reports."""
+    recording = FakeRecording(
+        load_scenario("two-joint-30"), RandomRefiner(split=split, max_states=10), seed=seed,
+        steps=120,
+    )  # fmt: skip
+    found = audit_determinism(recording)
+    for record, version in zip(recording.model_versions(), found.versions, strict=True):
+        own = TransitionSystem.from_snapshot(record.snapshot()).determinism_report()
+        assert (version.nondeterministic, version.empty) == (own.nondeterministic, own.empty)

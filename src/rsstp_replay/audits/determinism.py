@@ -224,12 +224,25 @@ def audit_determinism(
         raise ModelError("determinism audit: no model message (a recording has one at step 0)")
     found = []
     model: TransitionSystem | None = None
+    rows: dict[int, tuple[list[tuple[int, int, tuple[int, ...]]], list[tuple[int, int]]]] = {}
+    actions: tuple[int, ...] = ()
     for record in records:
         if model is None:
             model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
+            changed: set[int] = set(model.states)
         else:
-            _advance(model, record)
-        report = model.determinism_report()
+            changed = _advance(model, record)
+        if model.actions != actions:  # a new action: every state's empty pairs change
+            actions, changed = model.actions, set(model.states)
+        for s in changed:  # each state's part kept, redone only where an operation touched it
+            if s in model:
+                rows[s] = model.determinism_of(s)
+            else:
+                rows.pop(s, None)
+        report = DeterminismReport(
+            tuple(pair for s in model.states for pair in rows[s][0]),
+            tuple(pair for s in model.states for pair in rows[s][1]),
+        )
         if len(report.nondeterministic) != record.nondeterministic_pairs:
             raise ModelError(
                 f"model version {record.version} (step {record.step}) has "
@@ -249,12 +262,15 @@ def audit_determinism(
     return DeterminismFindings(tuple(found))
 
 
-def _advance(model: TransitionSystem, record: ModelRecord) -> None:
+def _advance(model: TransitionSystem, record: ModelRecord) -> set[int]:
     """Apply ``record``'s operations to ``model`` (the previous version) and check the result
-    against the record (version and states; the caller checks the nondeterministic pairs)."""
+    against the record (version and states; the caller checks the nondeterministic pairs);
+    the states whose outgoing transitions the operations may have changed."""
     where = f"model version {record.version} (step {record.step})"
+    changed: set[int] = set()
     for operation in record.operations:
         try:
+            changed |= model.sources_changed_by(operation.kind, operation.args)
             model.apply(operation.to_operation())
         except ModelError as exc:
             raise ModelError(f"{where}: its operations do not apply: {exc}") from None
@@ -270,6 +286,7 @@ def _advance(model: TransitionSystem, record: ModelRecord) -> None:
             f"{_short(record.states)}"
         )
     model.current = record.current
+    return changed
 
 
 def _stayed_from(versions: Sequence[VersionDeterminism], *, deterministic_only: bool) -> int | None:
