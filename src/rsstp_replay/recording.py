@@ -127,6 +127,7 @@ class Recording:
         self._agent: StepColumns | None = None
         self._log_times: _Ints | None = None
         self._models: tuple[ModelRecord, ...] | None = None
+        self._events: pd.DataFrame | None = None
 
     # -- properties ------------------------------------------------------------------------
 
@@ -161,6 +162,7 @@ class Recording:
         self._log_times = None
         self._agent_cache.clear()
         self._models = None
+        self._events = None
 
     def __enter__(self) -> Recording:
         return self
@@ -244,7 +246,14 @@ class Recording:
 
     def events(self) -> pd.DataFrame:
         """One row per event: ``step`` (int64), ``kind`` (categorical, :data:`EVENT_KINDS`),
-        ``text`` (one line), ``data`` (its details as JSON text)."""
+        ``text`` (one line), ``data`` (its details as JSON text). The messages are decoded
+        once per recording; each call gets its own copy of the table."""
+        self._check_open()
+        if self._events is None:
+            self._events = self._event_table()
+        return self._events.copy()
+
+    def _event_table(self) -> pd.DataFrame:
         events = self._records("/rsstp/event")
         return pd.DataFrame(
             {
