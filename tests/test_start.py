@@ -32,7 +32,13 @@ def _script(name: str) -> str:
     "command",
     [
         ["rsstp-sim", "run", "thesis-roulette", "--steps", "3000000", "--quiet"],
-        ["rsstp-replay", "audit", str(ROOT / "recordings" / "two-joint-30-learner.mcap")],
+        [  # the truth computed afresh: longer than the longest delay, however fast the audit
+            "rsstp-replay",
+            "audit",
+            "--truth",
+            "--no-cache",
+            str(ROOT / "recordings" / "three-joint-random.mcap"),
+        ],
     ],
     ids=["rsstp-sim run", "rsstp-replay audit"],
 )
