@@ -202,7 +202,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         bar.to(1)
         bar.stage("auditing")
         report = run_audits(loaded)
-        physics = check_physics(recording)
+        physics = check_physics(recording, loaded.steps())
         bar.to(2)
         truth = None
         if args.truth:
