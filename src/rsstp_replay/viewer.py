@@ -131,6 +131,9 @@ class LogSummary:
     rows: dict[str, int]
     model_versions: int
     log_lines: int
+    thinned: tuple[str, ...]
+    """The series paths that kept only their extremes (more changes than
+    :data:`~rsstp_replay._viewer_plots.SERIES_MAX_ROWS` in the steps shown)."""
     seconds_read: float
     seconds_prepare: float
     seconds_rerun: float
@@ -165,6 +168,11 @@ class ViewResult:
             "read "
             f"{s.seconds_read:.2f} s, audits and placing {s.seconds_prepare:.2f} s, Rerun "
             f"{self.seconds_rerun:.2f} s" + ("; " + ", ".join(where) if where else "")
+        ) + (
+            f"\nthinned to each curve's extremes (over {plots_part.SERIES_MAX_ROWS:,} changes): "
+            f"{', '.join(s.thinned)}; --from/--to on a shorter window shows every change"
+            if s.thinned
+            else ""
         )
 
     def serve_forever(self, stop: CtrlC | None = None) -> None:
@@ -422,15 +430,17 @@ def _log(
         loaded.places,
     )
     rows |= world_part.log_world(stream, window, scenario)
-    rows |= plots_part.log_series(
+    series, thinned = plots_part.log_series(
         stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
     )
+    rows |= series
     return LogSummary(
         first_step=first,
         last_step=last,
         rows=rows,
         model_versions=len(shown),
         log_lines=len(lines),
+        thinned=tuple(thinned),
         seconds_read=loaded.seconds_read,
         seconds_prepare=loaded.seconds_prepare,
         seconds_rerun=time.perf_counter() - began,

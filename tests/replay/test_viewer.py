@@ -151,6 +151,45 @@ def test_entity_paths_and_rows_match_the_recording(reference: tuple[Recording, R
     assert [step for step, _ in rrd.column("world/model/state/0", "Points2D:positions")] == [0]
 
 
+def test_a_series_of_too_many_changes_keeps_each_curves_extremes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Over its row budget, a series keeps (besides its first and last row) the steps where
+    each curve has its least and greatest value in each equal run of steps, every one with
+    its value; below the budget nothing is thinned."""
+    monkeypatch.setattr(viewer.plots_part, "SERIES_MAX_ROWS", 240)
+    out = tmp_path / "thin.rrd"
+    with open_recording(REFERENCE) as recording:
+        result = view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+        table = recording.steps()
+    rrd = Rrd(out)
+    assert "plots/distance" in result.summary.thinned
+    columns = [f"dist_{k}_{j}" for k in range(3) for j in range(2)]
+    values = table[columns].to_numpy(np.float64)
+    changes = _changes(values)
+    buckets = 240 // (2 * len(columns))
+    span = changes[-1] - changes[0] + 1
+    width = -(-span // buckets)
+    expected = {changes[0], changes[-1]}
+    for begin in range(changes[0], changes[-1] + 1, width):
+        inside = [t for t in changes if begin <= t < begin + width]
+        for c in range(len(columns)):
+            # the earliest step of the least value, the latest of the greatest
+            low = min(inside, key=lambda t: (values[t, c], t))
+            high = max(inside, key=lambda t: (values[t, c], t))
+            expected |= {low, high}
+    rows = rrd.column("plots/distance", "Scalars:scalars")
+    assert [step for step, _ in rows] == sorted(expected)
+    for step, scalars in rows:
+        np.testing.assert_array_equal(scalars, values[step])
+    # The sensation changes fewer times than the budget: every change is kept.
+    expected_sensation = _changes(table[["sensation"]].to_numpy(np.float64))
+    assert len(expected_sensation) <= 240
+    sensation = [step for step, _ in rrd.column("plots/agent/sensation", "Scalars:scalars")]
+    assert sensation == expected_sensation
+    assert "plots/agent/sensation" not in result.summary.thinned
+
+
 def test_the_sensation_is_a_step_plot_that_never_averages(
     reference: tuple[Recording, Rrd],
 ) -> None:
