@@ -9,7 +9,9 @@ snapshot, so a model at any step is known to be the one the run had.
 from __future__ import annotations
 
 import bisect
-import itertools
+from array import array
+from collections.abc import Iterable, Sequence
+from itertools import chain
 from pathlib import Path
 
 import msgspec
@@ -84,14 +86,8 @@ class ChainCheck:
                 ) from None
         model.drain_operations()
         patched = _patched(previous.transitions, model, touched)
-        t = record.transitions
-        if patched == (t.source, t.action, t.target):
-            record = msgspec.structs.replace(
-                record,
-                transitions=TransitionsRecord(
-                    source=patched[0], action=patched[1], target=patched[2]
-                ),
-            )
+        if patched.holds(record.transitions):
+            record = msgspec.structs.replace(record, transitions=patched)
             difference = _difference(model, record)
         else:
             difference = _difference(model, record, full=True)
@@ -118,13 +114,11 @@ class ChainCheck:
             )
 
 
-def _patched(
-    previous: TransitionsRecord, rebuilt: TransitionSystem, touched: set[int]
-) -> tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]]:
+def _patched(previous: TransitionsRecord, rebuilt: TransitionSystem, touched: set[int]) -> _Compact:
     """The previous snapshot's transitions with the rows of the ``touched`` states (sorted by
-    source, action and target) replaced by the rebuilt model's."""
+    source, action and target) replaced by the rebuilt model's, in compact columns."""
     source, action, target = previous.source, previous.action, previous.target
-    parts: list[tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]]] = []
+    parts: list[tuple[Sequence[int], Sequence[int], Sequence[int]]] = []
     done = 0
     for state in sorted(touched):
         lo = bisect.bisect_left(source, state, done)
@@ -132,16 +126,44 @@ def _patched(
         parts.append((source[done:lo], action[done:lo], target[done:lo]))
         if state in rebuilt:
             rows = rebuilt.transitions_from(state)
-            parts.append(
-                ((state,) * len(rows), tuple(a for a, _ in rows), tuple(t for _, t in rows))
-            )
+            parts.append(((state,) * len(rows), [a for a, _ in rows], [t for _, t in rows]))
         done = hi
     parts.append((source[done:], action[done:], target[done:]))
-    return (
-        tuple(itertools.chain.from_iterable(p[0] for p in parts)),
-        tuple(itertools.chain.from_iterable(p[1] for p in parts)),
-        tuple(itertools.chain.from_iterable(p[2] for p in parts)),
+    return _Compact(
+        source=_column(chain.from_iterable(p[0] for p in parts)),
+        action=_column(chain.from_iterable(p[1] for p in parts)),
+        target=_column(chain.from_iterable(p[2] for p in parts)),
     )
+
+
+class _Compact(TransitionsRecord, frozen=True, kw_only=True, gc=False):
+    """Transitions in ``array.array`` columns of the narrowest signed type that holds their
+    ids (2 bytes each below 32,768 states, where a tuple's slot takes 8)."""
+
+    def holds(self, other: TransitionsRecord) -> bool:
+        """Whether ``other`` has the same transitions in the same order."""
+        for mine, theirs in (
+            (self.source, other.source),
+            (self.action, other.action),
+            (self.target, other.target),
+        ):
+            assert isinstance(mine, array)
+            try:
+                if mine != array(mine.typecode, theirs):
+                    return False
+            except (OverflowError, TypeError):  # an id that does not fit: not one of ours
+                return False
+        return True
+
+
+def _column(values: Iterable[int]) -> array[int]:
+    """``values`` in the narrowest signed ``array.array`` that holds them."""
+    whole = list(values)
+    largest = max(max(whole, default=0), -min(whole, default=0))
+    for code in ("h", "i"):
+        if largest < 1 << (8 * array(code).itemsize - 1):
+            return array(code, whole)
+    return array("q", whole)
 
 
 def _difference(rebuilt: TransitionSystem, record: ModelRecord, *, full: bool = False) -> str:

@@ -57,7 +57,11 @@ def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(
                 touched |= model.sources_changed_by(kind, (s, t, a))
                 getattr(model, kind)(s, t, a)
         after = as_record(model)
-        assert _patched(before, model, touched) == (after.source, after.action, after.target)
+        patched = _patched(before, model, touched)
+        columns = (patched.source, patched.action, patched.target)
+        assert tuple(map(tuple, columns)) == (after.source, after.action, after.target)
+        assert patched.holds(after)
+        assert all(column.itemsize == 2 for column in columns)  # type: ignore[attr-defined]
         tracked.update(model, touched)
         labels = {s: bool(s % 2) for s in model.states}
         fresh, kept = ModelTable.of(model, labels, (0, 1)), tracked.table(labels)
