@@ -190,6 +190,41 @@ def test_a_series_of_too_many_changes_keeps_each_curves_extremes(
     assert "plots/agent/sensation" not in result.summary.thinned
 
 
+def test_a_long_window_is_an_overview_of_every_kth_step(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Over OVERVIEW_MAX_STEPS steps shown, the arm and the current state are shown at steps
+    0, k, 2k, ... and the last (rows where they changed between those), the sensor is left
+    out, and the log says so at the first step; the series keep every change."""
+    monkeypatch.setattr(viewer, "OVERVIEW_MAX_STEPS", 2_000)
+    out = tmp_path / "overview.rrd"
+    with open_recording(REFERENCE) as recording:
+        result = view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+        table = recording.steps()
+    rrd = Rrd(out)
+    k = 6  # 10,001 steps in at most 2,000 rows each
+    assert result.summary.every == k
+    shown = sorted({*range(0, len(table), k), len(table) - 1})
+    positions = table[[f"joint{j}_{a}" for j in range(4) for a in "xy"]].to_numpy()[shown]
+    blocked = table["blocked"].to_numpy()[shown]
+    changed = [
+        shown[i]
+        for i in range(len(shown))
+        if i == 0 or (positions[i] != positions[i - 1]).any() or blocked[i] != blocked[i - 1]
+    ]
+    assert [step for step, _ in rrd.column("world/arm", "LineStrips2D:strips")] == changed
+    assert "world/sensor" not in rrd.temporal
+    [(step, text)] = [
+        (step, text)
+        for step, [text] in rrd.column("log/audit", "TextLog:text")
+        if "overview" in text
+    ]
+    assert step == 0 and "one step in 6" in text
+    assert "one step in 6" in result.to_text()
+    feedback = [step for step, _ in rrd.column("plots/agent/feedback", "Scalars:scalars")]
+    assert feedback == _changes(table[["feedback"]].to_numpy(np.float64))
+
+
 def test_the_sensation_is_a_step_plot_that_never_averages(
     reference: tuple[Recording, Rrd],
 ) -> None:
