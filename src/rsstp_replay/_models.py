@@ -10,8 +10,7 @@ from __future__ import annotations
 
 import bisect
 from array import array
-from collections.abc import Iterable, Sequence
-from itertools import chain
+from collections.abc import Sequence
 from pathlib import Path
 
 import msgspec
@@ -118,27 +117,38 @@ def _patched(previous: TransitionsRecord, rebuilt: TransitionSystem, touched: se
     """The previous snapshot's transitions with the rows of the ``touched`` states (sorted by
     source, action and target) replaced by the rebuilt model's, in compact columns."""
     source, action, target = previous.source, previous.action, previous.target
-    parts: list[tuple[Sequence[int], Sequence[int], Sequence[int]]] = []
+    ids = max(rebuilt.next_id, -min(rebuilt.states, default=0))
+    moves = max(max(rebuilt.actions, default=0), -min(rebuilt.actions, default=0))
+    columns = (_column(ids), _column(moves), _column(ids))
     done = 0
-    for state in sorted(touched):
-        lo = bisect.bisect_left(source, state, done)
-        hi = bisect.bisect_right(source, state, lo)
-        parts.append((source[done:lo], action[done:lo], target[done:lo]))
-        if state in rebuilt:
-            rows = rebuilt.transitions_from(state)
-            parts.append(((state,) * len(rows), [a for a, _ in rows], [t for _, t in rows]))
-        done = hi
-    parts.append((source[done:], action[done:], target[done:]))
-    return _Compact(
-        source=_column(chain.from_iterable(p[0] for p in parts)),
-        action=_column(chain.from_iterable(p[1] for p in parts)),
-        target=_column(chain.from_iterable(p[2] for p in parts)),
-    )
+    try:
+        for state in sorted(touched):
+            lo = bisect.bisect_left(source, state, done)
+            hi = bisect.bisect_right(source, state, lo)
+            _extend(columns, source[done:lo], action[done:lo], target[done:lo])
+            if state in rebuilt:
+                rows = rebuilt.transitions_from(state)
+                _extend(columns, (state,) * len(rows), [a for a, _ in rows], [t for _, t in rows])
+            done = hi
+        _extend(columns, source[done:], action[done:], target[done:])
+    except OverflowError:  # an id past the model's own: the comparison names it
+        return _Compact(source=array("q"), action=array("q"), target=array("q"))
+    return _Compact(source=columns[0], action=columns[1], target=columns[2])
+
+
+def _extend(columns: tuple[array[int], ...], *parts: Sequence[int]) -> None:
+    """Append each part to its column (an array of the column's type is copied at C
+    speed; one of another type, after a version outgrew 2-byte ids, value by value)."""
+    for column, part in zip(columns, parts, strict=True):
+        if isinstance(part, array) and part.typecode != column.typecode:
+            column.extend(part.tolist())
+        else:
+            column.extend(part)  # type: ignore[arg-type]
 
 
 class _Compact(TransitionsRecord, frozen=True, kw_only=True, gc=False):
-    """Transitions in ``array.array`` columns of the narrowest signed type that holds their
-    ids (2 bytes each below 32,768 states, where a tuple's slot takes 8)."""
+    """Transitions in ``array.array`` columns of the narrowest signed type that holds the
+    model's ids (2 bytes each below 32,768 states, where a tuple's slot takes 8)."""
 
     def holds(self, other: TransitionsRecord) -> bool:
         """Whether ``other`` has the same transitions in the same order."""
@@ -156,14 +166,13 @@ class _Compact(TransitionsRecord, frozen=True, kw_only=True, gc=False):
         return True
 
 
-def _column(values: Iterable[int]) -> array[int]:
-    """``values`` in the narrowest signed ``array.array`` that holds them."""
-    whole = list(values)
-    largest = max(max(whole, default=0), -min(whole, default=0))
+def _column(largest: int) -> array[int]:
+    """An empty column of the narrowest signed type for ids of at most ``largest`` in
+    absolute value."""
     for code in ("h", "i"):
         if largest < 1 << (8 * array(code).itemsize - 1):
-            return array(code, whole)
-    return array("q", whole)
+            return array(code)
+    return array("q")
 
 
 def _difference(rebuilt: TransitionSystem, record: ModelRecord, *, full: bool = False) -> str:

@@ -85,3 +85,31 @@ def test_the_determinism_audit_kept_through_touched_states_is_every_versions_own
     for record, version in zip(recording.model_versions(), found.versions, strict=True):
         own = TransitionSystem.from_snapshot(record.snapshot()).determinism_report()
         assert (version.nondeterministic, version.empty) == (own.nondeterministic, own.empty)
+
+
+def test_a_version_that_outgrows_two_byte_ids_is_patched_whole() -> None:
+    """Columns of 2-byte ids carried into a version whose new state needs 4 bytes: the patch
+    holds every transition, the new state's included, in the wider type."""
+    first = TransitionSystem.from_snapshot(
+        {
+            "states": [0, 32_766],
+            "next_id": 32_767,
+            "current": 0,
+            "actions": [0, 1],
+            "transitions": [[0, 0, 32_766], [32_766, 1, 0], [32_766, 0, 32_766]],
+        }
+    )
+    narrow = _patched(as_record(first), first, set())  # the previous version, compacted
+    assert narrow.source.itemsize == 2  # type: ignore[attr-defined]
+    touched = first.sources_changed_by("split", (32_766,))
+    created = first.split(32_766)
+    assert created == 32_767
+    wide = _patched(narrow, first, touched)
+    after = as_record(first)
+    assert (tuple(wide.source), tuple(wide.action), tuple(wide.target)) == (
+        after.source,
+        after.action,
+        after.target,
+    )
+    assert wide.holds(after)
+    assert wide.source.itemsize == 4  # type: ignore[attr-defined]
