@@ -10,17 +10,36 @@ from __future__ import annotations
 
 import bisect
 from array import array
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import msgspec
 
 from rsstp_replay.errors import CorruptRecording
 from rsstp_sim.errors import ModelError
-from rsstp_sim.recording.records import ModelRecord, TransitionsRecord
+from rsstp_sim.recording.records import ModelRecord, OperationRecord, TransitionsRecord, encode
 from rsstp_sim.transition_system import TransitionSystem
 
-__all__ = ["ChainCheck", "build_model"]
+__all__ = ["HEADS", "ChainCheck", "ModelHead", "build_model"]
+
+
+class ModelHead(msgspec.Struct, kw_only=True, gc=False):
+    """A ``/rsstp/model`` message read without its transitions (the parser skips them):
+    what :meth:`ChainCheck.head` needs to rebuild the version and write its bytes again."""
+
+    version: int
+    step: int
+    states: tuple[int, ...]
+    next_id: int
+    current: int
+    actions: tuple[int, ...]
+    operations: tuple[OperationRecord, ...]
+    deterministic: bool
+    nondeterministic_pairs: int
+
+
+HEADS = msgspec.json.Decoder(list[ModelHead])
+"""Decodes a chunk's model messages joined as one JSON array."""
 
 
 def build_model(path: Path, record: ModelRecord) -> TransitionSystem:
@@ -54,16 +73,53 @@ class ChainCheck:
         self._model: TransitionSystem | None = None
 
     def __call__(self, record: ModelRecord) -> ModelRecord:
+        """Check ``record``, the next message decoded whole; the record to keep."""
+        if self._previous is None:
+            return self._first(record)
+        touched = self._advance(record)
+        return self._compare(record, touched)
+
+    def head(self, head: ModelHead, data: bytes, decode: Callable[[], ModelRecord]) -> ModelRecord:
+        """Check the next message from its ``head`` (decoded without the transitions) and its
+        bytes: when ``data`` is, byte for byte, the message of the version its operations
+        make (as the recorder writes it), its transitions are never parsed. Otherwise the
+        message is decoded whole (``decode``) and compared field by field, which names any
+        difference (equal values written another way pass)."""
+        previous = self._previous
+        if previous is None:
+            return self._first(decode())
+        touched = self._advance(head)
+        model = self._model
+        assert model is not None
+        patched = _patched(previous.transitions, model, touched)
+        fields = {name: getattr(head, name) for name in head.__struct_fields__}
+        expected = ModelRecord(
+            **fields,
+            transitions=TransitionsRecord(
+                source=list(patched.source),
+                action=list(patched.action),
+                target=list(patched.target),
+            ),
+        )
+        if encode(expected) != data:
+            return self._compare(decode(), touched, patched)
+        return self._accept(msgspec.structs.replace(expected, transitions=patched), "")
+
+    def _first(self, record: ModelRecord) -> ModelRecord:
+        if record.step != 0:
+            raise CorruptRecording(
+                f"{self._path}: the first model message is at step {record.step}, expected step 0"
+            )
+        self._model = model = build_model(self._path, record)
+        _check_flags(self._path, record, model)
+        self._previous = record
+        return record
+
+    def _advance(self, record: ModelRecord | ModelHead) -> set[int]:
+        """Apply the next message's operations to the model rebuilt so far (after checking
+        its step); the states whose transitions they may have changed."""
         path, previous, model = self._path, self._previous, self._model
-        if previous is None or model is None:
-            if record.step != 0:
-                raise CorruptRecording(
-                    f"{path}: the first model message is at step {record.step}, expected step 0"
-                )
-            self._model = model = build_model(path, record)
-            _check_flags(path, record, model)
-            self._previous = record
-            return record
+        assert previous is not None and model is not None
         if record.step > self._last_step:
             raise CorruptRecording(
                 f"{path}: {_name(record)} comes after the last step, {self._last_step:,}"
@@ -84,12 +140,24 @@ class ChainCheck:
                     f"{list(operation.args)}) does not apply to version {previous.version}: {exc}"
                 ) from None
         model.drain_operations()
-        patched = _patched(previous.transitions, model, touched)
+        return touched
+
+    def _compare(
+        self, record: ModelRecord, touched: set[int], patched: _Compact | None = None
+    ) -> ModelRecord:
+        """Compare a message decoded whole with the model its operations made."""
+        previous, model = self._previous, self._model
+        assert previous is not None and model is not None
+        if patched is None:
+            patched = _patched(previous.transitions, model, touched)
         if patched.holds(record.transitions):
             record = msgspec.structs.replace(record, transitions=patched)
-            difference = _difference(model, record)
-        else:
-            difference = _difference(model, record, full=True)
+            return self._accept(record, _difference(model, record))
+        return self._accept(record, _difference(model, record, full=True))
+
+    def _accept(self, record: ModelRecord, difference: str) -> ModelRecord:
+        path, previous, model = self._path, self._previous, self._model
+        assert previous is not None and model is not None
         if difference:
             raise CorruptRecording(
                 f"{path}: {_name(record)}: its operations applied to version "
@@ -150,6 +218,12 @@ class _Compact(TransitionsRecord, frozen=True, kw_only=True, gc=False):
     """Transitions in ``array.array`` columns of the narrowest signed type that holds the
     model's ids (2 bytes each below 32,768 states, where a tuple's slot takes 8)."""
 
+    def as_lists(self) -> TransitionsRecord:
+        """The same transitions in lists (what the JSON encoder writes)."""
+        columns = [self.source, self.action, self.target]
+        source, action, target = (c.tolist() for c in columns if isinstance(c, array))
+        return TransitionsRecord(source=source, action=action, target=target)
+
     def holds(self, other: TransitionsRecord) -> bool:
         """Whether ``other`` has the same transitions in the same order."""
         for mine, theirs in (
@@ -207,5 +281,5 @@ def _check_flags(path: Path, record: ModelRecord, model: TransitionSystem) -> No
         )
 
 
-def _name(record: ModelRecord) -> str:
+def _name(record: ModelRecord | ModelHead) -> str:
     return f"model version {record.version} (step {record.step})"
