@@ -392,7 +392,7 @@ def cli_runs(damaged: dict[str, Path]) -> dict[str, subprocess.CompletedProcess[
         command, *options = case.command
         argv = [command, str(damaged[name]), *(o.format(tmp=folder) for o in options)]
         processes[name] = subprocess.Popen(
-            [sys.executable, "-m", "rsstp_replay", *argv],
+            [sys.executable, "-m", "rsstp_cli.replay", *argv],
             env=env,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
@@ -449,7 +449,7 @@ def test_info_never_calls_a_file_with_a_failing_chunk_finished(damaged: dict[str
     """A finished file whose middle chunk fails its CRC: `info` reads every chunk, so it is
     one line and exit 2, not "finished"."""
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", "info", str(damaged["chunk-flip"])],
+        [sys.executable, "-m", "rsstp_cli.replay", "info", str(damaged["chunk-flip"])],
         capture_output=True,
         text=True,
         timeout=120,

@@ -369,8 +369,8 @@ def test_a_killed_writer_leaves_a_readable_recording(tmp_path: Path) -> None:
     path = tmp_path / "killed.mcap"
     side = tmp_path / "killed.mcap.partial"  # where it is written until it is finished
     env = {**os.environ, "PYTHONPATH": str(SRC)}
-    command = [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--steps", "10000000"]
-    command += ["--seed", "3", "--chunk-size", "4096", "-o", str(path)]
+    command = [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint"]
+    command += ["--steps", "10000000", "--seed", "3", "--chunk-size", "4096", "-o", str(path)]
     process = subprocess.Popen(command, env=env, stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 30

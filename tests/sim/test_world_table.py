@@ -48,7 +48,7 @@ def test_run_warns_in_one_line(tmp_path: Path) -> None:
     scenario = tmp_path / "blind.toml"
     scenario.write_text(ARM + "[feedback]\ntarget_deg = [90, 0]\n")
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_sim", "run", str(scenario), "--steps", "10"],
+        [sys.executable, "-m", "rsstp_cli.sim", "run", str(scenario), "--steps", "10"],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert done.returncode == 0

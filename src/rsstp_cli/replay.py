@@ -20,11 +20,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rsstp_cli._commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_replay.table_files import TABLE_FORMATS, sidecar_path, write_table
 from rsstp_replay.tables import TABLES, recording_table
-from rsstp_sim.commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_sim.files import check_output
 from rsstp_sim.words import counted
 
@@ -558,7 +558,7 @@ def _build_parser() -> Parser:
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(func=_cmd_export)
 
-    from rsstp_sweep.commands import add_report_parser  # the sweep's report (no Dask needed)
+    from rsstp_cli.sweep import add_report_parser  # the sweep's report (no Dask needed)
 
     add_report_parser(sub)
     return parser
