@@ -123,6 +123,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
             f"written by: rsstp {meta['package_version']} (Python {meta['python']}, "
             f"numpy {meta['numpy']}, mcap {meta['mcap']})"
         )
+        print(_metadata_text(recording))
     return 0
 
 
@@ -276,6 +277,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
         physics = check_physics(recording) if args.physics else None
     if args.json:
         document = findings.to_json()
+        document = {**document, "metadata_verified": recording.metadata_verified}
         if physics is not None:
             document = {**document, "physics": physics.to_json()}
         print(json.dumps(document, indent=2))
@@ -285,10 +287,23 @@ def _cmd_check(args: argparse.Namespace) -> int:
             f"{counted(versions, 'model version')}, {counted(events, 'event')}: every chunk read "
             "and checked"
         )
+        print(_metadata_text(recording))
         print(findings.to_text())
         if physics is not None:
             print(physics.to_text())
     return 0 if findings.holds and (physics is None or physics.holds) else 1
+
+
+def _metadata_text(recording: Recording) -> str:
+    if recording.metadata_verified:
+        return "metadata: verified by its checksum"
+    from rsstp_sim.recording.schemas import parse_version
+
+    version = max(recording.schema_versions.values(), key=parse_version)
+    return (
+        f"metadata: unverified (a schema {version} recording, written before the metadata "
+        "carried a checksum)"
+    )
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:

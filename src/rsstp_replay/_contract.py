@@ -38,6 +38,8 @@ from rsstp_sim.recording.records import RecordFormatError, ScenarioRecord, decod
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_NAME,
     MESSAGE_ENCODING,
+    METADATA_CHECKSUM_KEY,
+    METADATA_CHECKSUM_SINCE,
     METADATA_KEYS,
     METADATA_NAME,
     SCHEMA_ENCODING,
@@ -45,6 +47,7 @@ from rsstp_sim.recording.schemas import (
     STEP_NS,
     TOPICS,
     check_schema_version,
+    metadata_checksum,
     parse_version,
     version_refusal,
 )
@@ -58,7 +61,8 @@ _Ints = npt.NDArray[np.int64]
 @dataclass(frozen=True, slots=True)
 class CheckedFile:
     """A file that holds a recording, as :func:`check_file` found it: its channels by topic,
-    schema versions, metadata, message counts per topic (an unfinished file's cut at
+    schema versions, metadata (``metadata_verified``: by its checksum; False for a file older
+    than the checksum), message counts per topic (an unfinished file's cut at
     ``limit_ns``, its last recovered step), the last step, and the scenario. It reads the
     messages of a topic chunk by chunk for :class:`~rsstp_replay.recording.Recording`."""
 
@@ -66,6 +70,7 @@ class CheckedFile:
     channels: dict[str, int]
     schema_versions: dict[str, str]
     metadata: dict[str, str]
+    metadata_verified: bool
     topic_counts: dict[str, int]
     limit_ns: int | None
     n_steps: int
@@ -101,7 +106,7 @@ def check_file(container: Container) -> CheckedFile:
         )
     channels = rsstp_channels(container)
     schema_versions = check_schemas(container, channels)
-    metadata = read_metadata(container)
+    metadata, verified = read_metadata(container, schema_versions)
     counts = container.counts if container.counts is not None else count_messages(container)
     limit_ns: int | None = None
     if not container.data_complete:
@@ -124,6 +129,7 @@ def check_file(container: Container) -> CheckedFile:
         channels,
         schema_versions,
         metadata,
+        verified,
         topic_counts,
         limit_ns,
         n_step_messages - 1,
@@ -235,17 +241,38 @@ def check_schemas(container: Container, channels: dict[str, int]) -> dict[str, s
     return versions
 
 
-def read_metadata(container: Container) -> dict[str, str]:
-    """The ``rsstp`` metadata record, every key present."""
+def read_metadata(
+    container: Container, schema_versions: dict[str, str]
+) -> tuple[dict[str, str], bool]:
+    """The ``rsstp`` metadata record, every key present, and whether its checksum verified it:
+    a file of schema 2.2 or later must carry a checksum that matches; an older one has none,
+    and its metadata is read unverified (``schemas/README.md``, "The metadata checksum")."""
     path = container.path
     found = [m for m in container.metadata if m.name == METADATA_NAME]
     if not found:
         raise CorruptRecording(f"{path}: the {METADATA_NAME!r} metadata record is missing")
     metadata = dict(found[0].metadata)
+    recorded = metadata.get(METADATA_CHECKSUM_KEY)
+    if recorded is not None:
+        computed = metadata_checksum(metadata)
+        if recorded != computed:
+            raise CorruptRecording(
+                f"{path}: the {METADATA_NAME!r} metadata record fails its checksum: "
+                f"{METADATA_CHECKSUM_KEY} is {recorded[:80]!r}, its other keys hash to "
+                f"{computed} (the metadata was changed after it was written)"
+            )
+    else:
+        version = max(parse_version(v) for v in schema_versions.values())
+        if version >= METADATA_CHECKSUM_SINCE:
+            raise CorruptRecording(
+                f"{path}: the {METADATA_NAME!r} metadata record lacks its checksum "
+                f"{METADATA_CHECKSUM_KEY} (a schema {version[0]}.{version[1]} file must carry "
+                f"it, from {METADATA_CHECKSUM_SINCE[0]}.{METADATA_CHECKSUM_SINCE[1]} on)"
+            )
     missing = [key for key in METADATA_KEYS if key not in metadata]
     if missing:
         raise CorruptRecording(f"{path}: the {METADATA_NAME!r} metadata lacks the keys {missing}")
-    return metadata
+    return metadata, recorded is not None
 
 
 def cut_time(container: Container, step_channel: int) -> int:

@@ -153,10 +153,10 @@ def test_open_reads_the_scenario_metadata_and_counts(random_run: tuple[Path, Any
         assert recording.metadata["seed"] == str(SEED)
         assert recording.metadata["scenario_sha256"] == recording.scenario.sha256
         assert recording.schema_versions == {
-            "rsstp.Scenario": "2.1",
-            "rsstp.Step": "2.1",
-            "rsstp.Model": "2.1",
-            "rsstp.Event": "2.1",
+            "rsstp.Scenario": "2.2",
+            "rsstp.Step": "2.2",
+            "rsstp.Model": "2.2",
+            "rsstp.Event": "2.2",
         }
         assert "steps=0..2000" in repr(recording)
 
