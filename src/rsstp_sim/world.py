@@ -5,8 +5,8 @@ for a move depends only on the pose and the action, and the pose space is
 finite (integer angles), so every answer comes from the scenario's
 :class:`~rsstp_sim.world_table.WorldTable`, computed once and read back with a
 couple of array lookups per move: a small pose space's in vectorised blocks
-around the arm, a large one's (many links, small steps) move by move, each new
-move checked alone.
+around the arm, a large one's (many links, small steps) or a costly one's (many
+obstacles) move by move, each new move checked alone.
 """
 
 from __future__ import annotations
@@ -89,10 +89,15 @@ class World:
     def __init__(self, scenario: Scenario, *, per_move: bool | None = None) -> None:
         """``per_move``: grow the world table move by move (True) or in blocks of poses
         (False); by default per move exactly when the pose space is too large for a dense
-        table (see :mod:`rsstp_sim.world_table`). Both give the same answers."""
+        table, or the whole table would cost more than
+        :data:`~rsstp_sim.world_table.MAX_TABULATION_CHECKS` (many obstacles), since the
+        blocks double until they hold it (see :mod:`rsstp_sim.world_table`). Both give the
+        same answers."""
         self.scenario = scenario
         self.table = WorldTable(scenario)
-        self.per_move = not self.table.dense if per_move is None else per_move
+        if per_move is None:
+            per_move = not self.table.dense or self.table.heavy
+        self.per_move = per_move
         self.geometry = self.table.geometry
         self._actions = {action: k for k, action in enumerate(self.table.actions)}
         self._n_actions = len(self._actions)
