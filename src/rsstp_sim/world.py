@@ -39,7 +39,9 @@ class Pose:
     - ``distances``: ``(n, m)`` distance from tip ``k`` to obstacle ``j``'s surface.
 
     The sensation and the feedback are read at every step; the rest is computed from the
-    world table's row at first use (most poses of a long run are never asked for it).
+    world table's row at first use (most poses of a long run are never asked for it), and
+    kept, but for the distances of a table that keeps none (many obstacles), computed at
+    every read.
     """
 
     code: int
@@ -67,10 +69,12 @@ class Pose:
 
     @property
     def distances(self) -> FloatArray:
-        if self._distances is None:
-            object.__setattr__(self, "_distances", self._table.distances_of(self._row))
-        assert self._distances is not None
-        return self._distances
+        if self._distances is not None:
+            return self._distances
+        distances = self._table.distances_of(self._row)
+        if self._table.keeps_distances:  # else too many to keep for every pose visited
+            object.__setattr__(self, "_distances", distances)
+        return distances
 
 
 class World:
