@@ -162,3 +162,18 @@ def test_reading_a_recording_never_calls_back_up(finished: bool, tmp_path: Path)
     rank = {layer: at for at, layer in enumerate(READER_LAYERS)}
     assert {called for _, called in calls} >= {"_container", "_chunks", "_contract"}
     assert sorted({(a, b) for a, b in calls if rank[a] < rank[b]}) == []
+
+    def just_open() -> None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            open_recording(path)
+
+    # Opening: the recording finds the file's records (the container), then has them checked
+    # (the contract), which reads the scenario message through the chunks layer, which reads
+    # the chunk records through the container: one descent, no layer skipped on the way.
+    assert set(_calls_between_layers(just_open)) == {
+        ("recording", "_container"),
+        ("recording", "_contract"),
+        ("_contract", "_chunks"),
+        ("_chunks", "_container"),
+    }
