@@ -107,7 +107,9 @@ class Recording:
     ``seed``, ``strategy`` (its name), ``strategy_params``, ``recovered_steps`` (``None`` for a
     finished file, else ``n_steps``: the steps read from the complete chunks), ``scenario``
     (rebuilt from the ``scenario.toml`` attachment), ``scenario_record`` (the
-    ``/rsstp/scenario`` message), ``metadata`` (the ``rsstp`` metadata record) and
+    ``/rsstp/scenario`` message), ``metadata`` (the ``rsstp`` metadata record),
+    ``metadata_verified`` (its checksum matched; False for a file of schema 2.1 or older,
+    written before the checksum) and
     ``schema_versions`` (schema name -> ``"major.minor"`` found in the file).
 
     An unfinished file is cut before its last recovered step: that step's model and event
@@ -121,6 +123,7 @@ class Recording:
         self._ground_truth: GroundTruth | None = None
         self.schema_versions = file.schema_versions
         self.metadata = file.metadata
+        self.metadata_verified = file.metadata_verified
         self.topic_counts = file.topic_counts
         self.n_steps = file.n_steps
         self.recovered_steps: int | None = None if file.container.finished else self.n_steps
