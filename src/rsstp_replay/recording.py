@@ -313,7 +313,7 @@ class Recording:
         for ref, _, parts, times in self._chunks(topic):
             try:
                 heads = HEADS.decode(b"[" + b",".join(parts) + b"]")
-            except msgspec.DecodeError:  # decoded whole below, which names the problem
+            except (msgspec.DecodeError, RecursionError):  # decoded whole below: named there
                 heads = None
             if heads is None or len(heads) != len(parts):
                 records = self._file.decode_many(topic, parts, times, ref)
