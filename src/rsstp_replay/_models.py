@@ -12,30 +12,27 @@ import bisect
 from array import array
 from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 import msgspec
 
 from rsstp_replay.errors import CorruptRecording
 from rsstp_sim.errors import ModelError
-from rsstp_sim.recording.records import ModelRecord, OperationRecord, TransitionsRecord, encode
+from rsstp_sim.recording.records import ModelRecord, TransitionsRecord, encode
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["HEADS", "ChainCheck", "ModelHead", "build_model"]
 
 
-class ModelHead(msgspec.Struct, kw_only=True, gc=False):
-    """A ``/rsstp/model`` message read without its transitions (the parser skips them):
-    what :meth:`ChainCheck.head` needs to rebuild the version and write its bytes again."""
-
-    version: int
-    step: int
-    states: tuple[int, ...]
-    next_id: int
-    current: int
-    actions: tuple[int, ...]
-    operations: tuple[OperationRecord, ...]
-    deterministic: bool
-    nondeterministic_pairs: int
+ModelHead: Any = msgspec.defstruct(
+    "ModelHead",
+    [(f.name, f.type) for f in msgspec.structs.fields(ModelRecord) if f.name != "transitions"],
+    kw_only=True,
+    gc=False,
+)
+"""A ``/rsstp/model`` message read without its transitions (the parser skips them): the
+fields of :class:`~rsstp_sim.recording.records.ModelRecord` but those. What
+:meth:`ChainCheck.head` needs to rebuild the version and write its bytes again."""
 
 
 HEADS = msgspec.json.Decoder(list[ModelHead])
