@@ -251,7 +251,9 @@ def view(
     in_memory: rr.BinaryStream | None = None
     if target is not None and not spawn:
         in_memory = rr.binary_stream(recording=stream)
-        stream.send_blueprint(blueprint, make_active=False, make_default=True)
+        # Active as well as default: the web viewer ignores a default blueprint of a file it
+        # serves and lays the views out itself.
+        stream.send_blueprint(blueprint, make_active=True, make_default=True)
     else:
         sinks: list[rr.FileSink | rr.GrpcSink] = []
         if writing is not None:

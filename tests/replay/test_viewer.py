@@ -561,6 +561,22 @@ def test_the_blueprint_is_saved_with_the_step_timeline(reference: tuple[Recordin
     assert ["step"] in values
 
 
+def test_the_blueprint_is_made_active_so_a_viewer_lays_out_its_views(
+    reference: tuple[Recording, Rrd],
+) -> None:
+    """Rerun's own ``rrd print`` finds the command that makes the saved blueprint the active
+    and default one: without it the web viewer opened the file in its own grid of views (a
+    screenshot in headless Chromium showed it)."""
+    _, rrd = reference
+    rerun = Path(sys.executable).with_name("rerun")
+    printed = subprocess.run(
+        [str(rerun), "rrd", "print", str(rrd.path)], capture_output=True, text=True, check=True
+    ).stdout
+    commands = [line for line in printed.splitlines() if "BlueprintActivationCommand" in line]
+    assert len(commands) == 1
+    assert "make_active: true" in commands[0] and "make_default: true" in commands[0]
+
+
 def test_a_step_range(refined: tuple[Recording, Rrd], tmp_path: Path) -> None:
     recording, _ = refined
     out = tmp_path / "range.rrd"
