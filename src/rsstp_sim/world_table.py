@@ -406,6 +406,17 @@ class WorldTable:
         distances.flags.writeable = False
         return distances.reshape(n, m)
 
+    def truth_values(self, row: int) -> tuple[list[int], list[float], list[float]]:
+        """A row's joint angles, its points (``x0, y0, x1, y1, ...``: :meth:`positions_of`
+        flat) and its obstacle distances (tip by tip: :meth:`distances_of` flat), as plain
+        Python numbers (what a recorder encodes once per pose, without numpy's per-call work)."""
+        n_m = self.geometry.n * self.geometry.m
+        distances = self.distances[row * n_m : (row + 1) * n_m].tolist()
+        if n_m and math.isnan(distances[0]):
+            distances = self.distances_of(row).ravel().tolist()
+        positions = self.positions[row * self.width : (row + 1) * self.width].tolist()
+        return self.angles_of(self.codes[row]), positions, distances
+
     def angles(self) -> IntArray:
         """``(rows, n)`` joint angles of every row."""
         codes = np.frombuffer(self.codes, dtype=np.int64)
