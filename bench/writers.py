@@ -93,18 +93,25 @@ def messages_of(steps: int) -> tuple[list[Message], dict[str, tuple[str, bytes]]
     return found, schemas
 
 
+def _channels(
+    writer: ChunkedWriter | Writer, schemas: dict[str, tuple[str, bytes]]
+) -> dict[str, int]:
+    """Each topic's channel, with its schema, registered in the recording's order."""
+    return {
+        topic: writer.register_channel(
+            topic, "json", writer.register_schema(name, "jsonschema", data)
+        )
+        for topic, (name, data) in schemas.items()
+    }
+
+
 def write_chunked(
     path: Path, messages: list[Message], schemas: dict[str, tuple[str, bytes]]
 ) -> int:
     out = CountingSideFile(path)
     writer = ChunkedWriter(out, chunk_size=CHUNK)
     writer.start(profile="", library="bench")
-    channels = {
-        topic: writer.register_channel(
-            topic, "json", writer.register_schema(name, "jsonschema", data)
-        )
-        for topic, (name, data) in schemas.items()
-    }
+    channels = _channels(writer, schemas)
     add = writer.add_message
     for topic, log_time, data in messages:
         add(channels[topic], log_time, data)
@@ -117,12 +124,7 @@ def write_mcap(path: Path, messages: list[Message], schemas: dict[str, tuple[str
     out = CountingFile(path)
     writer = Writer(out, chunk_size=CHUNK, compression=CompressionType.ZSTD)  # type: ignore[arg-type]
     writer.start(profile="", library="bench")
-    channels = {
-        topic: writer.register_channel(
-            topic, "json", writer.register_schema(name, "jsonschema", data)
-        )
-        for topic, (name, data) in schemas.items()
-    }
+    channels = _channels(writer, schemas)
     add = writer.add_message
     for topic, log_time, data in messages:
         add(channels[topic], log_time, data, log_time)
