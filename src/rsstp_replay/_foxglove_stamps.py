@@ -17,6 +17,7 @@ from collections.abc import Callable
 
 from foxglove.messages import FrameTransforms, SceneUpdate
 
+from rsstp_replay.errors import ReplayError
 from rsstp_sim.recording.schemas import STEP_NS
 
 __all__ = ["PoseMessages", "timestamp_field"]
@@ -64,7 +65,10 @@ def _fields(data: bytes, tag: int) -> list[bytes]:
     at = 0
     while at < len(data):
         if data[at] != tag:
-            raise ValueError(f"expected field tag {tag:#x} at byte {at}, found {data[at]:#x}")
+            raise ReplayError(
+                f"foxglove-sdk's encoding: expected field tag {tag:#x} at byte {at}, found "
+                f"{data[at]:#x} (its messages' layout changed: the stamps need the same change)"
+            )
         at += 1
         length = shift = 0
         while True:
