@@ -14,7 +14,7 @@ seconds = time.perf_counter() - began
 usage = resource.getrusage(resource.RUSAGE_CHILDREN)
 cpu = usage.ru_utime + usage.ru_stime
 stderr = done.stderr.decode().strip().replace(chr(10), " | ")
-print(done.returncode, seconds, usage.ru_maxrss, cpu, stderr)
+print(done.returncode, seconds, cpu, usage.ru_maxrss, stderr)
 """
 
 
@@ -25,12 +25,12 @@ def measure(command: list[str]) -> tuple[float, float]:
 
 
 def measure_cpu(command: list[str]) -> tuple[float, float, float]:
-    """Wall seconds, CPU seconds (user and system, every thread) and peak RSS (GiB) of
-    ``command`` in a fresh process."""
+    """Wall seconds, CPU seconds (user and system: the figure on a loaded machine) and peak
+    RSS (GiB) of ``command`` in a fresh process."""
     done = subprocess.run(
         [sys.executable, "-c", _RUNNER, *command], capture_output=True, text=True, check=True
     )
-    code, seconds, peak_kib, cpu, stderr = done.stdout.split(" ", 4)
+    code, seconds, cpu, peak_kib, stderr = done.stdout.split(" ", 4)
     if int(code) not in (0, 1):  # audit exits 1 on a finding it was asked to gate on
         sys.exit(f"{' '.join(command)} failed ({code}): {stderr}")
     return float(seconds), float(cpu), int(peak_kib) / 2**20

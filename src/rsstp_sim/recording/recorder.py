@@ -46,11 +46,13 @@ from rsstp_sim.recording.output import SideFileWriter, open_side_file
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_MEDIA_TYPE,
     ATTACHMENT_NAME,
+    METADATA_CHECKSUM_KEY,
     METADATA_KEYS,
     METADATA_NAME,
     SCHEMA_NAMES,
     STEP_NS,
     TOPICS,
+    metadata_checksum,
     schema_bytes,
 )
 from rsstp_sim.recording.step_messages import StepMessages
@@ -207,7 +209,9 @@ class Recorder:
             "strategy_version": origin.version or "",
             "scenario_sha256": scenario.sha256,
         }
-        writer.add_metadata(METADATA_NAME, {key: meta[key] for key in METADATA_KEYS})
+        values = {key: meta[key] for key in METADATA_KEYS}
+        values[METADATA_CHECKSUM_KEY] = metadata_checksum(values)
+        writer.add_metadata(METADATA_NAME, values)
         writer.add_attachment(
             0, 0, ATTACHMENT_NAME, ATTACHMENT_MEDIA_TYPE, scenario.source.encode("utf-8")
         )

@@ -28,7 +28,12 @@ if TYPE_CHECKING:
     from rsstp_sim.geometry import Blocker
     from rsstp_sim.world import Pose
 
-__all__ = ["StepMessages"]
+__all__ = ["POSE_CACHE_BYTES", "StepMessages"]
+
+POSE_CACHE_BYTES = 128 * 1024 * 1024
+"""The most bytes of poses' encoded parts kept for the poses met again (three-joint's 39,232
+poses take 23 MB; a pose among 1,000 obstacles 60 KB, its 3,000 distances): the poses met
+after that are encoded at each visit."""
 
 _HEAD = b'{"step":%d,"agent":{"action":%d,"state_before":%d,"internal_state":%d%b%d'
 _FIRST_HEAD = b'{"step":0,"agent":{"internal_state":%d%b%d'
@@ -45,10 +50,11 @@ class StepMessages:
     kept for as long as the run's world keeps its poses.
     """
 
-    def __init__(self) -> None:
+    def __init__(self, *, cache_bytes: int = POSE_CACHE_BYTES) -> None:
         # pose -> (the agent part after internal_state, the tail of a step that moved with
         # a transition, where its truth's "blocked" field starts in that tail)
         self._poses: dict[Pose, tuple[bytes, bytes, int]] = {}
+        self._room = cache_bytes  # bytes the kept parts may still take
         self._truth: tuple[bytes, bytes] | None = None  # templates around "blocked"
         self._blocked_truth: dict[Blocker, bytes] = {}
         self._blocked_events: dict[tuple[int, Blocker], bytes] = {}
@@ -62,11 +68,11 @@ class StepMessages:
         before = self._truth[0] % (*angles, *texts[1:points])
         after = self._truth[1] % tuple(texts[points:])
         head = _AGENT % (b"true" if pose.sensation else b"false", texts[0])
-        parts = self._poses[pose] = (
-            head,
-            b"".join((_MOVED, before, _UNBLOCKED, after, b"}}")),
-            len(_MOVED) + len(before),
-        )
+        moved = b"".join((_MOVED, before, _UNBLOCKED, after, b"}}"))
+        parts = (head, moved, len(_MOVED) + len(before))
+        if self._room > 0:  # bounded: many obstacles, long runs
+            self._poses[pose] = parts
+            self._room -= len(head) + len(moved)
         return parts
 
     def first(self, pose: Pose, *, internal_state: int, model_version: int) -> tuple[bytes, bytes]:
