@@ -120,3 +120,19 @@ def test_every_message_is_the_encoders(
         assert no_transition
     if scenario_name in ("two-joint-30", "thesis-algo"):
         assert len(versions) > 1
+
+
+def test_past_its_bound_the_pose_cache_keeps_nothing_more_and_the_bytes_stay() -> None:
+    """A world of many obstacles or a long run: once the cached parts reach the bound, the
+    poses met after are encoded at each visit, to the same bytes."""
+    runner = Runner(load_scenario("three-joint"), RandomStrategy(), seed=5)
+    messages = StepMessages(cache_bytes=3000)  # a pose's parts are about 500 bytes
+    poses = set()
+    for _ in range(500):
+        outcome = runner.step()
+        poses.add(runner.world.current)
+        head, tail = messages.step(outcome, runner.world.current, runner.model.version)
+        assert head + tail == expected_step(runner, outcome), outcome
+    assert len(poses) > 50
+    sizes = [len(head) + len(tail) for head, tail, _ in messages._poses.values()]
+    assert sum(sizes[:-1]) < 3000 <= sum(sizes)  # kept while below the bound, then no more
