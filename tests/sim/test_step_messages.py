@@ -13,6 +13,7 @@ from collections.abc import Callable
 from typing import ClassVar
 
 import pytest
+from steps import step_record_after
 
 from rsstp_sim import (
     AgentView,
@@ -69,18 +70,7 @@ CASES: list[tuple[str, Callable[[], Strategy]]] = [
 
 def expected_step(runner: Runner, outcome: StepOutcome | None) -> bytes:
     """``records.encode`` of the builders' step record (the independent computation)."""
-    pose, model = runner.world.current, runner.model
-    record = builders.step_record(
-        0 if outcome is None else outcome.step,
-        pose,
-        action=None if outcome is None else outcome.action,
-        state_before=None if outcome is None else outcome.state_before,
-        internal_state=model.current if outcome is None else outcome.state_after,
-        model_version=model.version,
-        no_transition=outcome is not None and outcome.no_transition,
-        blocker=None if outcome is None else outcome.blocker,
-    )
-    return records.encode(record)
+    return records.encode(step_record_after(runner.world.current, runner.model, outcome))
 
 
 @pytest.mark.parametrize(("scenario_name", "strategy"), CASES, ids=[c[0] for c in CASES])
