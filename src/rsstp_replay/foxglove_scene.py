@@ -214,13 +214,15 @@ def _write_scene(
         lambda row: draw.links(None, poses.angles_deg[row].tolist()),
         cached=_CACHED_POSES,
     )
-    at = messages.at
+    at, next_event = messages.at, log_events.next_step
     for row, (step, code) in enumerate(poses.rows()):
-        if step > log_events.next_step:
+        if step > next_event:
             log_events.write_before(step)
+            next_event = log_events.next_step
         head, tail, links = at(step, code, row)
-        add(arm, step * STEP_NS, head, tail)
-        add(transforms, step * STEP_NS, links)
+        log_time = step * STEP_NS
+        add(arm, log_time, head, tail)
+        add(transforms, log_time, links)
     log_events.write_before(math.inf)
     writer.finish()
 
