@@ -34,6 +34,10 @@ other jobs (load 3 to 10, so the figures moved by up to 2x between runs), best o
     recorded steps/s       >= 83,000   target >= 50,000: met
     on disk                74.2 bytes/step (three-joint, float feedback)  target <= 120: met
 
+(Those figures and the breakdown below are from before 2026-11-26, when the recorder wrote
+through mcap's ``Writer``; ``bench/record_vs_run.py`` measures the recorder since, and
+``--profile`` times its parts: the step message, the chunked writer.)
+
 Where a warm recorded step goes (``--profile``, the parts alone, us/step): the simulation
 2.8, the step message bytes (``Recorder._step_bytes``, msgspec and joins) 2.0, mcap's
 ``Writer.add_message`` without compression 3.6-4.5, zstd 0.5-1.0. cProfile of the whole
@@ -62,8 +66,11 @@ from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
 from rsstp_sim import RandomStrategy, Runner, builtin_scenarios, load_scenario
+from rsstp_sim.recording.chunks import ChunkedWriter
+from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.recorder import DEFAULT_CHUNK_SIZE, Recorder
 from rsstp_sim.recording.schemas import STEP_NS
+from rsstp_sim.recording.step_messages import StepMessages
 from rsstp_sim.scenario import Scenario
 from step_rate import float_mode  # bench/ is the script folder
 
@@ -232,6 +239,18 @@ def _add_all(data: list[bytes], compression: CompressionType) -> None:
     writer.finish()
 
 
+def _add_chunked(data: list[bytes], path: Path) -> None:
+    output = SideFileWriter(io.FileIO(path, "w"), lambda: 0)
+    writer = ChunkedWriter(output, chunk_size=DEFAULT_CHUNK_SIZE)
+    writer.start(profile="", library="bench")
+    channel = writer.register_channel("/rsstp/step", "json", 0)
+    add = writer.add_message
+    for t, message in enumerate(data):
+        add(channel, t * STEP_NS, message)
+    writer.finish()
+    output.close()
+
+
 def _isolated_parts(steps: int, repeats: int) -> None:
     scenario = float_mode("three-joint")
     runner = Runner(scenario, RandomStrategy(), seed=SEED)
@@ -246,26 +265,26 @@ def _isolated_parts(steps: int, repeats: int) -> None:
     step_s = _best(repeats, simulate)
     runner.reset()
     outcomes = [(runner.step(), runner.world.current) for _ in range(steps)]
-    with tempfile.TemporaryDirectory() as tmp:
-        recorder = new_recorder(Path(tmp), scenario, warm_actions=None)
-        step_bytes = recorder._step_bytes
-        data: list[bytes] = []
+    step_message = StepMessages().step
+    data: list[bytes] = []
 
-        def encode() -> None:
-            data[:] = [step_bytes(o.step, o, pose) for o, pose in outcomes]
+    def encode() -> None:
+        data[:] = [b"".join(step_message(o, pose, 0)) for o, pose in outcomes]
 
-        encode_s = _best(repeats, encode)
-        recorder.close()
+    encode_s = _best(repeats, encode)
     add_s = _best(repeats, lambda: _add_all(data, CompressionType.NONE))
     add_zstd_s = _best(repeats, lambda: _add_all(data, CompressionType.ZSTD))
+    with tempfile.TemporaryDirectory() as tmp:
+        chunked_s = _best(repeats, lambda: _add_chunked(data, Path(tmp) / "chunked.mcap"))
 
     print()
     print(f"The parts alone (warm, {steps:,} steps, best of {repeats}, us/step):")
     rows: list[tuple[str, float]] = [
         ("Runner.step (the simulation, unrecorded)", step_s),
-        ("step message bytes (Recorder._step_bytes)", encode_s),
+        ("step message bytes (StepMessages.step, joined)", encode_s),
         ("mcap Writer.add_message, no compression, to memory", add_s),
         ("zstd chunk compression (add_message zstd - none)", add_zstd_s - add_s),
+        ("the recorder's ChunkedWriter, zstd on its thread, to a file", chunked_s),
     ]
     for label, seconds in rows:
         print(f"  {label:<52} {1e6 * seconds / steps:6.2f}")
@@ -275,7 +294,7 @@ GROUPS = (
     "zstd compression",
     "file writes (os)",
     "msgspec JSON encoding",
-    "mcap writer (records, chunk builder)",
+    "chunked writer (records, chunk builder)",
     "recorder (step bytes, loop, events)",
     "simulation (runner, world, memory, strategy)",
 )
@@ -291,7 +310,7 @@ def _group(filename: str, name: str) -> str | None:
         if "msgspec" in name:
             return GROUPS[2]
         return None
-    if f"{os.sep}mcap{os.sep}" in filename:
+    if f"{os.sep}mcap{os.sep}" in filename or filename.endswith(f"recording{os.sep}chunks.py"):
         return GROUPS[3]
     if f"{os.sep}recording{os.sep}" in filename:
         return GROUPS[4]

@@ -5,8 +5,11 @@
 The messages are those of a real recording (``rsstp-sim record three-joint --strategy random
 --seed 1``, its ``/rsstp/step`` messages and the others, in file order), written again by:
 
+- ``rsstp chunked``: the recorder's own writer (``rsstp_sim.recording.chunks``, the ``mcap``
+  ``Writer``'s bytes from encoded messages, each chunk's CRC, zstd and write on a second
+  thread), one ``add_message`` per message, as the recorder does since 2026-11-26;
 - ``mcap``: the Python ``mcap`` library's ``Writer.add_message``, one call per message, as the
-  recorder does today;
+  recorder did before;
 - ``foxglove-sdk``: the Rust writer of the ``foxglove-sdk`` package (``foxglove.open_mcap``
   with its own context, one ``Channel.log`` per message, multithreaded compression off),
   writing through a Python file object so that every finished chunk reaches the OS as the
@@ -32,26 +35,51 @@ from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
 from _recordings import random_three_joint
-from rsstp_sim.recording.output import WriteThrough
+from rsstp_sim.recording.chunks import ChunkedWriter
+from rsstp_sim.recording.output import SideFileWriter
 
 BIN = Path(sys.executable).parent
 CHUNK = 1024 * 1024
 Message = tuple[str, int, bytes]  # topic, log time (ns), data
 
 
-class CountingFile(WriteThrough):
-    """The recorder's write-through file, counting the writes."""
+class CountingFile:
+    """A write-through file (no user-space buffer, as the recorder writes), counting writes."""
+
+    def __init__(self, path: Path) -> None:
+        self._raw = io.FileIO(path, "w")
+        self.writes = 0
+
+    def write(self, data: bytes | bytearray | memoryview) -> int:
+        self.writes += 1
+        view = memoryview(data)
+        while view:
+            view = view[self._raw.write(view) or 0 :]
+        return len(data)
+
+    def tell(self) -> int:
+        return self._raw.tell()
+
+    def seek(self, offset: int, whence: int = 0) -> int:  # the foxglove writer seeks
+        return self._raw.seek(offset, whence)
+
+    def flush(self) -> None:
+        return None
+
+    def close(self) -> None:
+        self._raw.close()
+
+
+class CountingSideFile(SideFileWriter):
+    """The recorder's side file writer, counting the writes."""
 
     def __init__(self, path: Path) -> None:
         super().__init__(io.FileIO(path, "w"), lambda: 0)
         self.writes = 0
 
-    def write(self, data: bytes | bytearray | memoryview) -> int:
+    def _write(self, data: bytes, mark: int) -> None:
         self.writes += 1
-        return super().write(data)
-
-    def seek(self, offset: int, whence: int = 0) -> int:  # the foxglove writer seeks
-        return self._raw.seek(offset, whence)
+        super()._write(data, mark)
 
 
 def messages_of(steps: int) -> tuple[list[Message], dict[str, tuple[str, bytes]]]:
@@ -65,16 +93,38 @@ def messages_of(steps: int) -> tuple[list[Message], dict[str, tuple[str, bytes]]
     return found, schemas
 
 
-def write_mcap(path: Path, messages: list[Message], schemas: dict[str, tuple[str, bytes]]) -> int:
-    out = CountingFile(path)
-    writer = Writer(out, chunk_size=CHUNK, compression=CompressionType.ZSTD)  # type: ignore[arg-type]
-    writer.start(profile="", library="bench")
-    channels = {
+def _channels(
+    writer: ChunkedWriter | Writer, schemas: dict[str, tuple[str, bytes]]
+) -> dict[str, int]:
+    """Each topic's channel, with its schema, registered in the recording's order."""
+    return {
         topic: writer.register_channel(
             topic, "json", writer.register_schema(name, "jsonschema", data)
         )
         for topic, (name, data) in schemas.items()
     }
+
+
+def write_chunked(
+    path: Path, messages: list[Message], schemas: dict[str, tuple[str, bytes]]
+) -> int:
+    out = CountingSideFile(path)
+    writer = ChunkedWriter(out, chunk_size=CHUNK)
+    writer.start(profile="", library="bench")
+    channels = _channels(writer, schemas)
+    add = writer.add_message
+    for topic, log_time, data in messages:
+        add(channels[topic], log_time, data)
+    writer.finish()
+    out.close()
+    return out.writes
+
+
+def write_mcap(path: Path, messages: list[Message], schemas: dict[str, tuple[str, bytes]]) -> int:
+    out = CountingFile(path)
+    writer = Writer(out, chunk_size=CHUNK, compression=CompressionType.ZSTD)  # type: ignore[arg-type]
+    writer.start(profile="", library="bench")
+    channels = _channels(writer, schemas)
     add = writer.add_message
     for topic, log_time, data in messages:
         add(channels[topic], log_time, data, log_time)
@@ -129,6 +179,7 @@ def main() -> None:
     messages, schemas = messages_of(args.steps)
     print(f"{len(messages):,} messages ({args.steps:,} steps of three-joint, random)")
     writers: dict[str, Callable[[Path, list[Message], dict[str, tuple[str, bytes]]], int]] = {
+        "rsstp chunked": write_chunked,
         "mcap": write_mcap,
         "foxglove-sdk": write_foxglove,
     }

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import struct
 from collections.abc import Generator
+from contextlib import closing
 from pathlib import Path
 
 import numpy as np
@@ -174,15 +175,17 @@ def topic_chunks(
     messages are found through each chunk's message index, anything else by walking the
     chunk's records; an unfinished file's messages stop at ``limit_ns``."""
     path = container.path
-    with container.open() as stream:
-        for ref in container.chunks:
-            if ref.channels is not None and channel not in ref.channels:
-                continue
-            if step is not None and not ref.start_ns <= step * STEP_NS <= ref.end_ns:
-                continue
-            if limit_ns is not None and ref.start_ns >= limit_ns:
-                break
-            data = container.chunk_data(stream, ref)
+    refs = []
+    for ref in container.chunks:
+        if ref.channels is not None and channel not in ref.channels:
+            continue
+        if step is not None and not ref.start_ns <= step * STEP_NS <= ref.end_ns:
+            continue
+        if limit_ns is not None and ref.start_ns >= limit_ns:
+            break
+        refs.append(ref)
+    with container.open() as stream, closing(container.chunks_data(refs)) as chunks:
+        for ref, data in zip(refs, chunks, strict=True):
             cut = limit_ns if limit_ns is not None and ref.end_ns >= limit_ns else None
             if cut is None:
                 offsets = container.message_offsets(stream, ref, channel)

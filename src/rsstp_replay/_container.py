@@ -16,7 +16,8 @@ import io
 import os
 import struct
 import zlib
-from collections.abc import Callable
+from collections.abc import Callable, Generator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO
@@ -102,6 +103,28 @@ class Container:
                 f"{ref.length} bytes, the file ends after {len(raw)}"
             )
         return chunk_records(self.path, raw, ref.offset)
+
+    def chunks_data(self, refs: Sequence[ChunkRef]) -> Generator[bytes, None, None]:
+        """:meth:`chunk_data` of each chunk of ``refs``, in order, the next one read,
+        decompressed and checked on a second thread (file reads, zstd and CRCs release the
+        GIL) while the caller works on this one; an error is raised where its chunk comes."""
+        if len(refs) < 2:
+            with self.open() as stream:
+                yield from (self.chunk_data(stream, ref) for ref in refs)
+            return
+        with (
+            self.open() as stream,
+            ThreadPoolExecutor(max_workers=1, thread_name_prefix="rsstp-chunks") as ahead,
+        ):
+            coming = ahead.submit(self.chunk_data, stream, refs[0])
+            try:
+                for following in [*refs[1:], None]:
+                    data = coming.result()
+                    if following is not None:
+                        coming = ahead.submit(self.chunk_data, stream, following)
+                    yield data
+            finally:
+                coming.cancel()
 
     def message_offsets(self, stream: BinaryIO, ref: ChunkRef, channel: int) -> _Offsets | None:
         """Where the messages of ``channel`` start in the chunk's records, in order, from the

@@ -25,22 +25,31 @@ A metadata record ``rsstp.scene`` names what the scene was made from (scenario a
 SHA-256, strategy, seed, steps) and by which ``rsstp``. The world is the plane z = 0, in the
 recording's length unit. The ``log_time`` (and ``publish_time``) and the ``timestamp`` of
 every message of step ``t`` are ``t * 1,000,000`` ns, as in the recording, and nothing else
-holds a time: the same recording gives the same bytes (with the same foxglove-sdk, whose name
-and version the file's header gives).
+holds a time: the same recording gives the same bytes (with the same foxglove-sdk, whose
+version the file's header gives).
+
+The messages are foxglove-sdk's (its schemas, registered as it registers them, and its
+protobuf encoding); the file is written by the recorder's chunked MCAP writer
+(:mod:`rsstp_sim.recording.chunks`, zstd chunks, every index), not by one SDK call per
+message: the arm's entity and the links' transforms of a pose are encoded once without their
+timestamp, which each step puts in front (it is the first field of both, see
+:mod:`rsstp_replay._foxglove_stamps`).
 """
 
 from __future__ import annotations
 
+import io
 import math
 import os
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
+from importlib import metadata as distributions
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
-from foxglove.channels import FrameTransformsChannel, LogChannel, SceneUpdateChannel
+import pandas as pd
 from foxglove.messages import (
     Color,
     CylinderPrimitive,
@@ -60,16 +69,18 @@ from foxglove.messages import (
     Vector3,
 )
 
-from rsstp_replay._foxglove_writer import open_scene
+from rsstp_replay._decode import pose_numbers
+from rsstp_replay._foxglove_stamps import PoseMessages
 from rsstp_replay.errors import ReplayError
 from rsstp_sim import __version__, palette
 from rsstp_sim.files import written_whole
+from rsstp_sim.geometry import ArmGeometry
+from rsstp_sim.recording.chunks import ChunkedWriter
+from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.words import counted
 
 if TYPE_CHECKING:
-    import pandas as pd
-
     from rsstp_replay.recording import Recording
     from rsstp_sim.scenario import Scenario
 
@@ -98,7 +109,9 @@ _OBSTACLE_HEIGHT = 0.01
 _BLOCK = 65_536
 """Poses turned into Python numbers at a time."""
 _CACHED_POSES = 65_536
-"""Arm poses whose primitives are kept (three-joint has 39,232 reachable poses)."""
+"""Poses whose encoded messages are kept (three-joint has 39,232 reachable poses)."""
+_CHUNK_SIZE = 1024 * 1024
+"""Bytes of messages per zstd chunk (foxglove-sdk's writer's default too)."""
 
 
 @dataclass(frozen=True)
@@ -131,9 +144,9 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
     """
     out = Path(path)
     scenario = recording.scenario
-    steps = recording.steps()
+    steps = recording.steps(geometry=False)
     n_steps = len(steps)
-    poses = _ArmPoses.from_steps(steps, scenario.n_joints, source=recording.path)
+    poses = _ArmPoses.from_steps(steps, scenario, source=recording.path)
     del steps  # the poses where the arm moved are all that is kept of it
     events = recording.events()
     metadata = {
@@ -147,23 +160,16 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
     }
     draw = _Drawing(scenario)
 
-    with written_whole(out) as side, open_scene(side) as scene:
-        scene.writer.write_metadata("rsstp.scene", metadata)
-        context = scene.context
-        arm = SceneUpdateChannel(ARM_TOPIC, context=context)
-        static = SceneUpdateChannel(STATIC_TOPIC, context=context)
-        transforms = FrameTransformsChannel(TRANSFORMS_TOPIC, context=context)
-        logs = _EventLogs(events, LogChannel(LOG_TOPIC, context=context))
-        static.log(draw.static_scene(), log_time=0)
-        transforms.log(draw.fixed_transforms(), log_time=0)
-        for step, points, angles_deg in poses.rows():
-            logs.write_before(step)
-            log_time = step * STEP_NS
-            stamp = _timestamp(step)
-            arm.log(draw.arm(stamp, points), log_time=log_time)
-            transforms.log(draw.links(stamp, angles_deg), log_time=log_time)
-            scene.check()
-        logs.write_before(math.inf)
+    with written_whole(out) as side:
+        output = SideFileWriter(io.FileIO(side, "w"), lambda: 0)
+        try:
+            writer = ChunkedWriter(output, chunk_size=_CHUNK_SIZE)
+            _write_scene(writer, draw, poses, events, metadata)
+        except BaseException:  # a full disk, Ctrl-C: no part of a scene stays
+            output.close()
+            side.unlink(missing_ok=True)
+            raise
+        output.close()
     return SceneExport(
         path=out,
         steps=n_steps,
@@ -173,15 +179,73 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
     )
 
 
-class _EventLogs:
-    """The events as ``foxglove.Log`` messages on ``channel``, written in step order."""
+def _write_scene(
+    writer: ChunkedWriter,
+    draw: _Drawing,
+    poses: _ArmPoses,
+    events: pd.DataFrame,
+    metadata: dict[str, str],
+) -> None:
+    """The scene's records, in the order foxglove-sdk's writer gives them: the channels as
+    first logged on, the metadata, then the messages in step order."""
+    library = f"rsstp {__version__} (foxglove-sdk {_sdk_version()} messages)"
+    writer.start(profile="", library=library)
+    schemas = {
+        message: writer.register_schema(schema.name, schema.encoding, schema.data)
+        for message in (SceneUpdate, FrameTransforms, Log)
+        for schema in (message.get_schema(),)
+    }
+    static, transforms, arm, logs = (
+        writer.register_channel(topic, "protobuf", schemas[message])
+        for topic, message in (
+            (STATIC_TOPIC, SceneUpdate),
+            (TRANSFORMS_TOPIC, FrameTransforms),
+            (ARM_TOPIC, SceneUpdate),
+            (LOG_TOPIC, Log),
+        )
+    )
+    writer.add_metadata("rsstp.scene", metadata)
+    add = writer.add_message
+    add(static, 0, draw.static_scene().encode())
+    add(transforms, 0, draw.fixed_transforms().encode())
+    log_events = _EventLogs(events, lambda at, data: add(logs, at, data))
+    messages = PoseMessages(
+        lambda row: draw.arm(None, poses.points[row].tolist()),
+        lambda row: draw.links(None, poses.angles_deg[row].tolist()),
+        cached=_CACHED_POSES,
+    )
+    at, next_event = messages.at, log_events.next_step
+    for row, (step, code) in enumerate(poses.rows()):
+        if step > next_event:
+            log_events.write_before(step)
+            next_event = log_events.next_step
+        head, tail, links = at(step, code, row)
+        log_time = step * STEP_NS
+        add(arm, log_time, head, tail)
+        add(transforms, log_time, links)
+    log_events.write_before(math.inf)
+    writer.finish()
 
-    def __init__(self, events: pd.DataFrame, channel: LogChannel) -> None:
+
+def _sdk_version() -> str:
+    try:
+        return distributions.version("foxglove-sdk")
+    except distributions.PackageNotFoundError:  # pragma: no cover - it is a dependency
+        return "unknown"
+
+
+class _EventLogs:
+    """The events as ``foxglove.Log`` messages, handed to ``write(log_time, data)`` in step
+    order."""
+
+    def __init__(self, events: pd.DataFrame, write: Callable[[int, bytes], None]) -> None:
         self.steps: list[int] = events["step"].to_numpy(np.int64).tolist()
         self.kinds: list[str] = events["kind"].astype(str).tolist()
         self.texts: list[str] = events["text"].astype(str).tolist()
-        self.channel = channel
+        self.write = write
         self.written = 0
+        self.next_step: float = self.steps[0] if self.steps else math.inf
+        """The step of the next event not yet written."""
 
     def write_before(self, step: float) -> None:
         """Write the events of the steps before ``step`` not yet written."""
@@ -192,45 +256,49 @@ class _EventLogs:
             message = Log(
                 timestamp=_timestamp(at), level=level, message=texts[self.written], name=kind
             )
-            self.channel.log(message, log_time=at * STEP_NS)
+            self.write(at * STEP_NS, message.encode())
             self.written += 1
+        self.next_step = steps[self.written] if self.written < len(steps) else math.inf
 
 
 @dataclass(frozen=True)
 class _ArmPoses:
-    """The arm at step 0 and at every step where it moved: ``steps`` (m), ``points`` (m rows of
-    the ``n + 1`` joint positions, base first, as x0, y0, x1, y1, ...) and ``angles_deg`` (m
-    rows of the ``n`` relative joint angles)."""
+    """The arm at step 0 and at every step where it moved: ``steps`` (m), ``codes`` (m pose
+    codes, ``sum_j angle_j * 360**j``), ``points`` (m rows of the ``n + 1`` joint positions,
+    base first, as x0, y0, x1, y1, ...) and ``angles_deg`` (m rows of the ``n`` relative
+    joint angles). The points are computed from the angles as the recorder computes them
+    (the reader checks that the recording's are those, bit for bit), once per distinct pose.
+    """
 
     steps: npt.NDArray[np.int64]
+    codes: npt.NDArray[np.int64]
     points: npt.NDArray[np.float64]
     angles_deg: npt.NDArray[np.int64]
 
     @classmethod
-    def from_steps(cls, steps: pd.DataFrame, n_joints: int, *, source: Path) -> _ArmPoses:
+    def from_steps(cls, steps: pd.DataFrame, scenario: Scenario, *, source: Path) -> _ArmPoses:
         numbers = _step_numbers(steps, source=source)
-        columns = [f"joint{k}_{axis}" for k in range(n_joints + 1) for axis in "xy"]
-        points = steps[columns].to_numpy(np.float64)
-        angles = steps[[f"angle_deg_{j}" for j in range(n_joints)]].to_numpy(np.int64)
+        n = scenario.n_joints
+        angles = steps[[f"angle_deg_{j}" for j in range(n)]].to_numpy(np.int64)
         moved = np.ones(len(numbers), bool)
-        moved[1:] = (angles[1:] != angles[:-1]).any(axis=1) | (points[1:] != points[:-1]).any(
-            axis=1
-        )
-        return cls(numbers[moved], points[moved], angles[moved])
+        moved[1:] = (angles[1:] != angles[:-1]).any(axis=1)
+        angles = angles[moved]
+        places = 360 ** np.arange(n, dtype=np.int64)
+        codes = angles @ places
+        index, distinct = pd.factorize(codes)
+        distinct_angles = np.asarray(distinct)[:, None] // places % 360
+        positions, _ = pose_numbers(ArmGeometry.from_scenario(scenario), distinct_angles)
+        points = positions.reshape(len(distinct), 2 * (n + 1)).take(index, axis=0)
+        return cls(numbers[moved], codes, points, angles)
 
     def __len__(self) -> int:
         return len(self.steps)
 
-    def rows(self) -> Iterator[tuple[int, list[float], list[int]]]:
-        """``(step, points, angles_deg)`` as Python numbers, a block of rows at a time."""
+    def rows(self) -> Iterator[tuple[int, int]]:
+        """``(step, pose code)`` of every row as Python numbers, a block at a time."""
         for start in range(0, len(self.steps), _BLOCK):
             block = slice(start, start + _BLOCK)
-            yield from zip(
-                self.steps[block].tolist(),
-                self.points[block].tolist(),
-                self.angles_deg[block].tolist(),
-                strict=True,
-            )
+            yield from zip(self.steps[block].tolist(), self.codes[block].tolist(), strict=True)
 
 
 def _step_numbers(steps: pd.DataFrame, *, source: Path) -> npt.NDArray[np.int64]:
@@ -277,9 +345,6 @@ class _Drawing:
         ends = [Vector3(x=length, y=0.0, z=0.0) for length in scenario.lengths]
         self.origin, self.tip_offset = origin, ends[-1]
         self.link_offsets = [origin, *ends[:-1]]  # link k starts where link k - 1 ends
-        self._primitives: dict[
-            tuple[float, ...], tuple[list[LinePrimitive], list[SpherePrimitive]]
-        ] = {}
 
     def static_scene(self) -> SceneUpdate:
         """The obstacles and the feedback points, in ``world``, forever."""
@@ -339,7 +404,7 @@ class _Drawing:
             ]
         )
 
-    def links(self, stamp: Timestamp, angles_deg: list[int]) -> FrameTransforms:
+    def links(self, stamp: Timestamp | None, angles_deg: list[int]) -> FrameTransforms:
         """Every link's frame in its parent's at one pose (relative angles, base first)."""
         return FrameTransforms(
             transforms=[
@@ -356,17 +421,10 @@ class _Drawing:
             ]
         )
 
-    def arm(self, stamp: Timestamp, points: list[float]) -> SceneUpdate:
+    def arm(self, stamp: Timestamp | None, points: list[float]) -> SceneUpdate:
         """The arm at one pose (``x0, y0, x1, y1, ...``): a line strip through the joints, a
-        sphere on each. A walk comes back to its poses: their primitives are kept (a bounded
-        number of them) and only the entity is new."""
-        key = tuple(points)
-        primitives = self._primitives.get(key)
-        if primitives is None:
-            if len(self._primitives) >= _CACHED_POSES:
-                self._primitives.clear()
-            primitives = self._primitives[key] = self._arm_primitives(points)
-        line, joints = primitives
+        sphere on each."""
+        line, joints = self._arm_primitives(points)
         entity = SceneEntity(
             timestamp=stamp, frame_id=WORLD_FRAME, id="arm", lines=line, spheres=joints
         )

@@ -607,7 +607,8 @@ def _move_blocker(
     # Each moving link's bound (move_blockers' filters): every point stays within its sweep
     # of where it starts, and the link within half its length of its midpoint. A contact
     # farther than that, with 2 eps to spare for rounding, cannot be met.
-    mids: list[tuple[float, float, float]] = []  # a moving link's midpoint and its bound
+    # A moving link's midpoint, its bound and its segment (the pairs below read them often).
+    mids: list[tuple[float, float, float, tuple[float, float, float, float]]] = []
     near = 0.0  # the moving link's start from the pivot (the first one starts there)
     for j in range(joint, n):
         ax, ay, bx, by = points[2 * j : 2 * j + 4]
@@ -618,7 +619,7 @@ def _move_blocker(
             near = far
         else:
             sweep = 4 * eps
-        mids.append((mx, my, sweep))
+        mids.append((mx, my, sweep, (ax, ay, bx, by)))
         half = halves[j]
         for o, (cx, cy, radius) in enumerate(geo.disks):
             bound = radius + eps + sweep
@@ -636,11 +637,10 @@ def _move_blocker(
         fx, fy = 0.5 * (fixed[0] + fixed[2]), 0.5 * (fixed[1] + fixed[3])
         half_i = halves[i]
         for j in range(max(joint, i + 2), n):
-            mx, my, sweep = mids[j - joint]
+            mx, my, sweep, seg = mids[j - joint]
             bound = eps + sweep
             if hypot(fx - mx, fy - my) - half_i - halves[j] > bound:
                 continue
-            seg = points[2 * j : 2 * j + 4]
             if _segments_gap(fixed, seg) > bound:
                 continue
             if swept:

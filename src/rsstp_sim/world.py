@@ -76,6 +76,12 @@ class Pose:
             object.__setattr__(self, "_distances", distances)
         return distances
 
+    def truth_values(self) -> tuple[list[int], list[float], list[float]]:
+        """:attr:`angles_deg`, :attr:`joint_positions` and :attr:`distances` as flat lists of
+        plain numbers (positions ``x0, y0, x1, y1, ...``; distances tip by tip): the same
+        values, without numpy arrays."""
+        return self._table.truth_values(self._row)
+
 
 class World:
     """A 2D arm of ``n`` links, moved one joint at a time by ``step_deg``.

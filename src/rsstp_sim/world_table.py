@@ -445,6 +445,19 @@ class WorldTable:
         tips = self.positions_of(row)[1:]
         return geometry.obstacle_distances(tips, self.geometry.centers, self.geometry.radii)
 
+    def truth_values(self, row: int) -> tuple[list[int], list[float], list[float]]:
+        """A row's joint angles, its points (``x0, y0, x1, y1, ...``: :meth:`positions_of`
+        flat) and its obstacle distances (tip by tip: :meth:`distances_of` flat), as plain
+        Python numbers (what a recorder encodes once per pose, without numpy's per-call work)."""
+        n_m = self.geometry.n * self.geometry.m
+        kept = self.distances[row * n_m : (row + 1) * n_m] if self.keeps_distances else None
+        if n_m and (kept is None or math.isnan(kept[0])):
+            distances: list[float] = self.distances_of(row).ravel().tolist()
+        else:
+            distances = kept.tolist() if kept is not None else []
+        positions = self.positions[row * self.width : (row + 1) * self.width].tolist()
+        return self.angles_of(self.codes[row]), positions, distances
+
     def angles(self) -> IntArray:
         """``(rows, n)`` joint angles of every row."""
         codes = np.frombuffer(self.codes, dtype=np.int64)

@@ -4,6 +4,7 @@ by Rerun's MCAP importer and read back from the ``.rrd``."""
 
 from __future__ import annotations
 
+import importlib.metadata
 import math
 import os
 import shutil
@@ -267,7 +268,8 @@ def test_a_second_export_gives_the_same_bytes(recorded: Recorded, scene: Scene) 
     code, _, stderr = export("--foxglove", str(recorded.path), "-o", str(again))
     assert (code, stderr) == (0, "")
     assert again.read_bytes() == scene.path.read_bytes()
-    assert scene.header_library.startswith("foxglove-sdk-python/")
+    sdk = importlib.metadata.version("foxglove-sdk")
+    assert scene.header_library == f"rsstp {__version__} (foxglove-sdk {sdk} messages)"
 
 
 def test_the_scene_says_what_it_was_made_from(recorded: Recorded, scene: Scene) -> None:

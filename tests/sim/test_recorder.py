@@ -1,4 +1,4 @@
-"""The recorder: real MCAP files written through the ``mcap`` library and read back with it.
+"""The recorder: real MCAP files, written by its chunked writer and read back with ``mcap``.
 
 A recording is checked against the contract of docs/contract.md and ``schemas/README.md``
 (topics and counts, metadata, attachment, schemas byte for byte, step times, no wall-clock),

@@ -27,6 +27,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from jsonschema import Draft202012Validator
+from steps import step_record_after
 
 import rsstp_sim
 from rsstp_sim.coupling import Event, Runner, StepOutcome
@@ -244,17 +245,7 @@ def record_run(name: str) -> Corpus:
     world, model = runner.world, runner.model
 
     def step_message(out: StepOutcome | None) -> records.StepRecord:
-        """The step record after ``out`` (None: the reset), as the recorder builds it."""
-        return builders.step_record(
-            0 if out is None else out.step,
-            world.current,
-            action=None if out is None else out.action,
-            state_before=None if out is None else out.state_before,
-            internal_state=model.current if out is None else out.state_after,
-            model_version=model.version,
-            no_transition=out is not None and out.no_transition,
-            blocker=None if out is None else out.blocker,
-        )
+        return step_record_after(world.current, model, out)
 
     messages.append(step_message(None))
     for _ in range(STEPS):

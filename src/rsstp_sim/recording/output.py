@@ -4,10 +4,11 @@ The recording is written to a side file, ``<name>.partial`` beside the output, a
 onto the output only when finished (by the recorder): an existing recording (``force``)
 survives until the new one is whole, and nothing half written ever has the output's name.
 The side file holds an exclusive lock while it is written, so a second recorder on the same
-output is refused. It is written without a user-space buffer, so every chunk the writer
-completes is on disk at once; after a SIGKILL, a full disk or a file-size limit, the side
-file stays and a sequential reader recovers all its complete chunks (a later recorder
-refuses to replace it without ``force``). Only regular files are ever written or replaced.
+output is refused. It is written without a user-space buffer, each chunk as soon as it is
+compressed, on a second thread (:class:`SideFileWriter`); after a SIGKILL, a full disk or a
+file-size limit, the side file stays and a sequential reader recovers all its complete
+chunks (a later recorder refuses to replace it without ``force``). Only regular files are
+ever written or replaced.
 """
 
 from __future__ import annotations
@@ -15,31 +16,87 @@ from __future__ import annotations
 import fcntl
 import io
 import os
+import queue
+import threading
 from collections.abc import Callable
 from pathlib import Path
 
 from rsstp_sim.errors import RecordingError
 from rsstp_sim.files import irregular, side_file
 
-__all__ = ["WriteThrough", "open_side_file"]
+__all__ = ["SideFileWriter", "open_side_file"]
 
 
-class WriteThrough:
-    """A write-through file for the MCAP writer: each completed chunk reaches the OS at once.
+class SideFileWriter:
+    """Writes a recording's bytes to its side file, in order, without a user-space buffer.
 
-    (The writer would wrap a raw file in a ``BufferedWriter``, which could keep
-    the tail of a chunk in memory when the process is killed.) ``safe_steps`` is the last
-    step whose messages are all in complete chunks, as of the last write (the writer writes
-    only when a chunk is complete): what a reader recovers from the file as it stands.
+    Most records are written at once (:meth:`write`). A chunk is handed over as what builds
+    its bytes (:meth:`write_later`: CRC, zstd), which a second thread runs and writes while
+    the run goes on: zstd and file writes release the GIL. At most one chunk is in flight,
+    so the next hand-off waits for it; a SIGKILL loses at most the chunk in flight and the
+    one being built, and every chunk on disk is whole, written with one ``write`` (its
+    message indexes with it).
+
+    A write error is raised by the next call (the next chunk's hand-off, at most a chunk
+    later) and kept in ``error``; nothing is written after it. ``safe_steps`` is the last
+    step whose messages are all in chunks on disk: the step before the one being recorded
+    when the last chunk written was handed over (a chunk ends inside a step, whose other
+    messages follow in the next).
     """
 
     def __init__(self, raw: io.FileIO, steps_done: Callable[[], int]) -> None:
         self._raw = raw
         self._steps_done = steps_done
+        self._position = raw.tell()
         self.safe_steps = 0
-        self.error: OSError | None = None  # the write error, told apart from other OSErrors
+        self.error: BaseException | None = None  # the write error, told apart from others
+        self._free = threading.Semaphore(1)  # taken while a chunk is in flight
+        self._jobs: queue.SimpleQueue[tuple[Callable[[int], bytes], int] | None] = (
+            queue.SimpleQueue()
+        )
+        self._thread: threading.Thread | None = None
 
-    def write(self, data: bytes | bytearray | memoryview) -> int:
+    def write(self, data: bytes) -> None:
+        self._wait()
+        self._write(data, self._mark())
+
+    def write_later(self, build: Callable[[int], bytes]) -> None:
+        mark = self._mark()
+        self._free.acquire()  # the chunk before is written
+        if self.error is not None:
+            self._free.release()
+            raise self.error
+        if self._thread is None:
+            self._thread = threading.Thread(target=self._work, name="rsstp-chunks", daemon=True)
+            self._thread.start()
+        self._jobs.put((build, mark))
+
+    def tell(self) -> int:
+        self._wait()
+        return self._position
+
+    def _mark(self) -> int:
+        return max(0, self._steps_done() - 1)
+
+    def _wait(self) -> None:
+        """Until the chunk in flight is written; raise its error, if any."""
+        with self._free:
+            pass
+        if self.error is not None:
+            raise self.error
+
+    def _work(self) -> None:
+        while (job := self._jobs.get()) is not None:
+            build, mark = job
+            try:
+                if self.error is None:
+                    self._write(build(self._position), mark)
+            except BaseException as exc:  # handed to the recording thread
+                self.error = exc
+            finally:
+                self._free.release()
+
+    def _write(self, data: bytes, mark: int) -> None:
         view = memoryview(data)
         while view:
             try:
@@ -50,17 +107,16 @@ class WriteThrough:
             if written is None:  # pragma: no cover - only for non-blocking files
                 continue
             view = view[written:]
-        if data:  # the step being written may have messages after this chunk: not counted
-            self.safe_steps = max(0, self._steps_done() - 1)
-        return len(data)
-
-    def tell(self) -> int:
-        return self._raw.tell()
-
-    def flush(self) -> None:
-        return None
+            self._position += written
+        if data:
+            self.safe_steps = mark
 
     def close(self) -> None:
+        """Stop the thread (after the chunk in flight) and close the file."""
+        if self._thread is not None:
+            self._jobs.put(None)
+            self._thread.join()
+            self._thread = None
         self._raw.close()
 
 

@@ -14,6 +14,11 @@ runner's callbacks and writes:
 ``log_time`` of step ``t`` is ``t * 1_000_000`` ns; no wall-clock time is
 written, so the same scenario, strategy and seed give the same bytes.
 
+Speed: a step's message comes from per-pose templates
+(:mod:`~rsstp_sim.recording.step_messages`), goes into a chunk with little Python per message
+(:mod:`~rsstp_sim.recording.chunks`: the mcap ``Writer``'s bytes), and each chunk's CRC,
+compression and write run on a second thread (:mod:`~rsstp_sim.recording.output`).
+
 Crash safety: the recording goes to a locked side file, renamed onto the output only when
 finished (:mod:`rsstp_sim.recording.output`). :meth:`Recorder.request_stop` (what the CLI's
 SIGINT/SIGTERM handlers call) ends the run after the current step and the file is finished
@@ -32,14 +37,12 @@ from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
 
-import msgspec
-from mcap.writer import CompressionType, Writer
-
 from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.errors import RecordingError, RecordingWriteError, RsstpError
 from rsstp_sim.files import side_file
 from rsstp_sim.recording import builders, records
-from rsstp_sim.recording.output import WriteThrough, open_side_file
+from rsstp_sim.recording.chunks import ChunkedWriter
+from rsstp_sim.recording.output import SideFileWriter, open_side_file
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_MEDIA_TYPE,
     ATTACHMENT_NAME,
@@ -52,23 +55,15 @@ from rsstp_sim.recording.schemas import (
     metadata_checksum,
     schema_bytes,
 )
+from rsstp_sim.recording.step_messages import StepMessages
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.strategies import Strategy, strategy_origin
 from rsstp_sim.transition_system import Operation
-from rsstp_sim.world import Pose
-
-_json = msgspec.json.Encoder().encode
-"""The same encoder as ``records.encode``, so hand-assembled step bytes equal it."""
 
 __all__ = ["DEFAULT_CHUNK_SIZE", "RecordResult", "Recorder", "environment_versions", "record"]
 
 DEFAULT_CHUNK_SIZE = 1024 * 1024
 """Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
-
-_POSE_CACHE_BYTES = 128 * 1024 * 1024
-"""The most bytes of poses' encoded truth kept for the poses met again (three-joint's 39,232
-poses take 12 MB; a pose among 1,000 obstacles 60 KB, its 3,000 distances): the poses met
-after that are encoded at each visit."""
 
 _VERSION_KEYS = ("package_version", "python", "numpy", "shapely", "mcap")
 
@@ -127,7 +122,7 @@ class Recorder:
         if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1024:
             raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
         self.path = Path(path)
-        self._pending_events: list[records.EventRecord] = []
+        self._pending_events: list[tuple[int, bytes]] = []  # (step, message)
         # (step, operations): the model message is built when the step is written,
         # since the runner also reports changes made during its own reset, before
         # ``self.runner`` exists.
@@ -145,17 +140,15 @@ class Recorder:
             self._versions.update({k: v for k, v in versions.items() if k in _VERSION_KEYS})
         self._stop = False
         self._budget: int | None = None
-        self._pose_parts: dict[int, tuple[bytes, bytes]] = {}
-        self._pose_parts_bytes = 0
+        self._messages = StepMessages()
         self._counts = dict.fromkeys(self._topics, 0)
         self.side_file = side_file(self.path)
         self._raw = open_side_file(self.path, force=force)
-        self._file = WriteThrough(self._raw, lambda: self.runner.step_index)
-        self._writer = Writer(
-            self._file,  # type: ignore[arg-type]
-            chunk_size=chunk_size,
-            compression=CompressionType.ZSTD,
-        )
+        self._file = SideFileWriter(self._raw, lambda: self.runner.step_index)
+        self._writer = ChunkedWriter(self._file, chunk_size=chunk_size)
+        # What every step uses, looked up once.
+        self._world, self._model = self.runner.world, self.runner.model
+        self._step_message, self._add_step = self._messages.step, self._writer.add_message
         self._closed = False
         try:
             self._write_header(scenario, strategy, seed)
@@ -174,7 +167,8 @@ class Recorder:
         # Steps with no transition are recorded from the step outcome (it has the
         # state and the action); the runner's events add the strategy notes.
         if event.kind == "note":
-            self._pending_events.append(builders.note_event(event.step, event.text, event.data))
+            note = builders.note_event(event.step, event.text, event.data)
+            self._pending_events.append((event.step, records.encode(note)))
 
     def _on_model_change(self, step: int, operations: Sequence[Operation]) -> None:
         if "/rsstp/model" not in self._topics:
@@ -182,7 +176,9 @@ class Recorder:
                 f"step {step}: the model changed in a run recorded without a model channel"
             )
         self._pending_models.append((step, tuple(operations)))
-        self._pending_events.extend(builders.operation_events(step, operations))
+        self._pending_events.extend(
+            (step, records.encode(event)) for event in builders.operation_events(step, operations)
+        )
 
     # -- writing ----------------------------------------------------------------
 
@@ -231,77 +227,21 @@ class Recorder:
             self._pending_models.append((0, ()))  # step 0 always has the initial model
         self._write_step_zero()
 
-    def _add(self, topic: str, step: int, data: bytes) -> None:
-        log_time = step * STEP_NS
-        self._writer.add_message(self._channels[topic], log_time, data, log_time)
+    def _add(self, topic: str, step: int, data: bytes, tail: bytes = b"") -> None:
+        self._writer.add_message(self._channels[topic], step * STEP_NS, data, tail)
         self._counts[topic] += 1
-
-    def _pose_json(self, pose: Pose) -> tuple[bytes, bytes]:
-        """The pose's truth fields as JSON fragments, around the per-step blocked fields."""
-        parts = self._pose_parts.get(pose.code)
-        if parts is None:
-            truth = records.encode_json(builders.truth_record(pose, None))
-            before, _, after = truth[1:-1].partition(b',"blocked":false,')
-            parts = (before + b",", b"," + after)
-            if self._pose_parts_bytes < _POSE_CACHE_BYTES:  # bounded: many obstacles, long runs
-                self._pose_parts[pose.code] = parts
-                self._pose_parts_bytes += len(truth)
-        return parts
-
-    def _step_bytes(self, step: int, outcome: StepOutcome | None, pose: Pose) -> bytes:
-        """Encode one ``rsstp.Step`` message (the same bytes as ``records.encode``)."""
-        runner = self.runner
-        model = runner.model
-        if outcome is None:
-            agent = b'{"internal_state":%d' % model.current
-            blocked = b'"blocked":false'
-        else:
-            agent = b'{"action":%d,"state_before":%d,"internal_state":%d' % (
-                outcome.action,
-                outcome.state_before,
-                outcome.state_after,
-            )
-            blocker = outcome.blocker
-            if blocker is None:
-                blocked = b'"blocked":false'
-            else:
-                blocked = b'"blocked":true,"blocked_by":' + _json(
-                    {"kind": blocker.kind, "indices": list(blocker.indices)}
-                )
-        before, after = self._pose_json(pose)
-        return b"".join(
-            (
-                b'{"step":',
-                str(step).encode(),
-                b',"agent":',
-                agent,
-                b',"sensation":',
-                b"true" if pose.sensation else b"false",
-                b',"feedback":',
-                _json(pose.feedback),
-                b',"model_version":%d,"no_transition":' % model.version,
-                b"true" if outcome is not None and outcome.no_transition else b"false",
-                b'},"truth":{',
-                before,
-                blocked,
-                after,
-                b"}}",
-            )
-        )
 
     def _lead_events(self, outcome: StepOutcome) -> None:
         """The world acted first, then the internal transition: their events lead the step's."""
+        t = outcome.step
         lead = []
         if outcome.blocker is not None:
-            lead.append(
-                builders.blocked_event(outcome.step, action=outcome.action, blocker=outcome.blocker)
-            )
+            lead.append((t, self._messages.blocked_event(t, outcome.action, outcome.blocker)))
         if outcome.no_transition:
-            lead.append(
-                builders.no_transition_event(
-                    outcome.step, state=outcome.state_before, action=outcome.action
-                )
+            event = builders.no_transition_event(
+                t, state=outcome.state_before, action=outcome.action
             )
+            lead.append((t, records.encode(event)))
         self._pending_events[:0] = lead
 
     def _flush_pending(self, step: int) -> None:
@@ -309,13 +249,19 @@ class Recorder:
         for model_step, operations in self._pending_models:
             record = builders.model_record(model, step=model_step, operations=operations)
             self._add("/rsstp/model", step, records.encode(record))
-        for event in self._pending_events:
-            self._add("/rsstp/event", event.step, records.encode(event))
+        for event_step, event in self._pending_events:
+            self._add("/rsstp/event", event_step, event)
         self._pending_models.clear()
         self._pending_events.clear()
 
     def _write_step_zero(self) -> None:
-        self._add("/rsstp/step", 0, self._step_bytes(0, None, self.runner.world.current))
+        runner = self.runner
+        message = self._messages.first(
+            runner.world.current,
+            internal_state=runner.model.current,
+            model_version=runner.model.version,
+        )
+        self._add("/rsstp/step", 0, *message)
         self._flush_pending(0)
 
     # -- running ------------------------------------------------------------------
@@ -378,12 +324,8 @@ class Recorder:
 
     def _write_step(self, outcome: StepOutcome) -> None:
         t = outcome.step
-        self._writer.add_message(
-            self._step_channel,
-            t * STEP_NS,
-            self._step_bytes(t, outcome, self.runner.world.current),
-            t * STEP_NS,
-        )
+        head, tail = self._step_message(outcome, self._world.current, self._model.version)
+        self._add_step(self._step_channel, t * STEP_NS, head, tail)
         if outcome.blocker is not None or outcome.no_transition:
             self._lead_events(outcome)
         if self._pending_models or self._pending_events:
@@ -413,7 +355,7 @@ class Recorder:
         if self._closed:
             return f"{self.path} was not touched"
         try:
-            self._writer.finish()  # type: ignore[no-untyped-call]
+            self._writer.finish()
         except BaseException:  # a full disk, or still no memory: the chunks written stay
             finished = "unfinished; rsstp-replay reads its complete chunks"
         else:
@@ -436,7 +378,7 @@ class Recorder:
             return
         try:
             self._write_stop()
-            self._writer.finish()  # type: ignore[no-untyped-call]
+            self._writer.finish()
         except OSError as exc:
             if exc is not self._file.error:
                 self._closed = True
