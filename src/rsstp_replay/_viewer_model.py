@@ -16,9 +16,10 @@ and marking the states they touch) or its role changes, and an :class:`rr.Clear`
 deleted; so the data grows with the number of changes, not with versions times model size. At
 a row:
 
-- ``Points2D``: the state, coloured by its role in the version in force (what the truth audit
-  says it stood for: :mod:`rsstp_replay.audits.state_roles`, colours :data:`ROLE_COLORS`;
-  dark grey without the truth), labelled with its id where the label fits
+- ``Points2D``: the state, coloured by its role in the last version that was in it (what the
+  truth audit says it stood for over that version's steps:
+  :mod:`rsstp_replay.audits.state_roles`, colours :data:`ROLE_COLORS`; unvisited until a
+  version was in it; dark grey without the truth), labelled with its id where the label fits
   (:func:`labelled_states`; the id is in the entity path, shown on hover, everywhere);
 - ``Arrows2D``: one arrow per transition to another state, from the state towards the
   target (stopping short of it), coloured by action (:data:`ACTION_COLORS`), several actions
@@ -285,25 +286,30 @@ def log_model(
     labelled: set[int] | None = None,
 ) -> dict[str, int]:
     """Every state of ``versions[0]`` at ``steps[0]``, then each later version's changes (and
-    role changes, with ``roles``) at its step; labels on the ``labelled`` states (default:
-    all). Returns rows per entity path (the per-state paths summed under :data:`STATES`)."""
+    role changes, with ``roles``: a state keeps the role of the last version that was in it,
+    unvisited until one was) at its step; labels on the ``labelled`` states (default: all).
+    Returns rows per entity path (the per-state paths summed under :data:`STATES`)."""
     rows: dict[int, list[_Row]] = defaultdict(list)
     model = TransitionSystem.from_snapshot(versions[0].snapshot(), version=versions[0].version)
-    no_roles: dict[int, int] = {}
-    in_force = no_roles if roles is None else roles.get(versions[0].version, no_roles)
+    # A state's role is what it stood for in the last version that was in it: a version of a
+    # few hundred steps visits few of a thousand states, and "unvisited" in each would make
+    # every state flicker (a row each time) without telling anything new.
+    known: dict[int, int] = {} if roles is None else dict(roles.get(versions[0].version, {}))
     for state in model.states:
-        rows[state].append((steps[0], _outs(model, state), _role(roles, in_force, state)))
+        rows[state].append((steps[0], _outs(model, state), _role(roles, known, state)))
     for record, step in zip(versions[1:], steps[1:], strict=True):
         touched = _touched(model, record)
         candidates = touched
         if roles is not None:  # and the states whose role changed
-            before, in_force = in_force, roles.get(record.version, no_roles)
-            candidates = touched | _changed(before, in_force)
+            seen = roles.get(record.version, {})
+            changed = {s for s, role in seen.items() if known.get(s, UNVISITED) != role}
+            known.update(seen)
+            candidates = touched | changed
         for state in sorted(candidates):
             if state in model:
                 # A state whose role alone changed keeps its transitions: the last row's.
                 outs = _outs(model, state) if state in touched else rows[state][-1][1]
-                rows[state].append((step, outs, _role(roles, in_force, state)))
+                rows[state].append((step, outs, _role(roles, known, state)))
             elif state in touched:
                 rows[state].append((step, None, None))
     count = 0
@@ -321,15 +327,8 @@ def log_model(
     return {STATES: count}
 
 
-def _role(roles: Roles | None, in_force: dict[int, int], state: int) -> int | None:
-    return None if roles is None else in_force.get(state, UNVISITED)
-
-
-def _changed(before: dict[int, int], after: dict[int, int]) -> set[int]:
-    """The states whose role differs between two versions (absent: unvisited)."""
-    changed = {s for s, role in after.items() if before.get(s, UNVISITED) != role}
-    changed.update(s for s, role in before.items() if s not in after and role != UNVISITED)
-    return changed
+def _role(roles: Roles | None, known: dict[int, int], state: int) -> int | None:
+    return None if roles is None else known.get(state, UNVISITED)
 
 
 def log_legend(stream: rr.RecordingStream, *, reach: float) -> None:

@@ -385,8 +385,8 @@ def test_a_state_has_a_row_where_it_changed_and_a_clear_where_it_went(
 ) -> None:
     """Rows against a brute force over the versions: a state gets a row at the step of every
     version in which it appears, its transitions out differ from the version before or its
-    role does (the true classes it stood for over the version's steps), and a clear at the
-    step of the version that deletes it."""
+    role does (the true classes it stood for over the steps of the last version that was in
+    it; unvisited until one was), and a clear at the step of the version that deletes it."""
     recording, rrd = refined
     versions = recording.model_versions()
     expected_rows: dict[int, list[int]] = defaultdict(list)
@@ -394,9 +394,13 @@ def test_a_state_has_a_row_where_it_changed_and_a_clear_where_it_went(
     previous: dict[int, list[tuple[int, int]]] = {}
     previous_roles: dict[int, str] = {}
     roles = _brute_force_roles(recording)
+    last_seen: dict[int, str] = {}
     for version in versions:
         now = _outs(version)
-        now_roles = {s: roles.get((version.version, s), "unvisited") for s in now}
+        for state in now:
+            if (version.version, state) in roles:
+                last_seen[state] = roles[version.version, state]
+        now_roles = {s: last_seen.get(s, "unvisited") for s in now}
         for state, outs in now.items():
             if previous.get(state) != outs or previous_roles.get(state) != now_roles[state]:
                 expected_rows[state].append(version.step)
@@ -762,6 +766,8 @@ def test_per_version_findings_warn_and_history_ones_are_left_out(
 
 
 def test_states_are_coloured_by_what_they_stood_for(learner: tuple[Recording, Rrd]) -> None:
+    """A state's colour is its role in the last version that was in it (unvisited until
+    one was), by a brute force over the steps."""
     recording, rrd = learner
     roles = _brute_force_roles(recording)
     colors = {
@@ -776,7 +782,15 @@ def test_states_are_coloured_by_what_they_stood_for(learner: tuple[Recording, Rr
         version = versions[index]
         at = version.step if index == len(versions) - 1 else versions[index + 1].step - 1
         for state in version.states:
-            role = roles.get((version.version, state), "unvisited")
+            # the role of the last version up to this one that was in the state
+            role = next(
+                (
+                    roles[earlier.version, state]
+                    for earlier in reversed(versions[: index + 1])
+                    if (earlier.version, state) in roles
+                ),
+                "unvisited",
+            )
             [color] = rrd.at(f"world/model/state/{state}", "Points2D:colors", at)
             assert _rgb(color) == colors[role], (version.version, state)
             seen.add(role)
