@@ -297,6 +297,22 @@ def test_with_float_feedback_the_learner_climbs_to_the_sensed_pose() -> None:
     assert sum(b.index(True) if True in b else 200 for b in blind) > sum(firsts.values())
 
 
+def test_with_float_feedback_the_learner_needs_at_most_half_the_steps() -> None:
+    # The float twin of a two-joint world: what the agent feels tells poses apart, so a
+    # candidate felt otherwise is ruled out at once and a test can end where the agent is
+    # located; the model is still over the sensation, judged against the boolean truth.
+    scenario = load_scenario("two-joint-30")
+    twin = float_twin(scenario)
+    truth = compute_truth(scenario)
+    for seed in range(3):
+        blind, blind_runner = learn(scenario, 50_000, seed=seed)
+        felt, felt_runner = learn(twin, 50_000, seed=seed)
+        assert blind.done and felt.done
+        assert_minimal_and_equivalent(blind, blind_runner.model, truth)
+        assert_minimal_and_equivalent(felt, felt_runner.model, truth)
+        assert 2 * felt_runner.step_index <= blind_runner.step_index
+
+
 def test_notes_are_few() -> None:
     scenario = load_scenario("two-joint-30")
     learner = LearnerStrategy()

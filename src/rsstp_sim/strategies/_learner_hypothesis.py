@@ -26,6 +26,7 @@ __all__ = ["FAR", "Hypothesis"]
 
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
+FloatArray = NDArray[np.float64]
 
 FAR = np.iinfo(np.int64).max // 4
 """The distance to the landmark of a state with no confirmed path to it."""
@@ -39,6 +40,13 @@ class Hypothesis:
     world state ``s`` was created for: a fact of the trajectory, which defines ``s``.
     ``next[s, k]`` is the confirmed successor of ``s`` by ``actions[k]``, or -1.
 
+    ``feels`` (float feedback, ``mode = "float"``): ``feel[s]`` is the closeness the agent
+    felt at the world state ``s`` was created for (NaN: unknown, or several after a merge).
+    Two world states felt differently are different poses, so a candidate whose feel differs
+    from the one felt is ruled out as one whose label differs is (:meth:`agree`): the states
+    are then poses, and the minimisation at the end merges those the sensation cannot tell
+    apart. Without ``feels`` the feel is never compared.
+
     ``rng`` (the run's generator) draws, once, the order in which the actions are tried
     when several shortest paths or several nearest states tie: a path keeps one preference
     all run long (a coherent sweep of the world; drawn anew at every search, the walks
@@ -51,8 +59,11 @@ class Hypothesis:
         actions: tuple[int, ...],
         landmark: int,
         rng: np.random.Generator | None = None,
+        *,
+        feels: bool = False,
     ) -> None:
         self.model = model
+        self.feels = feels
         order = np.arange(len(actions)) if rng is None else rng.permutation(len(actions))
         self._columns: list[int] = [int(k) for k in order]
         self._ordered = [actions[k] for k in self._columns]
@@ -62,6 +73,7 @@ class Hypothesis:
         self.next: IntArray = np.full((capacity, len(actions)), -1, dtype=np.int64)
         self.label: BoolArray = np.zeros(capacity, dtype=bool)
         self.alive: BoolArray = np.zeros(capacity, dtype=bool)
+        self.feel: FloatArray = np.full(capacity, np.nan)
         self.labels: dict[int, bool] = {}
         self.access: dict[int, tuple[int, ...]] = {}
         for s in model.states:
@@ -96,6 +108,28 @@ class Hypothesis:
         """The states predicting ``sensation``, by id."""
         return [int(s) for s in np.flatnonzero(self.alive & (self.label == sensation))]
 
+    def agree(self, states: IntArray, sensation: bool, feel: float) -> BoolArray:
+        """Which of ``states`` agree with what was sensed (and felt, with ``feels``)."""
+        same: BoolArray = self.label[states] == sensation
+        if self.feels:
+            felt = self.feel[states]
+            same &= np.isnan(felt) | (felt == feel)
+        return same
+
+    def agrees(self, s: int, sensation: bool, feel: float) -> bool:
+        """Whether state ``s`` agrees with what was sensed (and felt, with ``feels``)."""
+        if self.labels[s] != sensation:
+            return False
+        if not self.feels:
+            return True
+        felt = float(self.feel[s])
+        return felt != felt or felt == feel  # (NaN: unknown)
+
+    def matching(self, sensation: bool, feel: float) -> list[int]:
+        """The states agreeing with what was sensed (and felt), by id."""
+        states = np.flatnonzero(self.alive)
+        return [int(s) for s in states[self.agree(states, sensation, feel)]]
+
     def step(
         self, start: IntArray, position: IntArray, action: int, via: tuple[int, int]
     ) -> IntArray:
@@ -111,16 +145,23 @@ class Hypothesis:
         return moved
 
     def consistent(
-        self, word: tuple[int, ...], outputs: tuple[bool, ...], via: tuple[int, int]
+        self,
+        word: tuple[int, ...],
+        outputs: tuple[bool, ...],
+        via: tuple[int, int],
+        feels: tuple[float, ...] = (),
     ) -> list[int]:
         """The states ``c`` from which ``word`` yields ``outputs`` (the first: ``c``'s own
-        label), if ``via`` leads to ``c`` (see :meth:`step`)."""
-        start = np.flatnonzero(self.alive & (self.label == outputs[0]))
+        label) and ``feels`` (with :attr:`feels`), if ``via`` leads to ``c`` (see
+        :meth:`step`)."""
+        felt = feels if self.feels and feels else (0.0,) * len(outputs)
+        start = np.flatnonzero(self.alive)
+        start = start[self.agree(start, outputs[0], felt[0])]
         position = start.copy()
-        for action, sensation in zip(word, outputs[1:], strict=True):
+        for action, sensation, feel in zip(word, outputs[1:], felt[1:], strict=True):
             moved = self.step(start, position, action, via)
             keep = moved >= 0
-            keep[keep] = self.label[moved[keep]] == sensation
+            keep[keep] = self.agree(moved[keep], sensation, feel)
             start, position = start[keep], moved[keep]
         return [int(s) for s in start]
 
@@ -294,7 +335,9 @@ class Hypothesis:
             self.next[s, k] = -1
             self._changed()
 
-    def create(self, s: int, action: int, sensation: bool, access: tuple[int, ...]) -> int:
+    def create(
+        self, s: int, action: int, sensation: bool, access: tuple[int, ...], feel: float = np.nan
+    ) -> int:
         """A new state for the world state ``s -action->`` leads to, by splitting the guess.
 
         The model's conjectured successor ``t`` of ``s`` by ``action`` turned out to stand for
@@ -322,6 +365,7 @@ class Hypothesis:
         self.alive[new] = True
         self.label[new] = sensation
         self.labels[new] = sensation
+        self.feel[new] = feel
         self.access[new] = access
         self.next[new] = -1
         self.unconfirmed += len(self.actions)
@@ -346,6 +390,7 @@ class Hypothesis:
         self._grow(new)
         self.alive[new] = True
         self.label[new] = False
+        self.feel[new] = np.nan
         self.labels[new] = False
         self.access[new] = ()
         self.next[new] = new
@@ -355,6 +400,8 @@ class Hypothesis:
     def merge(self, keep: int, gone: int) -> None:
         """``gone`` is the same world state as ``keep``: the model's merge, then the arrays."""
         self.model.merge(keep, gone)
+        if not self.feel[keep] == self.feel[gone]:  # (NaN: unknown stays unknown)
+            self.feel[keep] = np.nan
         self.unconfirmed -= int(np.count_nonzero(self.next[gone] < 0))
         self.next[gone] = -1
         self.next[self.next == gone] = keep
@@ -371,6 +418,7 @@ class Hypothesis:
         for action in self.actions:
             for t in model.successors(gone, action):
                 model.delete(gone, t, action)
+        self.feel[gone] = self.feel[self.landmark]  # (the landmark keeps its feel)
         self.merge(self.landmark, gone)
 
     def _grow(self, s: int) -> None:
@@ -383,6 +431,7 @@ class Hypothesis:
         self.next = grown
         self.label = np.concatenate([self.label, np.zeros(size - capacity, dtype=bool)])
         self.alive = np.concatenate([self.alive, np.zeros(size - capacity, dtype=bool)])
+        self.feel = np.concatenate([self.feel, np.full(size - capacity, np.nan)])
 
     def minimise(self) -> list[tuple[int, int]]:
         """Merge the states the complete hypothesis cannot tell apart (Moore's refinement).

@@ -48,13 +48,17 @@ class Refuted(Exception):
     """The hypothesis predicted a wrong sensation on a confirmed path from the landmark.
 
     ``word`` is the action word walked from the landmark, ``trace`` the sensation after each
-    of its actions (the last one the mispredicted).
+    of its actions (the last one the mispredicted), ``felt`` the float feedback after each
+    (with float feedback: the feel may be the mispredicted).
     """
 
-    def __init__(self, word: tuple[int, ...], trace: tuple[bool, ...]) -> None:
+    def __init__(
+        self, word: tuple[int, ...], trace: tuple[bool, ...], felt: tuple[float, ...]
+    ) -> None:
         super().__init__(f"counterexample of length {len(word)}")
         self.word = word
         self.trace = trace
+        self.felt = felt
 
 
 class Confined(Exception):
@@ -70,7 +74,8 @@ class Confined(Exception):
 class Walker:
     """The agent walking its hypothesis.
 
-    Since the landmark was last seen the agent took ``word`` and sensed ``trace``;
+    Since the landmark was last seen the agent took ``word``, sensed ``trace`` and felt
+    ``felt`` (the float feedback; zeros when the agent has none);
     ``beliefs[i]`` is the state it believed it was at after ``word[i]`` (-1: unknown), and
     ``belief`` is where it believes it is now (None: lost). ``stats`` counts steps per
     ``phase`` and events.
@@ -78,9 +83,16 @@ class Walker:
 
     def __init__(self, agent: AgentView) -> None:
         self.agent = agent
-        self.h = Hypothesis(agent.model, agent.actions, landmark=agent.model.current, rng=agent.rng)
+        self.h = Hypothesis(
+            agent.model,
+            agent.actions,
+            landmark=agent.model.current,
+            rng=agent.rng,
+            feels=agent.float_feedback,
+        )
         self.word: list[int] = []
         self.trace: list[bool] = []
+        self.felt: list[float] = []
         self.beliefs: list[int] = []
         self.belief: int | None = None
         self.phase = "search"
@@ -95,24 +107,30 @@ class Walker:
     def count(self, key: str, n: int = 1) -> None:
         self.stats[key] = self.stats.get(key, 0) + n
 
+    def feel(self) -> float:
+        """The float feedback felt now (0.0 when the agent has none)."""
+        return float(self.agent.memory.feedback[-1]) if self.h.feels else 0.0
+
     def move(self, action: int, *, check: bool = False) -> Generator[int, bool, bool]:
         """Take ``action``; follow the belief. With ``check``, a wrong prediction of a
         confirmed transition raises :class:`Refuted` (else the agent is just lost)."""
         sensation = yield action
         self.count(f"steps_{self.phase}")
         self.agent.enter(PHASES[self.phase])
+        feel = self.feel()
         self.word.append(action)
         self.trace.append(sensation)
+        self.felt.append(feel)
         h = self.h
         belief = self.belief
         if belief is not None:
             t = h.confirmed(belief, action)
-            if t >= 0 and h.labels[t] == sensation:
+            if t >= 0 and h.agrees(t, sensation, feel):
                 self.belief = t
             else:
                 self.belief = None
                 if t >= 0 and check:
-                    refuted = Refuted(tuple(self.word), tuple(self.trace))
+                    refuted = Refuted(tuple(self.word), tuple(self.trace), tuple(self.felt))
                     if sensation:
                         self.at_landmark()
                     raise refuted
@@ -124,11 +142,15 @@ class Walker:
 
     def at_landmark(self) -> None:
         """The sensation is true: the agent is at the landmark, whatever it believed."""
-        self.belief = self.h.landmark
+        h = self.h
+        self.belief = h.landmark
         self.last_seen = self.agent.step
         self.seen = True
+        if h.feels and np.isnan(h.feel[h.landmark]):
+            h.feel[h.landmark] = self.feel()
         self.word.clear()
         self.trace.clear()
+        self.felt.clear()
         self.beliefs.clear()
 
     def pick(self, among: list[int]) -> int:
@@ -179,10 +201,11 @@ class Walker:
             return
         climbing = self.agent.float_feedback
         sensation = self.trace[-1] if self.trace else True
-        ids = np.asarray([s for s in near if h.labels[s] == sensation], dtype=np.int64)
+        feel = self.feel()
+        ids = np.asarray([s for s in near if h.agrees(s, sensation, feel)], dtype=np.int64)
         widened = not len(ids)
         if widened:
-            ids = np.asarray(h.with_label(sensation), dtype=np.int64)
+            ids = np.asarray(h.matching(sensation, feel), dtype=np.int64)
         while True:
             usable = np.flatnonzero(h.distance[ids] < FAR)
             if len(usable) and self._run_left <= 0:
@@ -193,7 +216,7 @@ class Walker:
                     return
                 self._run_left = 0
                 widened = True
-                ids = np.asarray(h.with_label(False), dtype=np.int64)
+                ids = np.asarray(h.matching(False, self.feel()), dtype=np.int64)
                 continue
             else:
                 action = self.random_action()
@@ -202,16 +225,17 @@ class Walker:
                 self.phase = phase
                 return
             self.check_confined()
+            feel = self.feel()
             moved = h.next[ids, h.column[action]]
             keep = moved >= 0
-            keep[keep] = h.label[moved[keep]] == sensation
+            keep[keep] = h.agree(moved[keep], sensation, feel)
             ids = moved[keep]
             if not len(ids):
                 if widened and self._run_left <= 0:
                     self.random_action()  # start a run
                     self._run_left += 1
                 widened = True
-                ids = np.asarray(h.with_label(sensation), dtype=np.int64)
+                ids = np.asarray(h.matching(sensation, feel), dtype=np.int64)
 
     def check_confined(self) -> None:
         """After a step of a search for the landmark: raise :class:`Confined` when the search
