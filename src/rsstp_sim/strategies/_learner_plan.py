@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Generator
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR
@@ -133,23 +134,25 @@ class Learning(Identifier):
         belief = self.belief
         assert belief is not None
         distance = h.distance
-        rows, columns = np.nonzero(h.alive[:, None] & (h.next < 0))
-        open_pairs: dict[int, list[int]] = {}
-        for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
-            a = h.actions[k]
-            deferred = self.deferred.get((s, a))
-            if deferred is not None and (
-                deferred.version == h.version
-                or not any(u not in h.labels or distance[u] < FAR for u in deferred.candidates)
+        open_mask = h.alive[:, None] & (h.next < 0)
+        for (s, a), deferred in self.deferred.items():
+            # Put off until the model changed and a candidate can be tested.
+            if deferred.version == h.version or not any(
+                u not in h.labels or distance[u] < FAR for u in deferred.candidates
             ):
-                continue  # until the model changed and a candidate can be tested
-            open_pairs.setdefault(s, []).append(a)
-        if not open_pairs:
+                open_mask[s, h.column[a]] = False
+        wanted: NDArray[np.bool_] = np.asarray(open_mask.any(axis=1), dtype=bool)
+        if not wanted.any():
             return None
+        actions_of = h.actions
+
+        def open_actions(s: int) -> list[int]:
+            return [actions_of[k] for k in np.flatnonzero(open_mask[s]).tolist()]
+
         inverse = h.inverses()
 
         def first(s: int) -> int:
-            actions = open_pairs[s]
+            actions = open_actions(s)
             made_by = self.made_by.get(s)
             if made_by is None:
                 return self.pick(actions)
@@ -161,13 +164,13 @@ class Learning(Identifier):
             likely = [b for b in actions if b not in taken and b != made_by]
             return self.pick(likely or actions)
 
-        outside = [s for s in open_pairs if distance[s] == FAR]
-        if outside:
-            oldest = min(outside)
+        outside = np.flatnonzero(wanted & (distance[: len(wanted)] == FAR))
+        if len(outside):
+            oldest = int(outside[0])
             word = h.path(belief, oldest)
             if word is not None:
                 return word, (oldest, first(oldest))
-        found = h.nearest(belief, set(open_pairs))
+        found = h.nearest_where(belief, wanted)
         if found is not None:
             word, s = found
             return word, (s, first(s))
@@ -244,6 +247,8 @@ class Learning(Identifier):
                     agreeing = found if agreeing is None else agreeing & found
                 if agreeing != {t}:
                     doubtful.setdefault(s, []).append(a)
+                else:  # (verified while the model stays as it is)
+                    self._checked.add((s, a))
         if not doubtful:
             return None
         nearest = h.nearest(self.belief, set(doubtful))
