@@ -313,6 +313,45 @@ def test_with_float_feedback_the_learner_needs_at_most_half_the_steps() -> None:
         assert 2 * felt_runner.step_index <= blind_runner.step_index
 
 
+def test_the_way_to_the_landmark_is_kept_up_to_date() -> None:
+    # The learner keeps its distances to the landmark as transitions are confirmed; at every
+    # hundredth step they equal a breadth-first search over the confirmed transitions made
+    # here, and the first step toward the landmark is the first action, in the run's order,
+    # to a state one step nearer.
+    learner = LearnerStrategy()
+    runner = Runner(load_scenario("two-joint-30"), learner, seed=1)
+    checked = 0
+    while not learner.done and runner.step_index < 50_000:
+        runner.step()
+        if runner.step_index % 100:
+            continue
+        assert learner._learning is not None
+        h = learner._learning.h
+        states = h.states()
+        far = np.iinfo(np.int64).max // 4
+        expected = dict.fromkeys(states, far)
+        expected[h.landmark] = 0
+        frontier = [h.landmark]
+        while frontier:
+            reached = []
+            for s in states:
+                if expected[s] == far and any(int(t) in frontier for t in h.next[s] if t >= 0):
+                    expected[s] = expected[frontier[0]] + 1
+                    reached.append(s)
+            frontier = reached
+        assert {s: int(h.distance[s]) for s in states} == expected
+        order = [h.column[a] for a in h._ordered]
+        for s in states:
+            nearer = [
+                k
+                for k in order
+                if h.next[s, k] >= 0 and expected[int(h.next[s, k])] == expected[s] - 1
+            ]
+            assert int(h.toward[s]) == (nearer[0] if nearer else -1)
+        checked += 1
+    assert learner.done and checked >= 50
+
+
 def test_notes_are_few() -> None:
     scenario = load_scenario("two-joint-30")
     learner = LearnerStrategy()

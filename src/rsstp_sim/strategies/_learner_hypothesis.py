@@ -339,6 +339,11 @@ class Hypothesis:
         self._inverse = (self._edits, inverse)
         return inverse
 
+    def reversible(self) -> bool:
+        """Whether the confirmed transitions show an action undoing each action
+        (:meth:`inverses`): then no move leads into a part of the world the agent cannot leave."""
+        return len(self.inverses()) == len(self.actions)
+
     def reachable(self) -> set[int]:
         """The states reachable from the landmark over confirmed transitions."""
         seen = {self.landmark}

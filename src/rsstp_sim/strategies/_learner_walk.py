@@ -240,9 +240,11 @@ class Walker:
     def check_confined(self) -> None:
         """After a step of a search for the landmark: raise :class:`Confined` when the search
         has lasted 16 times as long as the run before it, :data:`CONFINED_STEPS`, and a run of
-        :data:`LONGEST_RUN` steps per state and action of the hypothesis. A heuristic: from
-        sensations alone, a part of the world that never senses cannot be told from a search
-        that has not yet found the sensed pose."""
+        :data:`LONGEST_RUN` steps per state and action of the hypothesis, unless the confirmed
+        transitions show an action undoing each action (:meth:`Hypothesis.reversible`): where
+        every move can be undone no part of the world is a trap, and the search goes on. A
+        heuristic: from sensations alone, a part of the world that never senses cannot be told
+        from a search that has not yet found the sensed pose."""
         searched = self.agent.step - self.last_seen
         if searched < self._confinement or self.confined is not None or not self.seen:
             return
@@ -250,9 +252,9 @@ class Walker:
         bound = max(
             CONFINED_STEPS, 16 * self.last_seen, LONGEST_RUN * len(h.labels) * len(h.actions)
         )
-        if searched >= bound:
+        if searched >= bound and not h.reversible():
             raise Confined(self.last_seen)
-        self._confinement = bound
+        self._confinement = max(bound, searched + CONFINED_STEPS)
 
     def climb(self, steps: int | None = None) -> Generator[int, bool, bool]:
         """With float feedback: climb the closeness to the sensed pose until it is sensed (True)
