@@ -313,6 +313,17 @@ def test_with_float_feedback_the_learner_needs_at_most_half_the_steps() -> None:
         assert 2 * felt_runner.step_index <= blind_runner.step_index
 
 
+def test_every_seed_learns_the_two_joint_world() -> None:
+    # Seed 8 once went round for ever in a test whose path to the landmark led through the
+    # transition being identified (back to the candidate itself, on that hypothesis).
+    scenario = load_scenario("two-joint-30")
+    truth = compute_truth(scenario)
+    for seed in range(10):
+        learner, runner = learn(scenario, 50_000, seed=seed)
+        assert learner.done, seed
+        assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
 def test_the_way_to_the_landmark_is_kept_up_to_date() -> None:
     # The learner keeps its distances to the landmark as transitions are confirmed; at every
     # hundredth step they equal a breadth-first search over the confirmed transitions made

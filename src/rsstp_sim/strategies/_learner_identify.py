@@ -261,6 +261,11 @@ class Identifier(Walker):
                     index = self.pick(usable[nearest].tolist())
                     chosen = int(ids[index])
                 action = h.actions[int(h.toward[position[index]])]
+                if position[index] == via[0] and action == via[1]:
+                    # Its path goes through ``via``, which leads back to it on this
+                    # hypothesis: followed, it would go round for ever.
+                    tracked[index] = False
+                    continue
             sensation = yield from self.move(action)
             taken += 1
             moved = h.step(ids, position, action, via)
