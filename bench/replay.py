@@ -55,8 +55,8 @@ def recording_path(steps: int) -> Path:
         print(f"the cached {path} does not open ({check.stderr.strip()}): recording again")
     print(f"recording {steps:,} steps to {path} (cached for later runs)...", flush=True)
     started = time.perf_counter()
-    command = [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--strategy", "random"]
-    command += ["--seed", "1", "--steps", str(steps), "-o", str(path), "--force"]
+    command = [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint", "--strategy"]
+    command += ["random", "--seed", "1", "--steps", str(steps), "-o", str(path), "--force"]
     subprocess.run(command, check=True)
     print(f"recorded in {time.perf_counter() - started:.1f} s")
     return path

@@ -126,7 +126,7 @@ def main() -> None:
         for n in (5, 6, 7):
             toml = Path(folder, f"links-{n}.toml")
             toml.write_text(_links(n))
-            command = [sys.executable, "-m", "rsstp_sim", "run", str(toml), "--strategy"]
+            command = [sys.executable, "-m", "rsstp_cli.sim", "run", str(toml), "--strategy"]
             command += ["random", "--steps", str(args.steps), "--seed", "1"]
             r = _fresh(_RUN, COMMAND=command)
             print(

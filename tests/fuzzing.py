@@ -44,10 +44,10 @@ from hypothesis import strategies as st
 sys.path.insert(0, str(Path(__file__).resolve().parent / "replay"))  # test_corrupt's rewrite
 
 from conftest import VALID_SCENARIO
+from rsstp_cli import replay as replay_cli
+from rsstp_cli import sim as sim_cli
 from rsstp_replay import ReplayError, UnfinishedRecordingWarning, open_recording
-from rsstp_replay import cli as replay_cli
 from rsstp_sim import RsstpError, load_scenario, make_strategy, parse_scenario
-from rsstp_sim import cli as sim_cli
 from rsstp_sim.recording import record
 from scenarios import toml_text
 

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import pytest
 
-from rsstp_replay.cli import main as replay_main
+from rsstp_cli.replay import main as replay_main
+from rsstp_cli.sim import main as sim_main
 from rsstp_sim import load_scenario, make_strategy
-from rsstp_sim.cli import main as sim_main
 from rsstp_sim.recording import record
 from rsstp_sim.scenario import MAX_MAGNITUDE
 
@@ -212,7 +212,8 @@ def test_a_table_past_a_file_size_limit_is_one_line_and_exit_1(
     out = tmp_path / f"steps{suffix}"
     out.write_bytes(b"keep me")
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", "table", str(roulette), "-o", str(out), "--force"],
+        [sys.executable, "-m", "rsstp_cli.replay", "table", str(roulette), "-o", str(out)]
+        + ["--force"],
         capture_output=True,
         text=True,
         timeout=120,

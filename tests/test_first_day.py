@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
+from rsstp_cli.sim import main
 from rsstp_sim import RecordingError, load_scenario, make_strategy
-from rsstp_sim.cli import main
 from rsstp_sim.recording import record
 
 ROOT = Path(__file__).resolve().parents[1]

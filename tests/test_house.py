@@ -4,9 +4,16 @@ purpose is the package's own (``except RsstpError`` catches them all)."""
 from __future__ import annotations
 
 import ast
+import sys
+import warnings
+from collections.abc import Callable
 from pathlib import Path
+from types import FrameType
+
+import pytest
 
 SRC = Path(__file__).resolve().parents[1] / "src"
+REFERENCE = SRC.parent / "recordings" / "three-joint-random.mcap"
 BUILT_IN = {"Exception", "ValueError", "TypeError", "KeyError", "IndexError", "RuntimeError"}
 SIGNALS = {"Refuted", "Confined"}
 """Exceptions used as control flow inside one module, never raised to a caller outside it:
@@ -45,3 +52,128 @@ def test_no_built_in_exception_is_raised_on_purpose() -> None:
         and node.exc.func.id in BUILT_IN
     ]
     assert raised == []
+
+
+# ------------------------------------------------------------------- one direction of import
+
+PACKAGES = ("rsstp_sim", "rsstp_replay", "rsstp_sweep", "rsstp_cli")
+"""Bottom to top: each package may import those before it, never one after it."""
+READER_LAYERS = ("_container", "_chunks", "_contract", "recording")
+"""The replay side's reader, bottom to top: the MCAP file's records, the messages inside its
+chunks, the recording contract, the recording."""
+
+
+def _imports(tree: ast.Module) -> set[str]:
+    """Every module named by an import anywhere in ``tree`` (inside functions and
+    ``TYPE_CHECKING`` blocks too: a deferred import is still an arrow)."""
+    names: set[str] = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names.update(alias.name for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            names.add(node.module)
+            names.update(f"{node.module}.{alias.name}" for alias in node.names)
+    return names
+
+
+def test_no_package_imports_one_above_it() -> None:
+    upward = []
+    for path, tree in _modules():
+        package = path.relative_to(SRC).parts[0]
+        if package not in PACKAGES:
+            continue
+        above = PACKAGES[PACKAGES.index(package) + 1 :]
+        upward += [
+            f"{path.relative_to(SRC)} imports {name}"
+            for name in sorted(_imports(tree))
+            if name.split(".")[0] in above
+        ]
+    assert upward == []
+
+
+def test_the_four_packages_are_all_there_is() -> None:
+    """No top-level module beside the packages in every user's site-packages, and the
+    console scripts start in the command-line package."""
+    import tomllib
+
+    installed = sorted(
+        p.stem for p in SRC.iterdir() if p.suffix == ".py" or (p / "__init__.py").is_file()
+    )
+    assert installed == sorted(PACKAGES)
+    project = tomllib.loads((SRC.parent / "pyproject.toml").read_text(encoding="utf-8"))
+    assert "py-modules" not in project["tool"]["setuptools"]
+    assert {script.split(":")[0] for script in project["project"]["scripts"].values()} == {
+        "rsstp_cli.start"
+    }
+
+
+def test_the_reader_layers_import_only_downwards() -> None:
+    upward = []
+    for rank, layer in enumerate(READER_LAYERS):
+        tree = ast.parse((SRC / "rsstp_replay" / f"{layer}.py").read_text(encoding="utf-8"))
+        above = {f"rsstp_replay.{name}" for name in READER_LAYERS[rank + 1 :]}
+        upward += [f"{layer} imports {name}" for name in sorted(_imports(tree) & above)]
+    assert upward == []
+
+
+def _calls_between_layers(action: Callable[[], object]) -> list[tuple[str, str]]:
+    """(caller layer, called layer) for every call from one reader layer into another while
+    ``action`` runs (a generator resumed counts as a call from its resumer)."""
+    files = {str(SRC / "rsstp_replay" / f"{layer}.py"): layer for layer in READER_LAYERS}
+    calls: list[tuple[str, str]] = []
+
+    def profile(frame: FrameType, event: str, arg: object) -> None:
+        if event != "call" or frame.f_back is None:
+            return
+        called = files.get(frame.f_code.co_filename)
+        caller = files.get(frame.f_back.f_code.co_filename)
+        if called is not None and caller is not None and called != caller:
+            calls.append((caller, called))
+
+    sys.setprofile(profile)
+    try:
+        action()
+    finally:
+        sys.setprofile(None)
+    return calls
+
+
+@pytest.mark.parametrize("finished", [True, False], ids=["finished", "unfinished"])
+def test_reading_a_recording_never_calls_back_up(finished: bool, tmp_path: Path) -> None:
+    """Opening a recording goes down the layers once (container, chunks, contract, recording:
+    each calls only those below it), and so does reading its tables; a file cut short by a
+    killed writer is scanned the same way."""
+    from rsstp_replay import open_recording
+
+    path = REFERENCE
+    if not finished:
+        path = tmp_path / "cut.mcap"
+        path.write_bytes(REFERENCE.read_bytes()[: REFERENCE.stat().st_size * 2 // 3])
+
+    def read() -> None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            recording = open_recording(path)
+        recording.steps()
+        recording.events()
+        recording.model_at(recording.n_steps)
+
+    calls = _calls_between_layers(read)
+    rank = {layer: at for at, layer in enumerate(READER_LAYERS)}
+    assert {called for _, called in calls} >= {"_container", "_chunks", "_contract"}
+    assert sorted({(a, b) for a, b in calls if rank[a] < rank[b]}) == []
+
+    def just_open() -> None:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            open_recording(path)
+
+    # Opening: the recording finds the file's records (the container), then has them checked
+    # (the contract), which reads the scenario message through the chunks layer, which reads
+    # the chunk records through the container: one descent, no layer skipped on the way.
+    assert set(_calls_between_layers(just_open)) == {
+        ("recording", "_container"),
+        ("recording", "_contract"),
+        ("_contract", "_chunks"),
+        ("_chunks", "_container"),
+    }

@@ -17,13 +17,14 @@ ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text())
 
 
-@pytest.mark.parametrize("program", ["rsstp_sim", "rsstp_replay"])
-def test_both_commands_print_the_installed_version(program: str) -> None:
+@pytest.mark.parametrize(
+    ("program", "name"), [("rsstp_cli.sim", "rsstp-sim"), ("rsstp_cli.replay", "rsstp-replay")]
+)
+def test_both_commands_print_the_installed_version(program: str, name: str) -> None:
     done = subprocess.run(
         [sys.executable, "-m", program, "--version"], capture_output=True, text=True, timeout=60
     )
     assert done.returncode == 0
-    name = program.replace("_", "-")
     assert done.stdout.strip() == f"{name} {metadata.version('rsstp')}"
     assert rsstp_sim.__version__ == metadata.version("rsstp") == PYPROJECT["project"]["version"]
 
@@ -56,7 +57,7 @@ def test_every_third_party_import_is_declared() -> None:
         name
         for name in imported
         if name not in sys.stdlib_module_names
-        and name not in {"rsstp_sim", "rsstp_replay", "rsstp_sweep"}
+        and name not in {"rsstp_sim", "rsstp_replay", "rsstp_sweep", "rsstp_cli"}
     }
     assert third_party
     for name in sorted(third_party):

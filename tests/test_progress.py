@@ -39,10 +39,11 @@ def on_a_terminal(*command: str) -> tuple[int, str]:
 
 
 COMMANDS = [
-    ("rsstp_sim", "run", "thesis-roulette", "--steps", "140000"),
-    ("rsstp_sim", "record", "one-joint-10", "--steps", "9000", "-o", "{tmp}/run.mcap", "--force"),
-    ("rsstp_replay", "audit", str(REFERENCE), "--truth"),
-    ("rsstp_sim", "sweep", str(ROOT / "tests/sweep/tiny-sweep.toml"), "-o", "{tmp}/sweep",
+    ("rsstp_cli.sim", "run", "thesis-roulette", "--steps", "140000"),
+    ("rsstp_cli.sim", "record", "one-joint-10", "--steps", "9000", "-o", "{tmp}/run.mcap",
+     "--force"),
+    ("rsstp_cli.replay", "audit", str(REFERENCE), "--truth"),
+    ("rsstp_cli.sim", "sweep", str(ROOT / "tests/sweep/tiny-sweep.toml"), "-o", "{tmp}/sweep",
      "--workers", "1"),
 ]  # fmt: skip
 

@@ -1,5 +1,5 @@
 """A Ctrl-C at any moment of either command, start-up included, is one line, never a
-traceback (the console scripts start in ``rsstp_start``, before the packages load).
+traceback (the console scripts start in ``rsstp_cli.start``, before the packages load).
 
 The first few hundredths of a second are Python's own start-up, before any of this project's
 code runs (its ``site`` and the console script's ``import re``): a Ctrl-C there gets Python's

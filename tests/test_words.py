@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from rsstp_replay.cli import main as replay_main
+from rsstp_cli.replay import main as replay_main
+from rsstp_cli.sim import main as sim_main
 from rsstp_sim import load_scenario, make_strategy
-from rsstp_sim.cli import main as sim_main
 from rsstp_sim.recording import record
 from rsstp_sim.words import counted
 

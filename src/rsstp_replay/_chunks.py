@@ -1,44 +1,41 @@
-"""The bytes of chunks: decompressed, CRC-checked, and their message records sliced out.
+"""The messages inside chunks: found, sliced out and counted.
 
-A chunk is read in one piece, decompressed in one call and checked against its CRC; its
-message records are then sliced out of its bytes (:func:`split_messages`) for a decoder to
-take many at once. This is the hot path of reading a recording: no object per record but the
-slice of its data.
+The reader's second layer, above :mod:`rsstp_replay._container` (which reads each chunk
+record, decompressed and CRC-checked) and below :mod:`rsstp_replay._contract`. A chunk's
+message records are sliced out of its bytes (:func:`split_messages`, or through the chunk's
+message index, :func:`messages_at`) for a decoder to take many at once; :func:`topic_chunks`
+reads a topic chunk by chunk. This is the hot path of reading a recording: no object per
+record but the slice of its data.
 """
 
 from __future__ import annotations
 
 import struct
-import zlib
-from collections.abc import Callable
+from collections.abc import Generator
 from pathlib import Path
 
 import numpy as np
 import numpy.typing as npt
-import zstandard
 from mcap.opcode import Opcode
 
+from rsstp_replay._container import MESSAGE_TIME, ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording
+from rsstp_sim.recording.schemas import STEP_NS
 
 __all__ = [
-    "MESSAGE_TIME",
-    "RECORD",
-    "chunk_records",
+    "count_messages",
     "message_channels",
     "message_times",
     "log_times_at",
     "messages_at",
     "split_messages",
+    "topic_chunks",
 ]
 
-RECORD = struct.Struct("<BQ")
-"""A record's opcode and the length of its body."""
-MESSAGE_TIME = struct.Struct("<BQHIQ")
-"""A message record's opcode, length, channel id, sequence and log time."""
+_Ints = npt.NDArray[np.int64]
 _MESSAGE = struct.Struct("<BQH")  # opcode, record length, channel id
 _MESSAGE_HEAD = 31  # opcode 1, length 8, channel 2, sequence 4, log_time 8, publish_time 8
 _LOG_TIME = 15  # where a message record's log_time starts
-_CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
 _MESSAGE_OP = int(Opcode.MESSAGE)
 
 
@@ -155,65 +152,45 @@ def message_times(data: bytes, channel: int) -> list[int]:
     return times
 
 
-def chunk_records(path: Path, raw: bytes, offset: int) -> bytes:
-    """The records inside a whole chunk record (``raw``): decompressed and CRC-checked."""
-    where = f"{path}: the chunk at byte {offset}"
-    try:
-        opcode, length = RECORD.unpack_from(raw)
-        _, _, uncompressed, crc, name_length = _CHUNK.unpack_from(raw, RECORD.size)
-        position = RECORD.size + _CHUNK.size
-        compression = raw[position : position + name_length].decode("utf-8")
-        position += name_length
-        (data_length,) = struct.unpack_from("<Q", raw, position)
-        position += 8
-    except (struct.error, UnicodeDecodeError):
-        raise CorruptRecording(f"{where} has an unreadable header") from None
-    if opcode != Opcode.CHUNK or RECORD.size + length != len(raw):
-        raise CorruptRecording(
-            f"{where}: expected a chunk record of {len(raw)} bytes, found opcode "
-            f"0x{opcode:02x} with length {length}"
-        )
-    if position + data_length > len(raw):
-        raise CorruptRecording(
-            f"{where} says {data_length} bytes of data, more than its record holds"
-        )
-    compressed = raw[position : position + data_length]
-    decompress = _DECOMPRESSORS.get(compression)
-    if decompress is None:
-        raise CorruptRecording(f"{where} uses an unknown compression {compression!r}")
-    try:
-        data = decompress(compressed, uncompressed)
-    except Exception as exc:  # zstandard.ZstdError, lz4's RuntimeError...
-        raise CorruptRecording(
-            f"{where} does not decompress ({compression}): {exc}".rstrip(": ")
-        ) from None
-    if len(data) != uncompressed:
-        raise CorruptRecording(
-            f"{where} decompresses to {len(data)} bytes, its header says {uncompressed}"
-        )
-    if crc != 0:
-        computed = zlib.crc32(data)
-        if computed != crc:
-            raise CorruptRecording(
-                f"{where} fails its CRC check: expected 0x{crc:08x}, computed 0x{computed:08x}"
-            )
-    return data
+def count_messages(container: Container) -> dict[int, int]:
+    """Messages per channel id, counted in the chunks (for files without statistics)."""
+    counts: dict[int, int] = {}
+    with container.open() as stream:
+        for ref in container.chunks:
+            for channel in message_channels(container.chunk_data(stream, ref)):
+                counts[channel] = counts.get(channel, 0) + 1
+    return counts
 
 
-def _zstd(data: bytes, size: int) -> bytes:
-    result: bytes = zstandard.ZstdDecompressor().decompress(data, max_output_size=max(size, 1))
-    return result
-
-
-def _lz4(data: bytes, size: int) -> bytes:
-    import lz4.frame  # type: ignore[import-untyped,import-not-found,unused-ignore]
-
-    result: bytes = lz4.frame.decompress(data)
-    return result
-
-
-_DECOMPRESSORS: dict[str, Callable[[bytes, int], bytes]] = {
-    "zstd": _zstd,
-    "lz4": _lz4,
-    "": lambda data, size: data,
-}
+def topic_chunks(
+    container: Container,
+    channel: int,
+    limit_ns: int | None,
+    *,
+    step: int | None = None,
+) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
+    """The chunks with messages of ``channel`` (or only those around ``step``'s log time),
+    each with its records, those messages' bytes and their log times. A finished file's
+    messages are found through each chunk's message index, anything else by walking the
+    chunk's records; an unfinished file's messages stop at ``limit_ns``."""
+    path = container.path
+    with container.open() as stream:
+        for ref in container.chunks:
+            if ref.channels is not None and channel not in ref.channels:
+                continue
+            if step is not None and not ref.start_ns <= step * STEP_NS <= ref.end_ns:
+                continue
+            if limit_ns is not None and ref.start_ns >= limit_ns:
+                break
+            data = container.chunk_data(stream, ref)
+            cut = limit_ns if limit_ns is not None and ref.end_ns >= limit_ns else None
+            if cut is None:
+                offsets = container.message_offsets(stream, ref, channel)
+                if offsets is not None:
+                    found = messages_at(path, data, offsets, channel, where=ref.offset)
+                    yield ref, data, found, log_times_at(data, offsets)
+                    continue
+            parts: dict[int, list[memoryview]] = {channel: []}
+            times: dict[int, list[int]] = {channel: []}
+            split_messages(path, data, parts, where=ref.offset, limit_ns=cut, times=times)
+            yield ref, data, parts[channel], np.array(times[channel], np.int64)

@@ -4,7 +4,9 @@ A finished file is opened with the ``mcap`` package's seeking reader (its summar
 channels, statistics, chunk, metadata and attachment indexes), after checking the summary's
 CRC. A file without a footer (the writer was killed) is scanned sequentially from its start;
 every complete chunk is kept, and the scan stops at the first truncated or invalid record.
-The chunks themselves are read by :mod:`rsstp_replay._chunks`. Every problem raises a
+A chunk record is read whole, decompressed and checked against its CRC here
+(:meth:`Container.chunk_data`); the messages inside it are the business of the layer above,
+:mod:`rsstp_replay._chunks`, which this module never calls. Every problem raises a
 :mod:`rsstp_replay.errors` exception whose message names the file and the byte offset.
 """
 
@@ -14,26 +16,32 @@ import io
 import os
 import struct
 import zlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import BinaryIO
 
 import numpy as np
 import numpy.typing as npt
+import zstandard
 from mcap.data_stream import ReadDataStream
 from mcap.exceptions import McapError
 from mcap.opcode import Opcode
 from mcap.reader import SeekingReader
 from mcap.records import Attachment, Channel, Metadata, Schema
 
-from rsstp_replay._chunks import MESSAGE_TIME, RECORD, chunk_records, message_channels
 from rsstp_replay.errors import CorruptRecording, NotARecording
 from rsstp_sim.files import irregular
 
-__all__ = ["ChunkRef", "Container", "open_container"]
+__all__ = ["MESSAGE_TIME", "RECORD", "ChunkRef", "Container", "chunk_records", "open_container"]
 
 MAGIC = b"\x89MCAP0\r\n"
 _FOOTER = struct.Struct("<BQQQI")  # opcode, length, summary start, summary offset start, crc
+RECORD = struct.Struct("<BQ")
+"""A record's opcode and the length of its body."""
+MESSAGE_TIME = struct.Struct("<BQHIQ")
+"""A message record's opcode, length, channel id, sequence and log time."""
+_CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
 _PARSE_ERRORS = (
     McapError,
     struct.error,
@@ -83,15 +91,6 @@ class Container:
     def open(self) -> BinaryIO:
         """The file, opened for reading (the caller closes it)."""
         return _open(self.path)
-
-    def count_messages(self) -> dict[int, int]:
-        """Messages per channel id, counted in the chunks (for files without statistics)."""
-        counts: dict[int, int] = {}
-        with self.open() as stream:
-            for ref in self.chunks:
-                for channel in message_channels(self.chunk_data(stream, ref)):
-                    counts[channel] = counts.get(channel, 0) + 1
-        return counts
 
     def chunk_data(self, stream: BinaryIO, ref: ChunkRef) -> bytes:
         """The decompressed records of the chunk ``ref``, CRC-checked."""
@@ -312,6 +311,70 @@ def _scan_chunk(container: Container, data: bytes, offset: int, length: int) -> 
             _register(container, opcode, body)
         position += RECORD.size + size
     return ChunkRef(offset, length, max(start_ns, 0), max(end_ns, 0), frozenset(channels))
+
+
+def chunk_records(path: Path, raw: bytes, offset: int) -> bytes:
+    """The records inside a whole chunk record (``raw``): decompressed and CRC-checked."""
+    where = f"{path}: the chunk at byte {offset}"
+    try:
+        opcode, length = RECORD.unpack_from(raw)
+        _, _, uncompressed, crc, name_length = _CHUNK.unpack_from(raw, RECORD.size)
+        position = RECORD.size + _CHUNK.size
+        compression = raw[position : position + name_length].decode("utf-8")
+        position += name_length
+        (data_length,) = struct.unpack_from("<Q", raw, position)
+        position += 8
+    except (struct.error, UnicodeDecodeError):
+        raise CorruptRecording(f"{where} has an unreadable header") from None
+    if opcode != Opcode.CHUNK or RECORD.size + length != len(raw):
+        raise CorruptRecording(
+            f"{where}: expected a chunk record of {len(raw)} bytes, found opcode "
+            f"0x{opcode:02x} with length {length}"
+        )
+    if position + data_length > len(raw):
+        raise CorruptRecording(
+            f"{where} says {data_length} bytes of data, more than its record holds"
+        )
+    compressed = raw[position : position + data_length]
+    decompress = _DECOMPRESSORS.get(compression)
+    if decompress is None:
+        raise CorruptRecording(f"{where} uses an unknown compression {compression!r}")
+    try:
+        data = decompress(compressed, uncompressed)
+    except Exception as exc:  # zstandard.ZstdError, lz4's RuntimeError...
+        raise CorruptRecording(
+            f"{where} does not decompress ({compression}): {exc}".rstrip(": ")
+        ) from None
+    if len(data) != uncompressed:
+        raise CorruptRecording(
+            f"{where} decompresses to {len(data)} bytes, its header says {uncompressed}"
+        )
+    if crc != 0:
+        computed = zlib.crc32(data)
+        if computed != crc:
+            raise CorruptRecording(
+                f"{where} fails its CRC check: expected 0x{crc:08x}, computed 0x{computed:08x}"
+            )
+    return data
+
+
+def _zstd(data: bytes, size: int) -> bytes:
+    result: bytes = zstandard.ZstdDecompressor().decompress(data, max_output_size=max(size, 1))
+    return result
+
+
+def _lz4(data: bytes, size: int) -> bytes:
+    import lz4.frame  # type: ignore[import-untyped,import-not-found,unused-ignore]
+
+    result: bytes = lz4.frame.decompress(data)
+    return result
+
+
+_DECOMPRESSORS: dict[str, Callable[[bytes, int], bytes]] = {
+    "zstd": _zstd,
+    "lz4": _lz4,
+    "": lambda data, size: data,
+}
 
 
 def _attachment(path: Path, raw: bytes, offset: int) -> Attachment:

@@ -1,14 +1,19 @@
-"""What a file must hold to be a recording: the reader's middle layer.
+"""What a file must hold to be a recording: the reader's third layer.
 
 The ``/rsstp/*`` channels (one per topic, with their schemas, encodings and a ``1.x``
 version), the ``rsstp`` metadata record, and the ``scenario.toml`` attachment agreeing with the
 ``/rsstp/scenario`` message and the metadata (``schemas/README.md`` is the contract).
 
-Opening a recording goes down the reader's layers once: :func:`~rsstp_replay.open_recording`
-calls :func:`check_file` (this module) on what
-:func:`~rsstp_replay._container.open_container` found (the file's records and chunks, each
-chunk's bytes read by :mod:`rsstp_replay._chunks`). After that,
-:class:`~rsstp_replay.recording.Recording` reads messages through :meth:`CheckedFile.chunks`.
+The reader's layers, each importing only those below it: the container
+(:mod:`rsstp_replay._container`: the file's records, its chunk records decompressed and
+CRC-checked), the chunks (:mod:`rsstp_replay._chunks`: the messages inside them), the contract
+(this module) and the recording (:mod:`rsstp_replay.recording`). Opening a recording goes
+down them once: :func:`~rsstp_replay.open_recording` takes what
+:func:`~rsstp_replay._container.open_container` found to :func:`check_file`, which reads the
+scenario message (and, for a file without statistics, the message counts) through the chunks
+layer, which reads the chunk records through the container. No call goes back up. After
+that, :class:`~rsstp_replay.recording.Recording` reads messages through
+:meth:`CheckedFile.chunks`, down the same way.
 """
 
 from __future__ import annotations
@@ -25,7 +30,7 @@ import msgspec
 import numpy as np
 import numpy.typing as npt
 
-from rsstp_replay._chunks import log_times_at, messages_at, split_messages
+from rsstp_replay._chunks import count_messages, topic_chunks
 from rsstp_replay._container import ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
 from rsstp_sim.errors import ScenarioError
@@ -33,6 +38,8 @@ from rsstp_sim.recording.records import RecordFormatError, ScenarioRecord, decod
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_NAME,
     MESSAGE_ENCODING,
+    METADATA_CHECKSUM_KEY,
+    METADATA_CHECKSUM_SINCE,
     METADATA_KEYS,
     METADATA_NAME,
     SCHEMA_ENCODING,
@@ -40,6 +47,7 @@ from rsstp_sim.recording.schemas import (
     STEP_NS,
     TOPICS,
     check_schema_version,
+    metadata_checksum,
     parse_version,
     version_refusal,
 )
@@ -53,7 +61,8 @@ _Ints = npt.NDArray[np.int64]
 @dataclass(frozen=True, slots=True)
 class CheckedFile:
     """A file that holds a recording, as :func:`check_file` found it: its channels by topic,
-    schema versions, metadata, message counts per topic (an unfinished file's cut at
+    schema versions, metadata (``metadata_verified``: by its checksum; False for a file older
+    than the checksum), message counts per topic (an unfinished file's cut at
     ``limit_ns``, its last recovered step), the last step, and the scenario. It reads the
     messages of a topic chunk by chunk for :class:`~rsstp_replay.recording.Recording`."""
 
@@ -61,6 +70,7 @@ class CheckedFile:
     channels: dict[str, int]
     schema_versions: dict[str, str]
     metadata: dict[str, str]
+    metadata_verified: bool
     topic_counts: dict[str, int]
     limit_ns: int | None
     n_steps: int
@@ -72,7 +82,7 @@ class CheckedFile:
     ) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
         """The chunks with messages of ``topic`` (or only those around ``step``'s log time),
         each with its records, those messages' bytes and their log times."""
-        return _topic_chunks(self.container, self.channels, self.limit_ns, topic, step=step)
+        return topic_chunks(self.container, self.channels[topic], self.limit_ns, step=step)
 
     def decode_one(self, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
         """The record of one message of ``topic``."""
@@ -96,8 +106,8 @@ def check_file(container: Container) -> CheckedFile:
         )
     channels = rsstp_channels(container)
     schema_versions = check_schemas(container, channels)
-    metadata = read_metadata(container)
-    counts = container.counts if container.counts is not None else container.count_messages()
+    metadata, verified = read_metadata(container, schema_versions)
+    counts = container.counts if container.counts is not None else count_messages(container)
     limit_ns: int | None = None
     if not container.data_complete:
         limit_ns = cut_time(container, channels["/rsstp/step"])
@@ -119,6 +129,7 @@ def check_file(container: Container) -> CheckedFile:
         channels,
         schema_versions,
         metadata,
+        verified,
         topic_counts,
         limit_ns,
         n_step_messages - 1,
@@ -136,47 +147,14 @@ def _scenario_message(
         raise CorruptRecording(
             f"{container.path}: expected one /rsstp/scenario message, found {count}"
         )
-    with closing(_topic_chunks(container, channels, limit_ns, "/rsstp/scenario")) as chunks:
+    channel = channels["/rsstp/scenario"]
+    with closing(topic_chunks(container, channel, limit_ns)) as chunks:
         for ref, _, parts, times in chunks:
             if parts:
                 record = _decode_one(container.path, "/rsstp/scenario", parts[0], times[0], ref)
                 assert isinstance(record, ScenarioRecord)
                 return record
     raise CorruptRecording(f"{container.path}: the /rsstp/scenario message is missing")
-
-
-def _topic_chunks(
-    container: Container,
-    channels: dict[str, int],
-    limit_ns: int | None,
-    topic: str,
-    *,
-    step: int | None = None,
-) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
-    """:meth:`CheckedFile.chunks`: a finished file's messages are found through each
-    chunk's message index, anything else by walking the chunk's records; an unfinished file's
-    messages stop at ``limit_ns``."""
-    path, channel = container.path, channels[topic]
-    with container.open() as stream:
-        for ref in container.chunks:
-            if ref.channels is not None and channel not in ref.channels:
-                continue
-            if step is not None and not ref.start_ns <= step * STEP_NS <= ref.end_ns:
-                continue
-            if limit_ns is not None and ref.start_ns >= limit_ns:
-                break
-            data = container.chunk_data(stream, ref)
-            cut = limit_ns if limit_ns is not None and ref.end_ns >= limit_ns else None
-            if cut is None:
-                offsets = container.message_offsets(stream, ref, channel)
-                if offsets is not None:
-                    found = messages_at(path, data, offsets, channel, where=ref.offset)
-                    yield ref, data, found, log_times_at(data, offsets)
-                    continue
-            parts: dict[int, list[memoryview]] = {channel: []}
-            times: dict[int, list[int]] = {channel: []}
-            split_messages(path, data, parts, where=ref.offset, limit_ns=cut, times=times)
-            yield ref, data, parts[channel], np.array(times[channel], np.int64)
 
 
 def _decode_many(
@@ -263,17 +241,38 @@ def check_schemas(container: Container, channels: dict[str, int]) -> dict[str, s
     return versions
 
 
-def read_metadata(container: Container) -> dict[str, str]:
-    """The ``rsstp`` metadata record, every key present."""
+def read_metadata(
+    container: Container, schema_versions: dict[str, str]
+) -> tuple[dict[str, str], bool]:
+    """The ``rsstp`` metadata record, every key present, and whether its checksum verified it:
+    a file of schema 2.2 or later must carry a checksum that matches; an older one has none,
+    and its metadata is read unverified (``schemas/README.md``, "The metadata checksum")."""
     path = container.path
     found = [m for m in container.metadata if m.name == METADATA_NAME]
     if not found:
         raise CorruptRecording(f"{path}: the {METADATA_NAME!r} metadata record is missing")
     metadata = dict(found[0].metadata)
+    recorded = metadata.get(METADATA_CHECKSUM_KEY)
+    if recorded is not None:
+        computed = metadata_checksum(metadata)
+        if recorded != computed:
+            raise CorruptRecording(
+                f"{path}: the {METADATA_NAME!r} metadata record fails its checksum: "
+                f"{METADATA_CHECKSUM_KEY} is {recorded[:80]!r}, its other keys hash to "
+                f"{computed} (the metadata was changed after it was written)"
+            )
+    else:
+        version = max(parse_version(v) for v in schema_versions.values())
+        if version >= METADATA_CHECKSUM_SINCE:
+            raise CorruptRecording(
+                f"{path}: the {METADATA_NAME!r} metadata record lacks its checksum "
+                f"{METADATA_CHECKSUM_KEY} (a schema {version[0]}.{version[1]} file must carry "
+                f"it, from {METADATA_CHECKSUM_SINCE[0]}.{METADATA_CHECKSUM_SINCE[1]} on)"
+            )
     missing = [key for key in METADATA_KEYS if key not in metadata]
     if missing:
         raise CorruptRecording(f"{path}: the {METADATA_NAME!r} metadata lacks the keys {missing}")
-    return metadata
+    return metadata, recorded is not None
 
 
 def cut_time(container: Container, step_channel: int) -> int:

@@ -9,17 +9,34 @@ snapshot, so a model at any step is known to be the one the run had.
 from __future__ import annotations
 
 import bisect
-import itertools
+from array import array
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import Any
 
 import msgspec
 
 from rsstp_replay.errors import CorruptRecording
 from rsstp_sim.errors import ModelError
-from rsstp_sim.recording.records import ModelRecord, TransitionsRecord
+from rsstp_sim.recording.records import ModelRecord, TransitionsRecord, encode
 from rsstp_sim.transition_system import TransitionSystem
 
-__all__ = ["ChainCheck", "build_model"]
+__all__ = ["HEADS", "ChainCheck", "ModelHead", "build_model"]
+
+
+ModelHead: Any = msgspec.defstruct(
+    "ModelHead",
+    [(f.name, f.type) for f in msgspec.structs.fields(ModelRecord) if f.name != "transitions"],
+    kw_only=True,
+    gc=False,
+)
+"""A ``/rsstp/model`` message read without its transitions (the parser skips them): the
+fields of :class:`~rsstp_sim.recording.records.ModelRecord` but those. What
+:meth:`ChainCheck.head` needs to rebuild the version and write its bytes again."""
+
+
+HEADS = msgspec.json.Decoder(list[ModelHead])
+"""Decodes a chunk's model messages joined as one JSON array."""
 
 
 def build_model(path: Path, record: ModelRecord) -> TransitionSystem:
@@ -53,16 +70,53 @@ class ChainCheck:
         self._model: TransitionSystem | None = None
 
     def __call__(self, record: ModelRecord) -> ModelRecord:
+        """Check ``record``, the next message decoded whole; the record to keep."""
+        if self._previous is None:
+            return self._first(record)
+        touched = self._advance(record)
+        return self._compare(record, touched)
+
+    def head(self, head: ModelHead, data: bytes, decode: Callable[[], ModelRecord]) -> ModelRecord:
+        """Check the next message from its ``head`` (decoded without the transitions) and its
+        bytes: when ``data`` is, byte for byte, the message of the version its operations
+        make (as the recorder writes it), its transitions are never parsed. Otherwise the
+        message is decoded whole (``decode``) and compared field by field, which names any
+        difference (equal values written another way pass)."""
+        previous = self._previous
+        if previous is None:
+            return self._first(decode())
+        touched = self._advance(head)
+        model = self._model
+        assert model is not None
+        patched = _patched(previous.transitions, model, touched)
+        fields = {name: getattr(head, name) for name in head.__struct_fields__}
+        expected = ModelRecord(
+            **fields,
+            transitions=TransitionsRecord(
+                source=list(patched.source),
+                action=list(patched.action),
+                target=list(patched.target),
+            ),
+        )
+        if encode(expected) != data:
+            return self._compare(decode(), touched, patched)
+        return self._accept(msgspec.structs.replace(expected, transitions=patched), "")
+
+    def _first(self, record: ModelRecord) -> ModelRecord:
+        if record.step != 0:
+            raise CorruptRecording(
+                f"{self._path}: the first model message is at step {record.step}, expected step 0"
+            )
+        self._model = model = build_model(self._path, record)
+        _check_flags(self._path, record, model)
+        self._previous = record
+        return record
+
+    def _advance(self, record: ModelRecord | ModelHead) -> set[int]:
+        """Apply the next message's operations to the model rebuilt so far (after checking
+        its step); the states whose transitions they may have changed."""
         path, previous, model = self._path, self._previous, self._model
-        if previous is None or model is None:
-            if record.step != 0:
-                raise CorruptRecording(
-                    f"{path}: the first model message is at step {record.step}, expected step 0"
-                )
-            self._model = model = build_model(path, record)
-            _check_flags(path, record, model)
-            self._previous = record
-            return record
+        assert previous is not None and model is not None
         if record.step > self._last_step:
             raise CorruptRecording(
                 f"{path}: {_name(record)} comes after the last step, {self._last_step:,}"
@@ -83,18 +137,24 @@ class ChainCheck:
                     f"{list(operation.args)}) does not apply to version {previous.version}: {exc}"
                 ) from None
         model.drain_operations()
-        patched = _patched(previous.transitions, model, touched)
-        t = record.transitions
-        if patched == (t.source, t.action, t.target):
-            record = msgspec.structs.replace(
-                record,
-                transitions=TransitionsRecord(
-                    source=patched[0], action=patched[1], target=patched[2]
-                ),
-            )
-            difference = _difference(model, record)
-        else:
-            difference = _difference(model, record, full=True)
+        return touched
+
+    def _compare(
+        self, record: ModelRecord, touched: set[int], patched: _Compact | None = None
+    ) -> ModelRecord:
+        """Compare a message decoded whole with the model its operations made."""
+        previous, model = self._previous, self._model
+        assert previous is not None and model is not None
+        if patched is None:
+            patched = _patched(previous.transitions, model, touched)
+        if patched.holds(record.transitions):
+            record = msgspec.structs.replace(record, transitions=patched)
+            return self._accept(record, _difference(model, record))
+        return self._accept(record, _difference(model, record, full=True))
+
+    def _accept(self, record: ModelRecord, difference: str) -> ModelRecord:
+        path, previous, model = self._path, self._previous, self._model
+        assert previous is not None and model is not None
         if difference:
             raise CorruptRecording(
                 f"{path}: {_name(record)}: its operations applied to version "
@@ -118,30 +178,72 @@ class ChainCheck:
             )
 
 
-def _patched(
-    previous: TransitionsRecord, rebuilt: TransitionSystem, touched: set[int]
-) -> tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]]:
+def _patched(previous: TransitionsRecord, rebuilt: TransitionSystem, touched: set[int]) -> _Compact:
     """The previous snapshot's transitions with the rows of the ``touched`` states (sorted by
-    source, action and target) replaced by the rebuilt model's."""
+    source, action and target) replaced by the rebuilt model's, in compact columns."""
     source, action, target = previous.source, previous.action, previous.target
-    parts: list[tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]]] = []
+    ids = max(rebuilt.next_id, -min(rebuilt.states, default=0))
+    moves = max(max(rebuilt.actions, default=0), -min(rebuilt.actions, default=0))
+    columns = (_column(ids), _column(moves), _column(ids))
     done = 0
-    for state in sorted(touched):
-        lo = bisect.bisect_left(source, state, done)
-        hi = bisect.bisect_right(source, state, lo)
-        parts.append((source[done:lo], action[done:lo], target[done:lo]))
-        if state in rebuilt:
-            rows = rebuilt.transitions_from(state)
-            parts.append(
-                ((state,) * len(rows), tuple(a for a, _ in rows), tuple(t for _, t in rows))
-            )
-        done = hi
-    parts.append((source[done:], action[done:], target[done:]))
-    return (
-        tuple(itertools.chain.from_iterable(p[0] for p in parts)),
-        tuple(itertools.chain.from_iterable(p[1] for p in parts)),
-        tuple(itertools.chain.from_iterable(p[2] for p in parts)),
-    )
+    try:
+        for state in sorted(touched):
+            lo = bisect.bisect_left(source, state, done)
+            hi = bisect.bisect_right(source, state, lo)
+            _extend(columns, source[done:lo], action[done:lo], target[done:lo])
+            if state in rebuilt:
+                rows = rebuilt.transitions_from(state)
+                _extend(columns, (state,) * len(rows), [a for a, _ in rows], [t for _, t in rows])
+            done = hi
+        _extend(columns, source[done:], action[done:], target[done:])
+    except OverflowError:  # an id past the model's own: the comparison names it
+        return _Compact(source=array("q"), action=array("q"), target=array("q"))
+    return _Compact(source=columns[0], action=columns[1], target=columns[2])
+
+
+def _extend(columns: tuple[array[int], ...], *parts: Sequence[int]) -> None:
+    """Append each part to its column (an array of the column's type is copied at C
+    speed; one of another type, after a version outgrew 2-byte ids, value by value)."""
+    for column, part in zip(columns, parts, strict=True):
+        if isinstance(part, array) and part.typecode != column.typecode:
+            column.extend(part.tolist())
+        else:
+            column.extend(part)  # type: ignore[arg-type]
+
+
+class _Compact(TransitionsRecord, frozen=True, kw_only=True, gc=False):
+    """Transitions in ``array.array`` columns of the narrowest signed type that holds the
+    model's ids (2 bytes each below 32,768 states, where a tuple's slot takes 8)."""
+
+    def as_lists(self) -> TransitionsRecord:
+        """The same transitions in lists (what the JSON encoder writes)."""
+        columns = [self.source, self.action, self.target]
+        source, action, target = (c.tolist() for c in columns if isinstance(c, array))
+        return TransitionsRecord(source=source, action=action, target=target)
+
+    def holds(self, other: TransitionsRecord) -> bool:
+        """Whether ``other`` has the same transitions in the same order."""
+        for mine, theirs in (
+            (self.source, other.source),
+            (self.action, other.action),
+            (self.target, other.target),
+        ):
+            assert isinstance(mine, array)
+            try:
+                if mine != array(mine.typecode, theirs):
+                    return False
+            except (OverflowError, TypeError):  # an id that does not fit: not one of ours
+                return False
+        return True
+
+
+def _column(largest: int) -> array[int]:
+    """An empty column of the narrowest signed type for ids of at most ``largest`` in
+    absolute value."""
+    for code in ("h", "i"):
+        if largest < 1 << (8 * array(code).itemsize - 1):
+            return array(code)
+    return array("q")
 
 
 def _difference(rebuilt: TransitionSystem, record: ModelRecord, *, full: bool = False) -> str:
@@ -176,5 +278,5 @@ def _check_flags(path: Path, record: ModelRecord, model: TransitionSystem) -> No
         )
 
 
-def _name(record: ModelRecord) -> str:
+def _name(record: ModelRecord | ModelHead) -> str:
     return f"model version {record.version} (step {record.step})"

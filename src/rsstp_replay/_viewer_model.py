@@ -39,6 +39,7 @@ import math
 from collections import defaultdict
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import chain
 
 import numpy as np
 import numpy.typing as npt
@@ -288,35 +289,47 @@ def log_model(
     all). Returns rows per entity path (the per-state paths summed under :data:`STATES`)."""
     rows: dict[int, list[_Row]] = defaultdict(list)
     model = TransitionSystem.from_snapshot(versions[0].snapshot(), version=versions[0].version)
-
-    def role(version: int, state: int) -> int | None:
-        return None if roles is None else roles.get(version, {}).get(state, UNVISITED)
-
-    shown: dict[int, int | None] = {}
+    no_roles: dict[int, int] = {}
+    in_force = no_roles if roles is None else roles.get(versions[0].version, no_roles)
     for state in model.states:
-        shown[state] = role(versions[0].version, state)
-        rows[state].append((steps[0], _outs(model, state), shown[state]))
-    previous = versions[0].version
+        rows[state].append((steps[0], _outs(model, state), _role(roles, in_force, state)))
     for record, step in zip(versions[1:], steps[1:], strict=True):
         touched = _touched(model, record)
-        candidates = set(touched)
-        if roles is not None:  # states whose role may have changed
-            candidates |= roles.get(record.version, {}).keys() | roles.get(previous, {}).keys()
+        candidates = touched
+        if roles is not None:  # and the states whose role changed
+            before, in_force = in_force, roles.get(record.version, no_roles)
+            candidates = touched | _changed(before, in_force)
         for state in sorted(candidates):
             if state in model:
-                now = role(record.version, state)
-                if state in touched or now != shown.get(state):
-                    rows[state].append((step, _outs(model, state), now))
-                    shown[state] = now
+                # A state whose role alone changed keeps its transitions: the last row's.
+                outs = _outs(model, state) if state in touched else rows[state][-1][1]
+                rows[state].append((step, outs, _role(roles, in_force, state)))
             elif state in touched:
                 rows[state].append((step, None, None))
-        previous = record.version
     count = 0
+    ids = np.array(sorted(places.places), np.int64)
+    xy = np.array([places.places[s] for s in ids.tolist()], np.float64).reshape(-1, 2)
     for state, changes in sorted(rows.items()):
         count += _log_state(
-            stream, state, changes, places, labelled=labelled is None or state in labelled
+            stream,
+            state,
+            changes,
+            places,
+            (ids, xy),
+            labelled=labelled is None or state in labelled,
         )
     return {STATES: count}
+
+
+def _role(roles: Roles | None, in_force: dict[int, int], state: int) -> int | None:
+    return None if roles is None else in_force.get(state, UNVISITED)
+
+
+def _changed(before: dict[int, int], after: dict[int, int]) -> set[int]:
+    """The states whose role differs between two versions (absent: unvisited)."""
+    changed = {s for s, role in after.items() if before.get(s, UNVISITED) != role}
+    changed.update(s for s, role in before.items() if s not in after and role != UNVISITED)
+    return changed
 
 
 def log_legend(stream: rr.RecordingStream, *, reach: float) -> None:
@@ -338,7 +351,7 @@ def log_legend(stream: rr.RecordingStream, *, reach: float) -> None:
 
 def _outs(model: TransitionSystem, state: int) -> tuple[tuple[int, int], ...]:
     """``(action, target)`` of every transition out of ``state``, sorted."""
-    return tuple((a, t) for a in model.actions for t in model.successors(state, a))
+    return tuple(model.transitions_from(state))
 
 
 def _log_state(
@@ -346,10 +359,12 @@ def _log_state(
     state: int,
     changes: list[_Row],
     places: StatePlaces,
+    place_table: tuple[npt.NDArray[np.int64], _Floats],
     *,
     labelled: bool,
 ) -> int:
-    """The rows of one state's entity (and its loops), a clear where it was deleted."""
+    """The rows of one state's entity (and its loops), a clear where it was deleted;
+    ``place_table`` is every state id, sorted, and its place."""
     path = state_path(state)
     x, y = places.places[state]
     alive = [(step, outs, role) for step, outs, role in changes if outs is not None]
@@ -359,24 +374,9 @@ def _log_state(
             [palette.STATE if role is None else ROLE_COLORS[role] for _, _, role in alive],
             np.uint8,
         )
-        origins, vectors, colors, arrow_counts = [], [], [], []
-        loops, loop_colors, loop_counts = [], [], []
-        for _, outs, _ in alive:
-            arrows = [(a, t) for a, t in outs if t != state]
-            for slot, (a, t) in enumerate(arrows):
-                start, delta = _arrow((x, y), places.places[t], slot, len(arrows), places.scale)
-                origins.append(start)
-                vectors.append(delta)
-                colors.append(ACTION_COLORS[a % len(ACTION_COLORS)])
-            arrow_counts.append(len(arrows))
-            self_loops = [a for a, t in outs if t == state]
-            for a in self_loops:
-                angle = 2 * math.pi * (a % len(ACTION_COLORS)) / len(ACTION_COLORS)
-                loops.append(
-                    (x + places.scale * math.cos(angle), y + places.scale * math.sin(angle))
-                )
-                loop_colors.append(ACTION_COLORS[a % len(ACTION_COLORS)])
-            loop_counts.append(len(self_loops))
+        arrows, loops = _drawn_transitions(
+            state, [outs for _, outs, _ in alive], places, place_table
+        )
         index = [rr.TimeColumn(TIMELINE, sequence=times)]
         stream.send_columns(
             path,
@@ -388,20 +388,18 @@ def _log_state(
                     labels=[str(state)] * len(times) if labelled else None,
                 ),
                 *rr.Arrows2D.columns(
-                    origins=np.array(origins, np.float64).reshape(-1, 2),
-                    vectors=np.array(vectors, np.float64).reshape(-1, 2),
-                    colors=np.array(colors, np.uint8).reshape(-1, 3),
-                ).partition(np.array(arrow_counts, np.int64)),
+                    origins=arrows.origins, vectors=arrows.vectors, colors=arrows.colors
+                ).partition(arrows.counts),
             ],
         )
         stream.send_columns(
             f"{path}/loops",
             indexes=index,
             columns=rr.Points2D.columns(
-                positions=np.array(loops, np.float64).reshape(-1, 2),
-                colors=np.array(loop_colors, np.uint8).reshape(-1, 3),
-                radii=np.full(len(loops), -2.5, np.float32),  # ui points
-            ).partition(np.array(loop_counts, np.int64)),
+                positions=loops.origins,
+                colors=loops.colors,
+                radii=np.full(len(loops.origins), -2.5, np.float32),  # ui points
+            ).partition(loops.counts),
         )
         poses = places.poses.get(state)
         if poses is not None:
@@ -422,25 +420,80 @@ def _log_state(
     return len(changes)
 
 
-def _arrow(
+@dataclass(frozen=True, slots=True)
+class _Drawn:
+    """Markers of a state's rows, flat: each one's origin (and vector, for arrows) and colour,
+    and how many belong to each row."""
+
+    origins: _Floats
+    vectors: _Floats
+    colors: npt.NDArray[np.uint8]
+    counts: npt.NDArray[np.int64]
+
+
+def _drawn_transitions(
+    state: int,
+    rows: list[tuple[tuple[int, int], ...]],
+    places: StatePlaces,
+    place_table: tuple[npt.NDArray[np.int64], _Floats],
+) -> tuple[_Drawn, _Drawn]:
+    """For each row's transitions out of ``state``: an arrow per transition to another state
+    (:func:`_arrow`), a marker per self-loop, placed around the state in the direction of
+    its action's slot on the colour wheel."""
+    x, y = places.places[state]
+    scale = places.scale
+    per_row = np.fromiter(map(len, rows), np.int64, len(rows))
+    flat = np.fromiter(chain.from_iterable(chain.from_iterable(rows)), np.int64).reshape(-1, 2)
+    row_of = np.repeat(np.arange(len(rows)), per_row)
+    actions, targets = flat[:, 0], flat[:, 1]
+    colors = np.array(ACTION_COLORS, np.uint8)[actions % len(ACTION_COLORS)]
+    loop = targets == state
+    # Self-loops: a marker at the action's angle.
+    angle = 2 * np.pi * (actions[loop] % len(ACTION_COLORS)) / len(ACTION_COLORS)
+    loop_at = np.stack([x + scale * np.cos(angle), y + scale * np.sin(angle)], axis=1)
+    loops = _Drawn(
+        loop_at,
+        np.zeros_like(loop_at),
+        colors[loop],
+        np.bincount(row_of[loop], minlength=len(rows)),
+    )
+    # Arrows: each row's k-th arrow in slot k of that row's arrows.
+    ids, xy = place_table
+    arrow_rows = row_of[~loop]
+    counts = np.bincount(arrow_rows, minlength=len(rows))
+    firsts = np.cumsum(counts) - counts
+    slot = np.arange(len(arrow_rows)) - firsts[arrow_rows]
+    origins, vectors = _arrows(
+        (x, y), xy[np.searchsorted(ids, targets[~loop])], slot, counts[arrow_rows], scale
+    )
+    return _Drawn(origins, vectors, colors[~loop], counts), loops
+
+
+def _arrows(
     source: tuple[float, float],
-    target: tuple[float, float],
-    slot: int,
-    slots: int,
+    targets: _Floats,
+    slot: npt.NDArray[np.int64],
+    slots: npt.NDArray[np.int64],
     scale: float,
-) -> tuple[tuple[float, float], tuple[float, float]]:
-    """An arrow from ``source`` towards ``target``, shortened at both ends, shifted sideways
-    by its slot so that arrows of several actions (and the way back) stay apart."""
-    (x0, y0), (x1, y1) = source, target
-    dx, dy = x1 - x0, y1 - y0
-    length = math.hypot(dx, dy)
-    if length == 0.0:  # two states at one place: a short arrow to the right
-        return (x0, y0), (2 * scale, 0.0)
-    ux, uy = dx / length, dy / length
+) -> tuple[_Floats, _Floats]:
+    """Arrows from ``source`` towards each of ``targets``, shortened at both ends, shifted
+    sideways by their slot so that arrows of several actions (and the way back) stay apart;
+    an arrow between two states at one place is a short one to the right."""
+    x0, y0 = source
+    delta = targets - np.array([x0, y0])
+    length = np.hypot(delta[:, 0], delta[:, 1])
+    apart = length > 0.0
+    unit = np.divide(delta, length[:, None], out=np.zeros_like(delta), where=apart[:, None])
     side = 0.35 * scale * (slot - (slots - 1) / 2) + 0.25 * scale
-    gap = min(1.2 * scale, 0.3 * length)
-    start = (x0 + ux * gap - uy * side, y0 + uy * gap + ux * side)
-    return start, (dx - 2 * ux * gap, dy - 2 * uy * gap)
+    gap = np.minimum(1.2 * scale, 0.3 * length)
+    origins = np.stack(
+        [x0 + unit[:, 0] * gap - unit[:, 1] * side, y0 + unit[:, 1] * gap + unit[:, 0] * side],
+        axis=1,
+    )
+    vectors = delta - 2 * unit * gap[:, None]
+    origins[~apart] = (x0, y0)
+    vectors[~apart] = (2 * scale, 0.0)
+    return origins, vectors
 
 
 def log_current_state(

@@ -39,6 +39,7 @@ __all__ = [
     "MODEL_TRANSITIONS",
     "PHASE",
     "SENSATION",
+    "SERIES_MAX_ROWS",
     "LogLine",
     "audit_lines",
     "distance_name",
@@ -68,13 +69,18 @@ def log_series(
     *,
     n_joints: int,
     n_obstacles: int,
-) -> dict[str, int]:
-    """Sensation, feedback and the sensor readings; returns rows per path.
+) -> tuple[dict[str, int], list[str]]:
+    """Sensation, feedback and the sensor readings; returns rows per path, and the paths
+    thinned to their extremes.
 
     A step's value holds until the next step, so every series is drawn as steps
     (``StepAfter``) and has a row only where its value changes (and at the first and last
     step): exact, and small on long runs (a sensation that is false for a million steps is
-    two rows). The distances are one entity with a series per tip and obstacle.
+    two rows). The distances are one entity with a series per tip and obstacle. A series
+    that changes more than :data:`SERIES_MAX_ROWS` times in the steps shown (the closeness
+    or the distances over a long run, which change with every pose) keeps each curve's
+    least and greatest value in each of equal runs of steps (:func:`_extremes`); a shorter
+    ``--from``/``--to`` window shows every change.
     """
     times = steps.index.to_numpy(np.int64)
     series: list[tuple[str, list[str], npt.NDArray[np.float64]]] = [
@@ -90,7 +96,7 @@ def log_series(
                 steps[[f"dist_{k}_{j}" for k, j in pairs]].to_numpy(np.float64),
             )
         )
-    logged = {}
+    logged, thinned = {}, []
     for path, names, values in series:
         # A boolean drawn zoomed out: min and max per pixel, not their average (0.5 is no
         # sensation the agent ever had).
@@ -103,8 +109,39 @@ def log_series(
             static=True,
         )
         rows = _changes(values)
+        if len(rows) > SERIES_MAX_ROWS:
+            rows = _extremes(times, values, rows, buckets=SERIES_MAX_ROWS // (2 * len(names)))
+            thinned.append(path)
         logged[path] = send_rows(stream, path, times[rows], _scalars(values[rows]))
-    return logged
+    return logged, thinned
+
+
+SERIES_MAX_ROWS = 100_000
+"""A series with more changes than this in the steps shown (a closeness or a distance that
+changes with every pose of a long run) keeps only its extremes: :func:`_extremes`."""
+
+
+def _extremes(
+    times: npt.NDArray[np.int64],
+    values: npt.NDArray[np.float64],
+    rows: npt.NDArray[np.int64],
+    *,
+    buckets: int,
+) -> npt.NDArray[np.int64]:
+    """Of the change ``rows``, those holding each column's least and greatest value in each
+    of ``buckets`` equal runs of steps, and the first and last row: every extreme of every
+    curve is drawn at its step with its value, the values between are the nearest kept
+    ones (at most ``2 * buckets * columns + 2`` rows)."""
+    span = int(times[rows[-1]] - times[rows[0]]) + 1
+    width = -(-span // max(buckets, 1))
+    bucket = (times[rows] - times[rows[0]]) // width
+    starts = np.flatnonzero(np.r_[True, bucket[1:] != bucket[:-1]])
+    kept = [rows[:1], rows[-1:]]
+    for column in values[rows].T:
+        order = np.lexsort((column, bucket))  # by bucket, then by value
+        ends = np.r_[starts[1:], len(rows)] - 1
+        kept += [rows[order[starts]], rows[order[ends]]]
+    return np.unique(np.concatenate(kept))
 
 
 def _scalars(values: npt.NDArray[np.float64]) -> Callable[[slice], rr.ComponentColumnList]:

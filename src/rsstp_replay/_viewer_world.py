@@ -25,7 +25,6 @@ __all__ = [
     "BLOCKED",
     "FEEDBACK_POINTS",
     "OBSTACLES",
-    "SENSOR_MAX_STEPS",
     "SENSOR",
     "WORLD",
     "joint_positions",
@@ -128,18 +127,16 @@ def sensor_segments(positions: _Floats, scenario: Scenario) -> _Floats:
     return np.stack([np.broadcast_to(tips, nearest.shape), nearest], axis=-2)
 
 
-SENSOR_MAX_STEPS = 250_000
-"""Above this many steps the sensor segments are left out (the distances stay as plots): on a
-long run they would be most of the file. ``--from``/``--to`` shows them for any window."""
-
-
 def log_world(
     stream: rr.RecordingStream,
     steps: pd.DataFrame,
     scenario: Scenario,
+    *,
+    sensor: bool = True,
 ) -> dict[str, int]:
-    """The arm with its joints, the obstacle sensor and the blocked moves over the steps of
-    ``steps``, a row only where something changed (the pose, or whether the move was
+    """The arm with its joints, the obstacle sensor (unless not ``sensor``: a long run's
+    overview leaves it out, the distances stay as plots) and the blocked moves over the steps
+    of ``steps``, a row only where something changed (the pose, or whether the move was
     blocked): Rerun shows the latest row at the time cursor. Returns rows per entity path."""
     times = steps.index.to_numpy(np.int64)
     n = scenario.n_joints
@@ -163,7 +160,7 @@ def log_world(
         ),
     }
     m = len(scenario.obstacles)
-    if m and len(times) <= SENSOR_MAX_STEPS:
+    if m and sensor:
         pose_rows = np.flatnonzero(moved)
         segments = sensor_segments(positions[pose_rows], scenario).astype(np.float32)
         logged[SENSOR] = send_rows(

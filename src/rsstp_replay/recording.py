@@ -22,9 +22,10 @@ import os
 import warnings
 from collections.abc import Callable, Generator, Iterator
 from contextlib import closing, contextmanager
+from functools import partial
 from pathlib import Path
 from types import TracebackType
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, TypeVar
 
 import msgspec
 import numpy as np
@@ -35,7 +36,7 @@ from rsstp_replay._chunks import message_times
 from rsstp_replay._container import ChunkRef, open_container
 from rsstp_replay._contract import CheckedFile, check_file
 from rsstp_replay._decode import StepColumns
-from rsstp_replay._models import ChainCheck, build_model
+from rsstp_replay._models import HEADS, ChainCheck, ModelHead, build_model
 from rsstp_replay.errors import (
     BadStep,
     CorruptRecording,
@@ -55,6 +56,8 @@ from rsstp_sim.truth_cache import load_truth
 from rsstp_sim.words import counted
 
 __all__ = ["EVENT_KINDS", "Recording", "open_recording"]
+
+_Stepped = TypeVar("_Stepped", EventRecord, ModelRecord, ModelHead)
 
 EVENT_KINDS = (
     "blocked",
@@ -104,7 +107,9 @@ class Recording:
     ``seed``, ``strategy`` (its name), ``strategy_params``, ``recovered_steps`` (``None`` for a
     finished file, else ``n_steps``: the steps read from the complete chunks), ``scenario``
     (rebuilt from the ``scenario.toml`` attachment), ``scenario_record`` (the
-    ``/rsstp/scenario`` message), ``metadata`` (the ``rsstp`` metadata record) and
+    ``/rsstp/scenario`` message), ``metadata`` (the ``rsstp`` metadata record),
+    ``metadata_verified`` (its checksum matched; False for a file of schema 2.1 or older,
+    written before the checksum) and
     ``schema_versions`` (schema name -> ``"major.minor"`` found in the file).
 
     An unfinished file is cut before its last recovered step: that step's model and event
@@ -118,6 +123,7 @@ class Recording:
         self._ground_truth: GroundTruth | None = None
         self.schema_versions = file.schema_versions
         self.metadata = file.metadata
+        self.metadata_verified = file.metadata_verified
         self.topic_counts = file.topic_counts
         self.n_steps = file.n_steps
         self.recovered_steps: int | None = None if file.container.finished else self.n_steps
@@ -294,11 +300,48 @@ class Recording:
                 one_state = TransitionSystem.universal(self.scenario_record.actions)
                 self._models = (model_record(one_state, step=0, operations=()),)
                 return self._models
-            chain = ChainCheck(self.path, last_step=self.n_steps)
-            models = self._records("/rsstp/model", keep=chain)
-            chain.finish()
-            self._models = tuple(models)
+            self._models = self._checked_models()
         return self._models
+
+    def _checked_models(self) -> tuple[ModelRecord, ...]:
+        """The model messages, each checked against the chain as it is read: a message that
+        is byte for byte what its operations make is read without parsing its transitions
+        (:meth:`~rsstp_replay._models.ChainCheck.head`)."""
+        topic = "/rsstp/model"
+        chain = ChainCheck(self.path, last_step=self.n_steps)
+        found: list[ModelRecord] = []
+        for ref, _, parts, times in self._chunks(topic):
+            try:
+                heads = HEADS.decode(b"[" + b",".join(parts) + b"]")
+            except (msgspec.DecodeError, RecursionError):  # decoded whole below: named there
+                heads = None
+            if heads is None or len(heads) != len(parts):
+                records = self._file.decode_many(topic, parts, times, ref)
+                for record, log_time in zip(records, times.tolist(), strict=True):
+                    found.append(chain(self._timed(topic, record, log_time, ref)))
+                continue
+            for head, part, log_time in zip(heads, parts, times.tolist(), strict=True):
+                self._timed(topic, head, log_time, ref)
+                decode = partial(self._file.decode_one, topic, part, log_time, ref)
+                found.append(chain.head(head, part.tobytes(), decode))
+        chain.finish()
+        expected = self.topic_counts.get(topic, 0)
+        if len(found) != expected:
+            raise CorruptRecording(
+                f"{self.path}: expected {expected} {topic} messages (the summary's count), "
+                f"found {len(found)}"
+            )
+        return tuple(found)
+
+    def _timed(self, topic: str, record: _Stepped, log_time: int, ref: ChunkRef) -> _Stepped:
+        """``record``, a ``topic`` message, checked to be logged at its step's time."""
+        if record.step * STEP_NS != log_time:
+            raise CorruptRecording(
+                f"{self.path}: a {topic} message logged at step "
+                f"{log_time / STEP_NS:g} says step {record.step} (chunk at byte "
+                f"{ref.offset})"
+            )
+        return record
 
     def model_at(self, step: int) -> TransitionSystem:
         """The model at the end of step ``step``, after the strategy's refinement.
@@ -361,14 +404,8 @@ class Recording:
         found: list[Any] = []
         for ref, _, parts, times in self._chunks(topic):
             records = self._file.decode_many(topic, parts, times, ref)
-            for record, log_time in zip(records, times, strict=True):
-                assert isinstance(record, EventRecord | ModelRecord)
-                if record.step * STEP_NS != log_time:
-                    raise CorruptRecording(
-                        f"{self.path}: a {topic} message logged at step "
-                        f"{log_time / STEP_NS:g} says step {record.step} (chunk at byte "
-                        f"{ref.offset})"
-                    )
+            for record, log_time in zip(records, times.tolist(), strict=True):
+                self._timed(topic, record, log_time, ref)
                 found.append(record if keep is None else keep(record))
         expected = self.topic_counts.get(topic, 0)
         if len(found) != expected:

@@ -57,6 +57,7 @@ from rsstp_sim.words import counted
 __all__ = [
     "APPLICATION_ID",
     "ENTITY_PATHS",
+    "OVERVIEW_MAX_STEPS",
     "TIMELINE",
     "LogSummary",
     "ViewResult",
@@ -131,6 +132,12 @@ class LogSummary:
     rows: dict[str, int]
     model_versions: int
     log_lines: int
+    thinned: tuple[str, ...]
+    """The series paths that kept only their extremes (more changes than
+    :data:`~rsstp_replay._viewer_plots.SERIES_MAX_ROWS` in the steps shown)."""
+    every: int
+    """The arm, its blocked marker and the current state are shown every ``every``-th step
+    (1: every step; more over :data:`OVERVIEW_MAX_STEPS` steps shown)."""
     seconds_read: float
     seconds_prepare: float
     seconds_rerun: float
@@ -151,21 +158,31 @@ class ViewResult:
     _folder: tempfile.TemporaryDirectory[str] | None = field(default=None, repr=False)
 
     def to_text(self) -> str:
-        """One line for the command line."""
+        """For the command line: one line, and one more for an overview and for thinned
+        series."""
         s = self.summary
         where = [f"saved {self.saved}"] if self.saved is not None else []
         if self.spawned:
             where.append("sent to a native viewer")
         if self.web_url is not None:
             where.append(f"serving the web viewer at {self.web_url}")
-        return (
+        lines = [
             f"steps {s.first_step:,}..{s.last_step:,}: "
             f"{counted(len(s.rows), 'entity', 'entities')}, "
-            f"{counted(s.model_versions, 'model version')}, {counted(s.log_lines, 'log line')}; "
-            "read "
-            f"{s.seconds_read:.2f} s, audits and placing {s.seconds_prepare:.2f} s, Rerun "
-            f"{self.seconds_rerun:.2f} s" + ("; " + ", ".join(where) if where else "")
-        )
+            f"{counted(s.model_versions, 'model version')}, "
+            f"{counted(s.log_lines, 'log line')}; read {s.seconds_read:.2f} s, audits and "
+            f"placing {s.seconds_prepare:.2f} s, Rerun {self.seconds_rerun:.2f} s"
+            + ("; " + ", ".join(where) if where else "")
+        ]
+        if s.every > 1:
+            lines.append(_overview_text(s.every))
+        if s.thinned:
+            lines.append(
+                f"thinned to each curve's extremes (over {plots_part.SERIES_MAX_ROWS:,} "
+                f"changes): {', '.join(s.thinned)}; --from/--to on a shorter window shows "
+                "every change"
+            )
+        return "\n".join(lines)
 
     def serve_forever(self, stop: CtrlC | None = None) -> None:
         """Keep serving the web viewer until Ctrl-C (or until ``stop`` is pressed), then stop."""
@@ -234,7 +251,9 @@ def view(
     in_memory: rr.BinaryStream | None = None
     if target is not None and not spawn:
         in_memory = rr.binary_stream(recording=stream)
-        stream.send_blueprint(blueprint, make_active=False, make_default=True)
+        # Active as well as default: the web viewer ignores a default blueprint of a file it
+        # serves and lays the views out itself.
+        stream.send_blueprint(blueprint, make_active=True, make_default=True)
     else:
         sinks: list[rr.FileSink | rr.GrpcSink] = []
         if writing is not None:
@@ -413,27 +432,50 @@ def _log(
         last_step=recording.n_steps,
     )
     lines = [line for line in every_line if first <= line.step <= last]
+    every = -(-len(window) // OVERVIEW_MAX_STEPS)
+    if every > 1:
+        lines.insert(0, plots_part.LogLine(first, "INFO", _overview_text(every)))
     if lines:
         rows[plots_part.LOG] = plots_part.log_lines(stream, lines)
+    sampled = window.iloc[np.unique(np.r_[0 : len(window) : every, len(window) - 1])]
     rows[model_part.CURRENT] = model_part.log_current_state(
         stream,
-        window.index.to_numpy(np.int64),
-        window["internal_state"].to_numpy(np.int64),
+        sampled.index.to_numpy(np.int64),
+        sampled["internal_state"].to_numpy(np.int64),
         loaded.places,
     )
-    rows |= world_part.log_world(stream, window, scenario)
-    rows |= plots_part.log_series(
+    rows |= world_part.log_world(stream, sampled, scenario, sensor=every == 1)
+    series, thinned = plots_part.log_series(
         stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
     )
+    rows |= series
     return LogSummary(
         first_step=first,
         last_step=last,
         rows=rows,
         model_versions=len(shown),
         log_lines=len(lines),
+        thinned=tuple(thinned),
+        every=every,
         seconds_read=loaded.seconds_read,
         seconds_prepare=loaded.seconds_prepare,
         seconds_rerun=time.perf_counter() - began,
+    )
+
+
+OVERVIEW_MAX_STEPS = 250_000
+"""Over this many steps shown, the arm, its blocked marker and the current state are an
+overview: shown every k-th step (and at the last), k the least that keeps them within this
+many rows, and the obstacle sensor is left out (the distances stay as plots); a
+``--from``/``--to`` window of at most this many steps shows every step. (A
+million-step run has a row per step in each; the web viewer needs minutes to take them in.)"""
+
+
+def _overview_text(every: int) -> str:
+    return (
+        f"overview: the arm, its blocked marker and the current state at one step in {every:,} "
+        f"(over {OVERVIEW_MAX_STEPS:,} steps shown); a --from/--to window of at most "
+        f"{OVERVIEW_MAX_STEPS:,} steps shows every step"
     )
 
 

@@ -40,7 +40,12 @@ from rsstp_sim.errors import ModelError, TruthError
 from rsstp_sim.moore import moore_classes
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.transition_system import TransitionSystem
-from rsstp_sim.world_table import WorldTable, pose_space_size
+from rsstp_sim.world_table import (
+    MAX_TABULATION_CHECKS,
+    WorldTable,
+    pose_space_size,
+    tabulation_checks,
+)
 
 __all__ = [
     "MAX_TRUTH_CHECKS",
@@ -249,11 +254,11 @@ def _reached(tail: IntArray, head: IntArray, start: int, n: int) -> BoolArray:
 # --------------------------------------------------------------- enumeration
 
 
-MAX_TRUTH_CHECKS = 1_000_000_000
+MAX_TRUTH_CHECKS = MAX_TABULATION_CHECKS
 """The most link-against-obstacle move checks :func:`compute_truth` takes on, counted over the
-pose lattice (an upper bound of the reachable poses): about 20 s on this project's machine.
-Three joints at 5 degrees among 1,000 obstacles count 6.7 billion; they took 130 s and 8.6 GB
-before this bound."""
+pose lattice (:func:`~rsstp_sim.world_table.tabulation_checks`): about 20 s on this project's
+machine. Three joints at 5 degrees among 1,000 obstacles count 6.7 billion; they took 130 s and
+8.6 GB before this bound."""
 
 
 def check_truth_size(
@@ -270,7 +275,7 @@ def check_truth_size(
             f"limit of {max_poses:,} (pass a larger max_poses)"
         )
     n_actions, n_links = len(scenario.actions), scenario.n_joints
-    checks = bound * n_actions * n_links * max(1, len(scenario.obstacles))
+    checks = tabulation_checks(scenario)
     if checks > max_checks:
         raise TruthError(
             f"{scenario.name}: refused: tabulating the world would take about {checks:,} "

@@ -5,8 +5,8 @@ for a move depends only on the pose and the action, and the pose space is
 finite (integer angles), so every answer comes from the scenario's
 :class:`~rsstp_sim.world_table.WorldTable`, computed once and read back with a
 couple of array lookups per move: a small pose space's in vectorised blocks
-around the arm, a large one's (many links, small steps) move by move, each new
-move checked alone.
+around the arm, a large one's (many links, small steps) or a costly one's (many
+obstacles) move by move, each new move checked alone.
 """
 
 from __future__ import annotations
@@ -39,7 +39,9 @@ class Pose:
     - ``distances``: ``(n, m)`` distance from tip ``k`` to obstacle ``j``'s surface.
 
     The sensation and the feedback are read at every step; the rest is computed from the
-    world table's row at first use (most poses of a long run are never asked for it).
+    world table's row at first use (most poses of a long run are never asked for it), and
+    kept, but for the distances of a table that keeps none (many obstacles), computed at
+    every read.
     """
 
     code: int
@@ -67,10 +69,12 @@ class Pose:
 
     @property
     def distances(self) -> FloatArray:
-        if self._distances is None:
-            object.__setattr__(self, "_distances", self._table.distances_of(self._row))
-        assert self._distances is not None
-        return self._distances
+        if self._distances is not None:
+            return self._distances
+        distances = self._table.distances_of(self._row)
+        if self._table.keeps_distances:  # else too many to keep for every pose visited
+            object.__setattr__(self, "_distances", distances)
+        return distances
 
 
 class World:
@@ -89,10 +93,15 @@ class World:
     def __init__(self, scenario: Scenario, *, per_move: bool | None = None) -> None:
         """``per_move``: grow the world table move by move (True) or in blocks of poses
         (False); by default per move exactly when the pose space is too large for a dense
-        table (see :mod:`rsstp_sim.world_table`). Both give the same answers."""
+        table, or the whole table would cost more than
+        :data:`~rsstp_sim.world_table.MAX_TABULATION_CHECKS` (many obstacles), since the
+        blocks double until they hold it (see :mod:`rsstp_sim.world_table`). Both give the
+        same answers."""
         self.scenario = scenario
         self.table = WorldTable(scenario)
-        self.per_move = not self.table.dense if per_move is None else per_move
+        if per_move is None:
+            per_move = not self.table.dense or self.table.heavy
+        self.per_move = per_move
         self.geometry = self.table.geometry
         self._actions = {action: k for k, action in enumerate(self.table.actions)}
         self._n_actions = len(self._actions)

@@ -23,13 +23,17 @@ vectorised batch per frontier, as many poses as the caller's budget allows, and
 enumeration). Or move by move: :meth:`WorldTable.step` computes just the move the arm makes
 (one swept check of the joint that turns, see :func:`~rsstp_sim.geometry.move_blocker`) and
 the one pose it reaches, in plain floats: the way of a pose space too large to be
-tabulated, where nearly every move reaches a new pose. A pose space of at most
+tabulated, where nearly every move reaches a new pose, or of a world whose whole table
+would cost more than :data:`MAX_TABULATION_CHECKS` link-obstacle checks (many obstacles),
+where the blocks would grow to that cost over a long run. A pose space of at most
 :data:`DENSE_LIMIT` lattice poses finds rows by pose code in a dense array, a larger one in
 a dict of the poses reached.
 
 Every row keeps its pose's :func:`~rsstp_sim.geometry.pose_points` (the base and the link
-tips, flat), its obstacle distances, its sensation and its float feedback, in growable
-arrays: a few hundred bytes a pose, whichever way it was computed.
+tips, flat), its sensation and its float feedback, and, when a pose has at most
+:data:`KEPT_DISTANCES` tip-obstacle distances, those distances, in growable arrays: a few
+hundred bytes a pose, whichever way it was computed. A pose of more distances (three links
+among 1,000 obstacles have 3,000, 24 KB) has them computed each time they are read.
 """
 
 from __future__ import annotations
@@ -47,15 +51,25 @@ from rsstp_sim.scenario import Scenario
 
 __all__ = [
     "DENSE_LIMIT",
+    "KEPT_DISTANCES",
+    "MAX_TABULATION_CHECKS",
     "WorldTable",
     "lattice_sizes",
     "pose_space_size",
+    "tabulation_checks",
     "unsensable",
 ]
 
 
 DENSE_LIMIT = 4_000_000
 """Pose spaces of at most this many lattice poses index their rows in a dense array."""
+MAX_TABULATION_CHECKS = 1_000_000_000
+"""The most link-obstacle checks a whole world table may cost (:func:`tabulation_checks`):
+about 20 s on this project's machine. A world beyond it is grown move by move (only the moves
+the arm makes), and its ground truth is refused. Three joints at 5 degrees among 1,000
+obstacles count 6.7 billion: grown in blocks, a 2,000-step run took 114 s and 6.7 GB."""
+KEPT_DISTANCES = 256
+"""A row keeps its tip-obstacle distances when it has at most this many (2 KB)."""
 _CHUNK_MOVES = 65_536
 """Moves per call to :func:`geometry.move_blockers` (bounds the temporaries' memory)."""
 
@@ -121,6 +135,14 @@ def pose_space_size(scenario: Scenario) -> int:
     return math.prod(lattice_sizes(scenario))
 
 
+def tabulation_checks(scenario: Scenario) -> int:
+    """What the whole world table would cost, known before any geometry: every move of every
+    lattice pose (an upper bound of the reachable ones), each moving link against each
+    obstacle."""
+    n_checks = pose_space_size(scenario) * len(scenario.actions) * scenario.n_joints
+    return n_checks * max(1, len(scenario.obstacles))
+
+
 class WorldTable:
     """The reachable poses of ``scenario`` found so far, and the moves computed so far."""
 
@@ -157,12 +179,20 @@ class WorldTable:
         self.feedback = array.array("d")
         self.positions = array.array("d")
         """Every row's :func:`~rsstp_sim.geometry.pose_points`, :attr:`width` floats a row."""
+        self.keeps_distances = n * self.geometry.m <= KEPT_DISTANCES
+        """Whether rows keep their distances (else :meth:`distances_of` computes them)."""
         self.distances = array.array("d")
-        """Every row's :func:`~rsstp_sim.geometry.obstacle_distances` (``n * m`` floats a
-        row) when its pose came in a block; NaN for a pose added alone (see :meth:`step`),
-        whose distances its reader computes (:meth:`distances_of`)."""
-        self._unknown_distances = array.array("d", [math.nan] * (n * self.geometry.m))
+        """When :attr:`keeps_distances`, every row's
+        :func:`~rsstp_sim.geometry.obstacle_distances` (``n * m`` floats a row) when its pose
+        came in a block; NaN for a pose added alone (see :meth:`step`), whose distances its
+        reader computes (:meth:`distances_of`). Empty otherwise."""
+        self._unknown_distances = array.array(
+            "d", [math.nan] * (n * self.geometry.m if self.keeps_distances else 0)
+        )
         self.dense = pose_space_size(scenario) <= DENSE_LIMIT
+        self.heavy = tabulation_checks(scenario) > MAX_TABULATION_CHECKS
+        """The whole table would cost more than :data:`MAX_TABULATION_CHECKS`: grow it move by
+        move (see :class:`~rsstp_sim.world.World`)."""
         # Rows by pose code: a dense array over a small lattice, else a dict of the poses
         # reached.
         sizes = np.asarray(lattice_sizes(scenario), dtype=np.int64)
@@ -360,7 +390,6 @@ class WorldTable:
         sensation, closeness = geometry.feedback(
             tips, self._points, self.geometry.lengths, self._tolerance_abs
         )
-        distances = geometry.obstacle_distances(tips, self.geometry.centers, self.geometry.radii)
         if self._dense is not None:
             cells = (((angles - self._initial) % 360) // self._spacing) @ self._lattice_radix
             self._dense[cells] = rows
@@ -368,7 +397,11 @@ class WorldTable:
             self._row_of.update(zip(codes.tolist(), rows.tolist(), strict=True))
         self.codes.frombytes(codes.astype(np.int64).tobytes())
         self.positions.frombytes(positions.tobytes())
-        self.distances.frombytes(distances.tobytes())
+        if self.keeps_distances:
+            distances = geometry.obstacle_distances(
+                tips, self.geometry.centers, self.geometry.radii
+            )
+            self.distances.frombytes(distances.tobytes())
         self.sensation.frombytes(sensation.astype(np.int8).tobytes())
         self.feedback.frombytes(closeness.astype(np.float64).tobytes())
         blank = len(codes) * len(self.actions)
@@ -394,17 +427,23 @@ class WorldTable:
 
     def distances_of(self, row: int) -> FloatArray:
         """``(n, m)`` from every tip of a row to every obstacle's surface (a read-only copy),
-        computed now when the row's pose was added alone."""
+        computed now when the row's pose was added alone or the rows keep no distances."""
         n, m = self.geometry.n, self.geometry.m
-        distances = np.frombuffer(self.distances[row * n * m : (row + 1) * n * m])
-        if m and math.isnan(distances[0]):
-            tips = self.positions_of(row)[1:]
-            distances = geometry.obstacle_distances(
-                tips, self.geometry.centers, self.geometry.radii
-            )
-            self.distances[row * n * m : (row + 1) * n * m] = array.array("d", distances.tobytes())
+        if not self.keeps_distances:
+            distances = self._compute_distances(row)
+        else:
+            distances = np.frombuffer(self.distances[row * n * m : (row + 1) * n * m])
+            if m and math.isnan(distances[0]):
+                distances = self._compute_distances(row)
+                self.distances[row * n * m : (row + 1) * n * m] = array.array(
+                    "d", distances.tobytes()
+                )
         distances.flags.writeable = False
         return distances.reshape(n, m)
+
+    def _compute_distances(self, row: int) -> FloatArray:
+        tips = self.positions_of(row)[1:]
+        return geometry.obstacle_distances(tips, self.geometry.centers, self.geometry.radii)
 
     def angles(self) -> IntArray:
         """``(rows, n)`` joint angles of every row."""

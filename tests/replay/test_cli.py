@@ -18,10 +18,10 @@ from typing import ClassVar
 import pandas as pd
 import pytest
 
+from rsstp_cli.replay import main
 from rsstp_replay import open_recording, read_table
 from rsstp_replay.audits import audit_truth, compare, run_audits
 from rsstp_replay.audits.physics import check_physics
-from rsstp_replay.cli import main
 from rsstp_sim import AgentView, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording.recorder import record
 
@@ -92,7 +92,7 @@ def test_info_on_an_unfinished_file_warns_in_one_line(run: Path, tmp_path: Path)
     data = run.read_bytes()
     cut.write_bytes(data[: len(data) // 2])
     process = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", "info", str(cut)],
+        [sys.executable, "-m", "rsstp_cli.replay", "info", str(cut)],
         env={**os.environ, "PYTHONPATH": str(SRC)},
         capture_output=True,
         text=True,

@@ -144,7 +144,7 @@ def test_check_and_audit_gate_on_the_contract(tmp_path: Path) -> None:
 
     def cli(*args: str) -> subprocess.CompletedProcess[str]:
         return subprocess.run(
-            [sys.executable, "-m", "rsstp_replay", *args],
+            [sys.executable, "-m", "rsstp_cli.replay", *args],
             capture_output=True,
             text=True,
             timeout=120,

@@ -8,6 +8,7 @@ print one line on stderr, exit with 2 and never show a traceback.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import re
@@ -28,6 +29,7 @@ from rsstp_sim import AgentView, StrategyBase, load_scenario
 from rsstp_sim.recording.recorder import record
 
 SRC = Path(__file__).resolve().parents[2] / "src"
+RECORDINGS = SRC.parent / "recordings"
 STEPS = 400
 CHUNK_SIZE = 8 * 1024
 CHUNK_DATA = 1 + 8 + 8 + 8 + 8 + 4 + 4 + len("zstd") + 8
@@ -60,6 +62,7 @@ def rewrite(
     message: Callable[[str, int, bytes], bytes | None] = lambda topic, log_time, data: data,
     attachment: Callable[[bytes], bytes] = lambda data: data,
     retime: Callable[[str, int], int] = lambda topic, log_time: log_time,
+    metadata: Callable[[dict[str, str]], dict[str, str]] = lambda values: values,
 ) -> Path:
     """Copy a recording record by record into a new finished file, changing what is asked
     (``message`` returning None drops the message; ``retime`` gives a message's new log
@@ -78,8 +81,8 @@ def rewrite(
             cid: writer.register_channel(c.topic, c.message_encoding, schema_ids[c.schema_id])
             for cid, c in summary.channels.items()
         }
-        for metadata in reader.iter_metadata():
-            writer.add_metadata(metadata.name, metadata.metadata)
+        for found_metadata in reader.iter_metadata():
+            writer.add_metadata(found_metadata.name, metadata(dict(found_metadata.metadata)))
         for found in reader.iter_attachments():
             writer.add_attachment(
                 found.log_time,
@@ -264,7 +267,7 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
 
     def version1(name: str, data: bytes) -> bytes:
         return (
-            data.replace(b'"version": "2.1"', b'"version": "1.0"') if name == "rsstp.Step" else data
+            data.replace(b'"version": "2.2"', b'"version": "1.0"') if name == "rsstp.Step" else data
         )
 
     rewrite(original, files["version1"], schema=version1)
@@ -334,7 +337,7 @@ def test_api_raises_a_one_line_error(name: str, damaged: dict[str, Path]) -> Non
 
 def test_a_later_minor_version_with_new_fields_is_read(original: Path, tmp_path: Path) -> None:
     def minor(name: str, data: bytes) -> bytes:
-        return data.replace(b'"version": "2.1"', b'"version": "2.3"')
+        return data.replace(b'"version": "2.2"', b'"version": "2.3"')
 
     def extra_fields(topic: str, log_time: int, data: bytes) -> bytes:
         value = json.loads(data)
@@ -384,7 +387,7 @@ def test_an_event_of_an_unknown_kind_is_refused(original: Path, tmp_path: Path) 
 
 @pytest.fixture(scope="module")
 def cli_runs(damaged: dict[str, Path]) -> dict[str, subprocess.CompletedProcess[str]]:
-    """``python -m rsstp_replay`` on every damaged file, all at once (they take a while)."""
+    """``python -m rsstp_cli.replay`` on every damaged file, all at once (they take a while)."""
     env = {**os.environ, "PYTHONPATH": str(SRC)}
     folder = damaged["text"].parent
     processes = {}
@@ -392,7 +395,7 @@ def cli_runs(damaged: dict[str, Path]) -> dict[str, subprocess.CompletedProcess[
         command, *options = case.command
         argv = [command, str(damaged[name]), *(o.format(tmp=folder) for o in options)]
         processes[name] = subprocess.Popen(
-            [sys.executable, "-m", "rsstp_replay", *argv],
+            [sys.executable, "-m", "rsstp_cli.replay", *argv],
             env=env,
             stdout=subprocess.PIPE,
             stderr=subprocess.PIPE,
@@ -449,7 +452,7 @@ def test_info_never_calls_a_file_with_a_failing_chunk_finished(damaged: dict[str
     """A finished file whose middle chunk fails its CRC: `info` reads every chunk, so it is
     one line and exit 2, not "finished"."""
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", "info", str(damaged["chunk-flip"])],
+        [sys.executable, "-m", "rsstp_cli.replay", "info", str(damaged["chunk-flip"])],
         capture_output=True,
         text=True,
         timeout=120,
@@ -461,3 +464,151 @@ def test_info_never_calls_a_file_with_a_failing_chunk_finished(damaged: dict[str
         r"(fails its CRC check|does not decompress).*\n",
         done.stderr,
     )
+
+
+def test_model_messages_written_another_way_read_the_same(original: Path, tmp_path: Path) -> None:
+    """Model messages spaced out and with their keys in reverse order are not the bytes the
+    recorder writes, so none is read by its head alone: each is decoded whole and compared
+    value by value, and the versions are the original's."""
+
+    def respace(topic: str, log_time: int, data: bytes) -> bytes:
+        if topic != "/rsstp/model":
+            return data
+        value = json.loads(data)
+        return json.dumps(dict(reversed(list(value.items()))), indent=1).encode()
+
+    spaced = rewrite(original, tmp_path / "spaced.mcap", message=respace)
+
+    def versions(path: Path) -> list[tuple[object, ...]]:
+        with open_recording(path) as recording:
+            return [
+                (v.version, v.step, tuple(v.states), v.current, v.triples(), v.operations)
+                for v in recording.model_versions()
+            ]
+
+    assert len(versions(original)) >= 5  # the splitter's versions, each read whole
+    assert versions(spaced) == versions(original)
+
+
+# ------------------------------------------------------------------ the metadata checksum
+
+CHECKSUM_KEY = "metadata_sha256"
+
+
+def _documented_checksum(values: dict[str, str]) -> str:
+    """schemas/README.md's rule, written out here: SHA-256 of the other keys as one JSON
+    object, keys sorted, no spaces, UTF-8."""
+    others = {key: value for key, value in values.items() if key != CHECKSUM_KEY}
+    text = json.dumps(others, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()
+
+
+def _metadata_values(path: Path) -> dict[str, str]:
+    with open(path, "rb") as stream:
+        (found,) = make_reader(stream).iter_metadata()
+    return dict(found.metadata)
+
+
+@pytest.mark.parametrize("path", sorted(RECORDINGS.glob("*.mcap")), ids=lambda p: p.stem)
+def test_every_reference_recording_carries_the_documented_checksum(path: Path) -> None:
+    values = _metadata_values(path)
+    assert list(values)[-1] == CHECKSUM_KEY
+    assert values[CHECKSUM_KEY] == _documented_checksum(values)
+    with open_recording(path) as recording:
+        assert recording.metadata_verified
+
+
+def _change_one_byte(raw: bytes, key: str, value: str, *, in_key: bool) -> bytes:
+    """``raw`` with one byte of the metadata record's ``key`` (or of its value) changed, the
+    record staying well-formed MCAP: a character becomes another of the same size."""
+    encoded = struct.pack("<I", len(key)) + key.encode() + struct.pack("<I", len(value))
+    at = raw.index(encoded + value.encode())
+    assert raw.count(encoded + value.encode()) == 1
+    at += 4 + (len(key) - 1 if in_key else len(key) + 4)
+    changed = bytearray(raw)
+    changed[at] = ord("0") if changed[at] != ord("0") else ord("1")
+    return bytes(changed)
+
+
+@pytest.mark.parametrize(
+    ("key", "in_key", "match"),
+    [
+        ("seed", False, "fails its checksum"),
+        ("package_version", False, "fails its checksum"),
+        ("strategy_params", False, "fails its checksum"),
+        ("scenario_sha256", False, "fails its checksum"),
+        (CHECKSUM_KEY, False, "fails its checksum"),
+        ("python", True, "fails its checksum"),
+        (CHECKSUM_KEY, True, "lacks its checksum metadata_sha256"),
+    ],
+    ids=lambda v: v if isinstance(v, str) and " " not in v else None,
+)
+def test_a_metadata_record_changed_by_one_byte_is_refused(
+    original: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    key: str,
+    in_key: bool,
+    match: str,
+) -> None:
+    """Every command that opens the file (check, audit, info) refuses it in one line; the
+    summary's CRC does not cover the data section, so only the checksum can tell."""
+    from rsstp_cli.replay import main
+
+    values = _metadata_values(original)
+    bad = tmp_path / "changed.mcap"
+    bad.write_bytes(_change_one_byte(original.read_bytes(), key, values[key], in_key=in_key))
+    with open(bad, "rb") as stream:  # still well-formed MCAP, the record changed
+        (found,) = make_reader(stream).iter_metadata()
+    assert dict(found.metadata) != values
+    for command in ("check", "audit", "info"):
+        assert main([command, str(bad)]) == 2
+        out, err = capsys.readouterr()
+        assert len(err.splitlines()) == 1, err
+        assert err.startswith(f"rsstp-replay: error: {bad}: the 'rsstp' metadata record {match}")
+
+
+def _older(values: dict[str, str]) -> dict[str, str]:
+    return {key: value for key, value in values.items() if key != CHECKSUM_KEY}
+
+
+def _to_version(version: str) -> Callable[[str, bytes], bytes]:
+    def schema(name: str, data: bytes) -> bytes:
+        return data.replace(b'"version": "2.2"', f'"version": "{version}"'.encode())
+
+    return schema
+
+
+def test_an_older_recording_without_a_checksum_is_read_unverified(
+    original: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """A 2.1 file was written before the checksum: it is read, and `check` and `info` say its
+    metadata is unverified; a 2.2 file without its checksum is refused."""
+    from rsstp_cli.replay import main
+
+    old = rewrite(original, tmp_path / "old.mcap", schema=_to_version("2.1"), metadata=_older)
+    with open_recording(old) as recording:
+        assert not recording.metadata_verified
+        assert recording.metadata == _older(_metadata_values(original))
+    unverified = "metadata: unverified (a schema 2.1 recording, written before the metadata "
+    for command in ("check", "info"):
+        assert main([command, str(old)]) == 0
+        out, err = capsys.readouterr()
+        assert err == ""
+        assert unverified in out
+    assert main(["check", str(old), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["metadata_verified"] is False
+    assert main(["check", str(original), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["metadata_verified"] is True
+
+    stripped = rewrite(original, tmp_path / "stripped.mcap", metadata=_older)
+    with pytest.raises(errors.CorruptRecording, match="lacks its checksum metadata_sha256"):
+        open_recording(stripped)
+
+    def wrong(values: dict[str, str]) -> dict[str, str]:
+        return {**values, "seed": "7"}
+
+    changed_old = rewrite(original, tmp_path / "old-changed.mcap", schema=_to_version("2.1"),
+                          metadata=wrong)  # fmt: skip
+    with pytest.raises(errors.CorruptRecording, match="fails its checksum"):
+        open_recording(changed_old)  # a checksum present is verified, whatever the version

@@ -18,7 +18,10 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", *args], capture_output=True, text=True, timeout=120
+        [sys.executable, "-m", "rsstp_cli.replay", *args],
+        capture_output=True,
+        text=True,
+        timeout=120,
     )
 
 

@@ -23,8 +23,8 @@ from mcap.reader import make_reader
 from mcap_protobuf.decoder import DecoderFactory
 from rerun.chunk import RrdReader
 
+from rsstp_cli.replay import main
 from rsstp_replay import foxglove_scene, open_recording
-from rsstp_replay.cli import main
 from rsstp_replay.foxglove_scene import ARM_TOPIC, LOG_TOPIC, STATIC_TOPIC, TRANSFORMS_TOPIC
 from rsstp_sim import __version__, palette
 from rsstp_sim.recording import record
@@ -338,7 +338,7 @@ def test_a_file_size_limit_never_leaves_a_truncated_scene(
         resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
 
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", "export", "--foxglove", str(recorded.path),
+        [sys.executable, "-m", "rsstp_cli.replay", "export", "--foxglove", str(recorded.path),
          "-o", str(out), "--force"],
         capture_output=True, text=True, timeout=120, preexec_fn=small_files,
         env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": "/tmp",

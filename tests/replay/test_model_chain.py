@@ -57,7 +57,11 @@ def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(
                 touched |= model.sources_changed_by(kind, (s, t, a))
                 getattr(model, kind)(s, t, a)
         after = as_record(model)
-        assert _patched(before, model, touched) == (after.source, after.action, after.target)
+        patched = _patched(before, model, touched)
+        columns = (patched.source, patched.action, patched.target)
+        assert tuple(map(tuple, columns)) == (after.source, after.action, after.target)
+        assert patched.holds(after)
+        assert all(column.itemsize == 2 for column in columns)  # type: ignore[attr-defined]
         tracked.update(model, touched)
         labels = {s: bool(s % 2) for s in model.states}
         fresh, kept = ModelTable.of(model, labels, (0, 1)), tracked.table(labels)
@@ -81,3 +85,31 @@ def test_the_determinism_audit_kept_through_touched_states_is_every_versions_own
     for record, version in zip(recording.model_versions(), found.versions, strict=True):
         own = TransitionSystem.from_snapshot(record.snapshot()).determinism_report()
         assert (version.nondeterministic, version.empty) == (own.nondeterministic, own.empty)
+
+
+def test_a_version_that_outgrows_two_byte_ids_is_patched_whole() -> None:
+    """Columns of 2-byte ids carried into a version whose new state needs 4 bytes: the patch
+    holds every transition, the new state's included, in the wider type."""
+    first = TransitionSystem.from_snapshot(
+        {
+            "states": [0, 32_766],
+            "next_id": 32_767,
+            "current": 0,
+            "actions": [0, 1],
+            "transitions": [[0, 0, 32_766], [32_766, 1, 0], [32_766, 0, 32_766]],
+        }
+    )
+    narrow = _patched(as_record(first), first, set())  # the previous version, compacted
+    assert narrow.source.itemsize == 2  # type: ignore[attr-defined]
+    touched = first.sources_changed_by("split", (32_766,))
+    created = first.split(32_766)
+    assert created == 32_767
+    wide = _patched(narrow, first, touched)
+    after = as_record(first)
+    assert (tuple(wide.source), tuple(wide.action), tuple(wide.target)) == (
+        after.source,
+        after.action,
+        after.target,
+    )
+    assert wide.holds(after)
+    assert wide.source.itemsize == 4  # type: ignore[attr-defined]

@@ -12,9 +12,9 @@ from typing import Any
 import pytest
 from test_corrupt import rewrite
 
+from rsstp_cli.replay import main
 from rsstp_replay import open_recording
 from rsstp_replay.audits.physics import check_physics
-from rsstp_replay.cli import main
 from rsstp_sim import load_scenario, make_strategy
 from rsstp_sim.recording import record
 

@@ -153,10 +153,10 @@ def test_open_reads_the_scenario_metadata_and_counts(random_run: tuple[Path, Any
         assert recording.metadata["seed"] == str(SEED)
         assert recording.metadata["scenario_sha256"] == recording.scenario.sha256
         assert recording.schema_versions == {
-            "rsstp.Scenario": "2.1",
-            "rsstp.Step": "2.1",
-            "rsstp.Model": "2.1",
-            "rsstp.Event": "2.1",
+            "rsstp.Scenario": "2.2",
+            "rsstp.Step": "2.2",
+            "rsstp.Model": "2.2",
+            "rsstp.Event": "2.2",
         }
         assert "steps=0..2000" in repr(recording)
 
@@ -369,8 +369,8 @@ def test_a_killed_writer_leaves_a_readable_recording(tmp_path: Path) -> None:
     path = tmp_path / "killed.mcap"
     side = tmp_path / "killed.mcap.partial"  # where it is written until it is finished
     env = {**os.environ, "PYTHONPATH": str(SRC)}
-    command = [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--steps", "10000000"]
-    command += ["--seed", "3", "--chunk-size", "4096", "-o", str(path)]
+    command = [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint"]
+    command += ["--steps", "10000000", "--seed", "3", "--chunk-size", "4096", "-o", str(path)]
     process = subprocess.Popen(command, env=env, stderr=subprocess.DEVNULL)
     try:
         deadline = time.monotonic() + 30

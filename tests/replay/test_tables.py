@@ -11,8 +11,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from rsstp_cli.replay import main
 from rsstp_replay import Recording, open_recording, read_table
-from rsstp_replay.cli import main
 from rsstp_replay.tables import TABLES, model_table, recording_table, scenario_table
 from rsstp_sim import Runner, make_strategy, parse_scenario
 from rsstp_sim.geometry import Blocker

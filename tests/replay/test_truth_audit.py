@@ -131,7 +131,7 @@ def test_first_steps_are_where_the_correspondence_breaks(tmp_path: Path) -> None
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", *args],
+        [sys.executable, "-m", "rsstp_cli.replay", *args],
         capture_output=True,
         text=True,
         env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin"},

@@ -208,7 +208,7 @@ def test_the_command_line_fails_a_one_way_run_and_says_why(tmp_path: Path) -> No
     the model knows of where the arm ended; the JSON names the confinement."""
     path = tmp_path / "one-way.mcap"
     record(path, load_scenario("one-way"), make_strategy("learner"), steps=600, seed=0)
-    command = [sys.executable, "-m", "rsstp_replay", "audit", "--truth", str(path)]
+    command = [sys.executable, "-m", "rsstp_cli.replay", "audit", "--truth", str(path)]
     gated = subprocess.run(
         [*command, "--fail-on", "not-learned"], capture_output=True, text=True, timeout=300
     )

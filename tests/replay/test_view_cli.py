@@ -23,7 +23,7 @@ LEARNER = ROOT / "recordings" / "two-joint-30-learner.mcap"
 
 def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", *args],
+        [sys.executable, "-m", "rsstp_cli.replay", *args],
         capture_output=True,
         text=True,
         env={"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "HOME": "/tmp"},
@@ -106,7 +106,7 @@ def test_a_graphviz_crash_is_one_line(
         [
             sys.executable,
             "-m",
-            "rsstp_replay",
+            "rsstp_cli.replay",
             "graph",
             str(LEARNER),
             "--step",
@@ -184,7 +184,7 @@ def _serve(web: int, grpc: int, tmp_path: Path) -> subprocess.Popen[str]:
     """``rsstp-replay view REFERENCE --serve-web`` on these ports, its temporary files in
     ``tmp_path``."""
     return subprocess.Popen(
-        [sys.executable, "-m", "rsstp_replay", "view", str(REFERENCE), "--serve-web"]
+        [sys.executable, "-m", "rsstp_cli.replay", "view", str(REFERENCE), "--serve-web"]
         + ["--web-port", str(web), "--grpc-port", str(grpc)],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -272,7 +272,7 @@ def test_a_file_size_limit_never_leaves_a_truncated_rrd(tmp_path: Path) -> None:
         resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))
 
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", "view", str(LEARNER), "--save", str(out),
+        [sys.executable, "-m", "rsstp_cli.replay", "view", str(LEARNER), "--save", str(out),
          "--force", "--quiet"],
         capture_output=True, text=True, timeout=120, preexec_fn=small_files,
         env={"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "HOME": "/tmp"},

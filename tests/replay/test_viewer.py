@@ -151,6 +151,80 @@ def test_entity_paths_and_rows_match_the_recording(reference: tuple[Recording, R
     assert [step for step, _ in rrd.column("world/model/state/0", "Points2D:positions")] == [0]
 
 
+def test_a_series_of_too_many_changes_keeps_each_curves_extremes(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Over its row budget, a series keeps (besides its first and last row) the steps where
+    each curve has its least and greatest value in each equal run of steps, every one with
+    its value; below the budget nothing is thinned."""
+    monkeypatch.setattr(viewer.plots_part, "SERIES_MAX_ROWS", 240)
+    out = tmp_path / "thin.rrd"
+    with open_recording(REFERENCE) as recording:
+        result = view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+        table = recording.steps()
+    rrd = Rrd(out)
+    assert "plots/distance" in result.summary.thinned
+    columns = [f"dist_{k}_{j}" for k in range(3) for j in range(2)]
+    values = table[columns].to_numpy(np.float64)
+    changes = _changes(values)
+    buckets = 240 // (2 * len(columns))
+    span = changes[-1] - changes[0] + 1
+    width = -(-span // buckets)
+    expected = {changes[0], changes[-1]}
+    for begin in range(changes[0], changes[-1] + 1, width):
+        inside = [t for t in changes if begin <= t < begin + width]
+        for c in range(len(columns)):
+            # the earliest step of the least value, the latest of the greatest
+            low = min(inside, key=lambda t: (values[t, c], t))
+            high = max(inside, key=lambda t: (values[t, c], t))
+            expected |= {low, high}
+    rows = rrd.column("plots/distance", "Scalars:scalars")
+    assert [step for step, _ in rows] == sorted(expected)
+    for step, scalars in rows:
+        np.testing.assert_array_equal(scalars, values[step])
+    # The sensation changes fewer times than the budget: every change is kept.
+    expected_sensation = _changes(table[["sensation"]].to_numpy(np.float64))
+    assert len(expected_sensation) <= 240
+    sensation = [step for step, _ in rrd.column("plots/agent/sensation", "Scalars:scalars")]
+    assert sensation == expected_sensation
+    assert "plots/agent/sensation" not in result.summary.thinned
+
+
+def test_a_long_window_is_an_overview_of_every_kth_step(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Over OVERVIEW_MAX_STEPS steps shown, the arm and the current state are shown at steps
+    0, k, 2k, ... and the last (rows where they changed between those), the sensor is left
+    out, and the log says so at the first step; the series keep every change."""
+    monkeypatch.setattr(viewer, "OVERVIEW_MAX_STEPS", 2_000)
+    out = tmp_path / "overview.rrd"
+    with open_recording(REFERENCE) as recording:
+        result = view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+        table = recording.steps()
+    rrd = Rrd(out)
+    k = 6  # 10,001 steps in at most 2,000 rows each
+    assert result.summary.every == k
+    shown = sorted({*range(0, len(table), k), len(table) - 1})
+    positions = table[[f"joint{j}_{a}" for j in range(4) for a in "xy"]].to_numpy()[shown]
+    blocked = table["blocked"].to_numpy()[shown]
+    changed = [
+        shown[i]
+        for i in range(len(shown))
+        if i == 0 or (positions[i] != positions[i - 1]).any() or blocked[i] != blocked[i - 1]
+    ]
+    assert [step for step, _ in rrd.column("world/arm", "LineStrips2D:strips")] == changed
+    assert "world/sensor" not in rrd.temporal
+    [(step, text)] = [
+        (step, text)
+        for step, [text] in rrd.column("log/audit", "TextLog:text")
+        if "overview" in text
+    ]
+    assert step == 0 and "one step in 6" in text
+    assert "one step in 6" in result.to_text()
+    feedback = [step for step, _ in rrd.column("plots/agent/feedback", "Scalars:scalars")]
+    assert feedback == _changes(table[["feedback"]].to_numpy(np.float64))
+
+
 def test_the_sensation_is_a_step_plot_that_never_averages(
     reference: tuple[Recording, Rrd],
 ) -> None:
@@ -485,6 +559,22 @@ def test_the_blueprint_is_saved_with_the_step_timeline(reference: tuple[Recordin
         for value in column.to_pylist()
     ]
     assert ["step"] in values
+
+
+def test_the_blueprint_is_made_active_so_a_viewer_lays_out_its_views(
+    reference: tuple[Recording, Rrd],
+) -> None:
+    """Rerun's own ``rrd print`` finds the command that makes the saved blueprint the active
+    and default one: without it the web viewer opened the file in its own grid of views (a
+    screenshot in headless Chromium showed it)."""
+    _, rrd = reference
+    rerun = Path(sys.executable).with_name("rerun")
+    printed = subprocess.run(
+        [str(rerun), "rrd", "print", str(rrd.path)], capture_output=True, text=True, check=True
+    ).stdout
+    commands = [line for line in printed.splitlines() if "BlueprintActivationCommand" in line]
+    assert len(commands) == 1
+    assert "make_active: true" in commands[0] and "make_default: true" in commands[0]
 
 
 def test_a_step_range(refined: tuple[Recording, Rrd], tmp_path: Path) -> None:

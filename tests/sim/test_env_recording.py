@@ -131,7 +131,7 @@ def test_every_replay_command_reads_a_recording_without_a_model(
     env = random_episodes(tmp_path, episodes=1, steps=120)
     words = [w.format(file=env.recordings[0], out=tmp_path / "out") for w in command]
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", *words],
+        [sys.executable, "-m", "rsstp_cli.replay", *words],
         capture_output=True,
         text=True,
         timeout=300,

@@ -189,7 +189,7 @@ def test_a_picture_that_cannot_be_written_whole_leaves_the_old_one(tmp_path: Pat
         resource.setrlimit(resource.RLIMIT_FSIZE, (20, 20))
 
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_sim", "graph", "--matrix", "[[[0],[1]],[[1],[0]]]",
+        [sys.executable, "-m", "rsstp_cli.sim", "graph", "--matrix", "[[[0],[1]],[[1],[0]]]",
          "-o", str(out), "--force"],
         capture_output=True, text=True, timeout=60, preexec_fn=tiny_files,
     )  # fmt: skip

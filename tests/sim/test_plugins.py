@@ -89,7 +89,7 @@ def test_a_class_by_its_import_path_records_and_audits(mine: Path, provided: boo
         (mine / "my_strategies-1.2.dist-info" / "top_level.txt").unlink()
     out = mine / "run.mcap"
     done = cli(
-        "rsstp_sim", "record", "thesis-roulette", "--strategy", "my_strategies:Clockwise",
+        "rsstp_cli.sim", "record", "thesis-roulette", "--strategy", "my_strategies:Clockwise",
         "--steps", "20", "-o", str(out), path=mine,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
@@ -101,22 +101,22 @@ def test_a_class_by_its_import_path_records_and_audits(mine: Path, provided: boo
         found = (strategy.distribution, strategy.version)
         assert found == (("my-strategies", "1.2") if provided else (None, None))
         assert recording.metadata["strategy_distribution"] == ("my-strategies" if provided else "")
-    assert cli("rsstp_replay", "audit", str(out), path=mine).returncode == 0
+    assert cli("rsstp_cli.replay", "audit", str(out), path=mine).returncode == 0
 
 
 def test_an_entry_point_is_listed_and_runs_by_name(mine: Path) -> None:
-    listed = cli("rsstp_sim", "strategies", path=mine)
+    listed = cli("rsstp_cli.sim", "strategies", path=mine)
     assert listed.returncode == 0
     assert "clockwise    my_strategies:Clockwise (my-strategies 1.2)" in listed.stdout
-    ran = cli("rsstp_sim", "run", "thesis-roulette", "--strategy", "clockwise", "--steps", "8",
+    ran = cli("rsstp_cli.sim", "run", "thesis-roulette", "--strategy", "clockwise", "--steps", "8",
               path=mine)  # fmt: skip
     assert ran.returncode == 0, ran.stderr
     assert "sensations seen: false: 6, true: 3" in ran.stdout  # the start, then every 4 moves
     out = mine / "by-name.mcap"
-    recorded = cli("rsstp_sim", "record", "thesis-roulette", "--strategy", "clockwise",
+    recorded = cli("rsstp_cli.sim", "record", "thesis-roulette", "--strategy", "clockwise",
                    "--steps", "4", "-o", str(out), path=mine)  # fmt: skip
     assert recorded.returncode == 0, recorded.stderr
-    info = cli("rsstp_replay", "info", str(out), path=mine)
+    info = cli("rsstp_cli.replay", "info", str(out), path=mine)
     assert "  class: my_strategies:Clockwise (from my-strategies 1.2)" in info.stdout
 
 
@@ -141,7 +141,7 @@ def test_a_failing_strategy_stops_in_one_line_and_keeps_a_valid_file(
 ) -> None:
     out = mine / "broken.mcap"
     done = cli(
-        "rsstp_sim", "record", "thesis-roulette", "--strategy", f"my_strategies:{strategy}",
+        "rsstp_cli.sim", "record", "thesis-roulette", "--strategy", f"my_strategies:{strategy}",
         "--steps", "50", "-o", str(out), path=mine,
     )  # fmt: skip
     side = mine / "broken.mcap.partial"
@@ -153,7 +153,7 @@ def test_a_failing_strategy_stops_in_one_line_and_keeps_a_valid_file(
     assert not out.exists()
     with open_recording(side) as recording:
         assert recording.finished and recording.n_steps == kept
-    assert cli("rsstp_replay", "check", str(side), path=mine).returncode == 0
+    assert cli("rsstp_cli.replay", "check", str(side), path=mine).returncode == 0
 
 
 def test_the_readme_strategy_records_and_learns_its_world(tmp_path: Path) -> None:
@@ -167,7 +167,7 @@ def test_the_readme_strategy_records_and_learns_its_world(tmp_path: Path) -> Non
     for line in commands[1].splitlines():
         words = shlex.split(line, comments=True)
         words = words[1:] if words[0] == "PYTHONPATH=." else words
-        program = {"rsstp-sim": "rsstp_sim", "rsstp-replay": "rsstp_replay"}[words[0]]
+        program = {"rsstp-sim": "rsstp_cli.sim", "rsstp-replay": "rsstp_cli.replay"}[words[0]]
         done = subprocess.run(
             [sys.executable, "-m", program, *words[1:]],
             capture_output=True, text=True, timeout=120, cwd=tmp_path,
@@ -196,7 +196,7 @@ def test_the_readme_strategy_records_and_learns_its_world(tmp_path: Path) -> Non
     ],
 )
 def test_a_strategy_that_cannot_run_is_one_line(mine: Path, strategy: str, message: str) -> None:
-    done = cli("rsstp_sim", "run", "thesis-roulette", "--strategy", strategy, "--steps", "5",
+    done = cli("rsstp_cli.sim", "run", "thesis-roulette", "--strategy", strategy, "--steps", "5",
                path=mine)  # fmt: skip
     assert done.returncode == 2
     lines = done.stderr.strip().splitlines()

@@ -45,7 +45,7 @@ def cli_env(**extra: str) -> dict[str, str]:
 
 def rsstp_record(*args: str | Path, **env: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "rsstp_sim", "record", *map(str, args)],
+        [sys.executable, "-m", "rsstp_cli.sim", "record", *map(str, args)],
         env=cli_env(**env),
         capture_output=True,
         text=True,
@@ -147,7 +147,8 @@ def bad_runs(
     for case, (args, where, _) in BAD_ARGUMENTS.items():
         directory = tmp_path_factory.mktemp(case)
         (directory / "a-file").write_text("a file")
-        command = [sys.executable, "-m", "rsstp_sim", "record", *args, "-o", str(directory / where)]
+        output = str(directory / where)
+        command = [sys.executable, "-m", "rsstp_cli.sim", "record", *args, "-o", output]
         proc = subprocess.Popen(
             command, env=cli_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
         )
@@ -208,7 +209,7 @@ def test_same_bytes_across_processes_and_hash_seeds(tmp_path: Path) -> None:
 
 def start_long_recording(out: Path) -> subprocess.Popen[str]:
     return subprocess.Popen(
-        [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--strategy", "random"]
+        [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint", "--strategy", "random"]
         + ["--steps", "2000000", "--seed", "1", "-o", str(out), "--chunk-size", str(CHUNK_SIZE)],
         env=cli_env(),
         stdout=subprocess.PIPE,
@@ -361,7 +362,7 @@ def test_force_keeps_the_old_recording_until_the_new_one_is_whole(tmp_path: Path
     assert rsstp_record("thesis-roulette", "--steps", "20", "-o", out).returncode == 0
     old = out.read_bytes()
     proc = subprocess.Popen(
-        [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--steps", "2000000",
+        [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint", "--steps", "2000000",
          "-o", str(out), "--chunk-size", str(CHUNK_SIZE), "--force"],
         env=cli_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
     )  # fmt: skip
@@ -412,7 +413,7 @@ def test_a_file_size_limit_is_one_line_saying_what_is_safe(tmp_path: Path) -> No
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_sim", "record", "three-joint", "--steps", "50000",
+        [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint", "--steps", "50000",
          "-o", str(out)],
         env=cli_env(), capture_output=True, text=True, timeout=TIMEOUT_S, preexec_fn=small_files,
     )  # fmt: skip
@@ -468,12 +469,12 @@ def test_a_named_pipe_is_refused_not_waited_on(tmp_path: Path) -> None:
     pipe = tmp_path / "scenario.toml"
     os.mkfifo(pipe)
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_sim", "run", str(pipe), "--steps", "3"],
+        [sys.executable, "-m", "rsstp_cli.sim", "run", str(pipe), "--steps", "3"],
         env=cli_env(), capture_output=True, text=True, timeout=30,
     )  # fmt: skip
     assert_one_line_error(done, r"scenario.toml: a named pipe, not a scenario file")
     replay = subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", "info", str(pipe)],
+        [sys.executable, "-m", "rsstp_cli.replay", "info", str(pipe)],
         env=cli_env(), capture_output=True, text=True, timeout=30,
     )  # fmt: skip
     assert replay.returncode == 2 and "a named pipe, not a recording" in replay.stderr

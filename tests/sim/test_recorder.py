@@ -201,7 +201,7 @@ def test_metadata_record_rsstp(recording: Path, three_joint: Scenario) -> None:
         metadata = list(make_reader(stream).iter_metadata())
     assert [m.name for m in metadata] == [schemas.METADATA_NAME] == ["rsstp"]
     values = metadata[0].metadata
-    assert tuple(values) == schemas.METADATA_KEYS
+    assert tuple(values) == (*schemas.METADATA_KEYS, schemas.METADATA_CHECKSUM_KEY)
     assert all(isinstance(v, str) for v in values.values())
     assert values["package"] == "rsstp"
     assert values["seed"] == str(SEED)

@@ -541,7 +541,7 @@ def test_many_obstacles_run_with_a_one_line_warning(tmp_path: Path) -> None:
         "[arm]\nlengths = [1.0, 1.0]\ninitial_deg = [0, 0]\nstep_deg = 10\n" + obstacles
     )
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_sim", "run", str(scenario), "--steps", "10"],
+        [sys.executable, "-m", "rsstp_cli.sim", "run", str(scenario), "--steps", "10"],
         capture_output=True, text=True, timeout=60,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr

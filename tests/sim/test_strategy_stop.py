@@ -10,10 +10,11 @@ from typing import ClassVar
 import pytest
 from mcap.reader import make_reader
 
+from rsstp_cli.replay import main as replay_main
+from rsstp_cli.sim import main as sim_main
 from rsstp_replay import open_recording
 from rsstp_replay.audits import run_audits
 from rsstp_replay.audits.loaded import load
-from rsstp_replay.cli import main as replay_main
 from rsstp_sim import (
     AgentView,
     RandomStrategy,
@@ -22,7 +23,6 @@ from rsstp_sim import (
     StrategyError,
     load_scenario,
 )
-from rsstp_sim.cli import main as sim_main
 from rsstp_sim.recording.recorder import Recorder, record
 from rsstp_sim.strategies._learner_walk import PHASES
 from rsstp_sim.strategies.learner import LearnerStrategy

@@ -103,7 +103,7 @@ def test_cache_info_on_the_command_line(cache_home: Path, tmp_path: Path) -> Non
     scenario_file = tmp_path / "world.toml"
     scenario_file.write_text(WORLD)
     env = {**os.environ}
-    run = [sys.executable, "-m", "rsstp_sim", "truth"]
+    run = [sys.executable, "-m", "rsstp_cli.sim", "truth"]
     subprocess.run([*run, str(scenario_file)], check=True, capture_output=True, env=env)
     done = subprocess.run(
         [*run, "--cache-info", "--json"], check=True, capture_output=True, text=True, env=env

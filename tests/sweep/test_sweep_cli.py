@@ -55,7 +55,7 @@ SWEEP = sweep_toml(steps=300, seeds=2, more_strategies=["sweep_faulty:Breaks"])
 
 def sweep_cli(*args: str, path: Path, timeout: float = 240) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "rsstp_sim", "sweep", *args],
+        [sys.executable, "-m", "rsstp_cli.sim", "sweep", *args],
         capture_output=True,
         text=True,
         timeout=timeout,
@@ -65,7 +65,7 @@ def sweep_cli(*args: str, path: Path, timeout: float = 240) -> subprocess.Comple
 
 def report_cli(*args: str) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
-        [sys.executable, "-m", "rsstp_replay", "report", *args],
+        [sys.executable, "-m", "rsstp_cli.replay", "report", *args],
         capture_output=True,
         text=True,
         timeout=120,
@@ -244,7 +244,8 @@ def test_ctrl_c_keeps_every_finished_run(folder: Path, tmp_path: Path) -> None:
     )
     out = tmp_path / "out"
     process = subprocess.Popen(
-        [sys.executable, "-m", "rsstp_sim", "sweep", str(sweep), "-o", str(out), "--workers", "1"],
+        [sys.executable, "-m", "rsstp_cli.sim", "sweep", str(sweep), "-o", str(out)]
+        + ["--workers", "1"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

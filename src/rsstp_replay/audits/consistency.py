@@ -45,6 +45,7 @@ __all__ = [
     "StateContradiction",
     "Witness",
     "audit_consistency",
+    "audit_consistency_both",
     "audit_consistency_by_version",
     "find_contradictions",
 ]
@@ -161,28 +162,51 @@ def audit_consistency_by_version(
     or merged is another state. (The continuations after the two times may run through any
     versions: they are what the world did.) Each finding names its version.
     """
-    versions = np.asarray(model_versions, dtype=np.int64)
-    states = memory.internal_states
-    if len(versions) != len(states):
-        raise MemoryRangeError(
-            f"model_versions has {len(versions)} entries, the memory {len(states)}"
-        )
-    version_ids, version_codes = np.unique(versions, return_inverse=True)
-    state_ids, state_codes = np.unique(states, return_inverse=True)
-    keys = version_codes.astype(np.int64) * max(len(state_ids), 1) + state_codes
-    found = find_contradictions(memory.actions, keys, memory.sensations)
-    width = max(len(state_ids), 1)
-    return ConsistencyFindings(
-        tuple(
-            replace(
-                item,
-                state=int(state_ids[item.state % width]),
-                version=int(version_ids[item.state // width]),
-            )
-            for item in found.contradictions
-        ),
-        found.steps,
+    keys = _VersionStates(memory, model_versions)
+    (found,) = _contradictions(memory.actions, [keys.codes], memory.sensations)
+    return keys.named(found)
+
+
+def audit_consistency_both(
+    memory: Memory, model_versions: npt.ArrayLike
+) -> tuple[ConsistencyFindings, ConsistencyFindings]:
+    """:func:`audit_consistency` and :func:`audit_consistency_by_version`, the memory's
+    suffixes ranked once for both."""
+    keys = _VersionStates(memory, model_versions)
+    whole, found = _contradictions(
+        memory.actions, [memory.internal_states, keys.codes], memory.sensations
     )
+    return whole, keys.named(found)
+
+
+class _VersionStates:
+    """Each time's (model version, internal state) as one integer code."""
+
+    def __init__(self, memory: Memory, model_versions: npt.ArrayLike) -> None:
+        versions = np.asarray(model_versions, dtype=np.int64)
+        states = memory.internal_states
+        if len(versions) != len(states):
+            raise MemoryRangeError(
+                f"model_versions has {len(versions)} entries, the memory {len(states)}"
+            )
+        self.version_ids, version_codes = np.unique(versions, return_inverse=True)
+        self.state_ids, state_codes = np.unique(states, return_inverse=True)
+        self.width = max(len(self.state_ids), 1)
+        self.codes = version_codes.astype(np.int64) * self.width + state_codes
+
+    def named(self, found: ConsistencyFindings) -> ConsistencyFindings:
+        """``found`` over the codes, as findings over states, each naming its version."""
+        return ConsistencyFindings(
+            tuple(
+                replace(
+                    item,
+                    state=int(self.state_ids[item.state % self.width]),
+                    version=int(self.version_ids[item.state // self.width]),
+                )
+                for item in found.contradictions
+            ),
+            found.steps,
+        )
 
 
 def find_contradictions(
@@ -195,18 +219,47 @@ def find_contradictions(
     Raises :class:`MemoryRangeError` for columns of different lengths, of the wrong kind, or
     empty (the audit needs at least the reset entry).
     """
-    action_column, state_column, sensation_column = _validated(actions, states, sensations)
+    return _contradictions(actions, [states], sensations)[0]
+
+
+def _contradictions(
+    actions: npt.ArrayLike, labellings: list[npt.ArrayLike], sensations: npt.ArrayLike
+) -> list[ConsistencyFindings]:
+    """:func:`find_contradictions` of each labelling of one memory's times (internal states,
+    or states of a version), its suffixes ranked once."""
+    checked = [_validated(actions, states, sensations) for states in labellings]
+    action_column, _, sensation_column = checked[0]
     steps = len(action_column) - 1
     if steps < 2:  # a contradiction needs i < j and j + k <= T with k >= 1
-        return ConsistencyFindings((), steps)
+        return [ConsistencyFindings((), steps) for _ in labellings]
     # Columns of one value per step in int32 where they fit (positions, ranks, codes): the
     # audit of ten million steps is bounded by its memory.
     positions = index_type(steps + 1)
     # The string y_p = (a_{p+1}, o_{p+1}), p = 0..T-1: the suffix at p is the memory after time p.
     action_codes = np.unique(action_column[1:], return_inverse=True)[1].astype(positions)
     symbols = 2 * action_codes + sensation_column[1:]
-    rank_levels = suffix_ranks(symbols)
-    del symbols
+    ranked = [suffix_ranks(symbols)]
+    del symbols, checked
+    found = []
+    for index, states in enumerate(labellings):
+        last = index == len(labellings) - 1
+        column = np.asarray(states)
+        found.append(_contradictions_of(column, action_column, action_codes, ranked, last))
+    return found
+
+
+def _contradictions_of(
+    state_column: npt.NDArray[Any],
+    action_column: npt.NDArray[np.integer[Any]],
+    action_codes: npt.NDArray[np.integer[Any]],
+    ranked: list[list[Any]],
+    last: bool,
+) -> ConsistencyFindings:
+    """One labelling's contradictions, from the ranked suffixes (``ranked[0]``, emptied once
+    the ``last`` labelling no longer needs it: the ranks are the audit's largest arrays)."""
+    rank_levels = ranked[0]
+    steps = len(action_column) - 1
+    positions = index_type(steps + 1)
     # Every time p = 0..T-1 (time T has nothing after it), sorted by (state, suffix rank).
     state_ids, state_codes = np.unique(state_column[:steps], return_inverse=True)
     state_codes = state_codes.astype(positions)
@@ -217,13 +270,15 @@ def find_contradictions(
     left, right = order[:-1][same_state], order[1:][same_state]
     lcp = common_prefix_lengths(left, right, rank_levels)
     del rank_levels
+    if last:
+        ranked.clear()
     # A pair of neighbours with common prefix l contradicts iff both go on and the next
     # actions agree (the sensations then differ, or the common prefix would be longer).
     left += lcp
     right += lcp
     contradicts = (left < steps) & (right < steps)
     contradicts[contradicts] = action_codes[left[contradicts]] == action_codes[right[contradicts]]
-    del left, right, action_codes
+    del left, right
     if not contradicts.any():
         return ConsistencyFindings((), steps)
     # boundary_lcp[b]: common prefix of sorted neighbours b-1 and b; -1 between states and at

@@ -30,7 +30,7 @@ import numpy as np
 from rsstp_replay.audits.consistency import (
     ConsistencyFindings,
     audit_consistency,
-    audit_consistency_by_version,
+    audit_consistency_both,
 )
 from rsstp_replay.audits.contract import ContractFindings, check_contract
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
@@ -142,15 +142,15 @@ def run_audits(source: AuditSource) -> AuditReport:
     """
     loaded = load(source)
     steps, memory = loaded.steps(), loaded.memory()
-    consistency = audit_consistency(memory)
     versions = steps["model_version"].to_numpy(np.int64)
     if len(versions) and (versions == versions[0]).all():  # one version: the same audit
+        consistency = audit_consistency(memory)
         within = ConsistencyFindings(
             tuple(replace(found, version=int(versions[0])) for found in consistency.contradictions),
             consistency.steps,
         )
     else:
-        within = audit_consistency_by_version(memory, versions)
+        consistency, within = audit_consistency_both(memory, versions)
     return AuditReport(
         summary=audit_summary(loaded, consistency=consistency),
         consistency=consistency,

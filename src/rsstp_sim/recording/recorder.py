@@ -43,11 +43,13 @@ from rsstp_sim.recording.output import WriteThrough, open_side_file
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_MEDIA_TYPE,
     ATTACHMENT_NAME,
+    METADATA_CHECKSUM_KEY,
     METADATA_KEYS,
     METADATA_NAME,
     SCHEMA_NAMES,
     STEP_NS,
     TOPICS,
+    metadata_checksum,
     schema_bytes,
 )
 from rsstp_sim.scenario import Scenario
@@ -62,6 +64,11 @@ __all__ = ["DEFAULT_CHUNK_SIZE", "RecordResult", "Recorder", "environment_versio
 
 DEFAULT_CHUNK_SIZE = 1024 * 1024
 """Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
+
+_POSE_CACHE_BYTES = 128 * 1024 * 1024
+"""The most bytes of poses' encoded truth kept for the poses met again (three-joint's 39,232
+poses take 12 MB; a pose among 1,000 obstacles 60 KB, its 3,000 distances): the poses met
+after that are encoded at each visit."""
 
 _VERSION_KEYS = ("package_version", "python", "numpy", "shapely", "mcap")
 
@@ -139,6 +146,7 @@ class Recorder:
         self._stop = False
         self._budget: int | None = None
         self._pose_parts: dict[int, tuple[bytes, bytes]] = {}
+        self._pose_parts_bytes = 0
         self._counts = dict.fromkeys(self._topics, 0)
         self.side_file = side_file(self.path)
         self._raw = open_side_file(self.path, force=force)
@@ -205,7 +213,9 @@ class Recorder:
             "strategy_version": origin.version or "",
             "scenario_sha256": scenario.sha256,
         }
-        writer.add_metadata(METADATA_NAME, {key: meta[key] for key in METADATA_KEYS})
+        values = {key: meta[key] for key in METADATA_KEYS}
+        values[METADATA_CHECKSUM_KEY] = metadata_checksum(values)
+        writer.add_metadata(METADATA_NAME, values)
         writer.add_attachment(
             0, 0, ATTACHMENT_NAME, ATTACHMENT_MEDIA_TYPE, scenario.source.encode("utf-8")
         )
@@ -233,7 +243,9 @@ class Recorder:
             truth = records.encode_json(builders.truth_record(pose, None))
             before, _, after = truth[1:-1].partition(b',"blocked":false,')
             parts = (before + b",", b"," + after)
-            self._pose_parts[pose.code] = parts
+            if self._pose_parts_bytes < _POSE_CACHE_BYTES:  # bounded: many obstacles, long runs
+                self._pose_parts[pose.code] = parts
+                self._pose_parts_bytes += len(truth)
         return parts
 
     def _step_bytes(self, step: int, outcome: StepOutcome | None, pose: Pose) -> bytes:

@@ -17,6 +17,7 @@ True
 from __future__ import annotations
 
 import functools
+import hashlib
 import json
 import re
 from collections.abc import Mapping
@@ -32,6 +33,8 @@ __all__ = [
     "ATTACHMENT_MEDIA_TYPE",
     "ATTACHMENT_NAME",
     "MESSAGE_ENCODING",
+    "METADATA_CHECKSUM_KEY",
+    "METADATA_CHECKSUM_SINCE",
     "METADATA_KEYS",
     "METADATA_NAME",
     "SCHEMA_ENCODING",
@@ -41,6 +44,7 @@ __all__ = [
     "TOPICS",
     "check_schema_version",
     "log_time_ns",
+    "metadata_checksum",
     "parse_version",
     "schema_bytes",
     "schema_json",
@@ -49,7 +53,7 @@ __all__ = [
     "version_refusal",
 ]
 
-SCHEMA_VERSION = "2.1"
+SCHEMA_VERSION = "2.2"
 """The version (``major.minor``) of the schemas this package writes."""
 
 SCHEMA_NAMES = ("rsstp.Scenario", "rsstp.Step", "rsstp.Model", "rsstp.Event")
@@ -86,6 +90,11 @@ METADATA_KEYS = (
     "scenario_sha256",
 )
 """The keys of the ``rsstp`` metadata record (every value a string)."""
+METADATA_CHECKSUM_KEY = "metadata_sha256"
+"""The record's last key, from 2.2: :func:`metadata_checksum` of all the others."""
+METADATA_CHECKSUM_SINCE = (2, 2)
+"""The schema version from which a recording's metadata must carry its checksum (an older
+file has none: it is read, its metadata marked unverified)."""
 
 ATTACHMENT_NAME = "scenario.toml"
 ATTACHMENT_MEDIA_TYPE = "application/toml"
@@ -96,6 +105,20 @@ _VERSION = re.compile(r"(0|[1-9][0-9]*)\.(0|[1-9][0-9]*)")
 def log_time_ns(step: int) -> int:
     """The ``log_time`` (and ``publish_time``) of step ``step``, in nanoseconds."""
     return step * STEP_NS
+
+
+def metadata_checksum(metadata: Mapping[str, str]) -> str:
+    """The SHA-256 (hex) that covers an ``rsstp`` metadata record: of every key but
+    :data:`METADATA_CHECKSUM_KEY`, written as one JSON object, keys sorted, no spaces,
+    non-ASCII as UTF-8 (``schemas/README.md`` gives the rule for other languages).
+
+    >>> metadata_checksum({"seed": "1", "package": "rsstp"}) == hashlib.sha256(
+    ...     b'{"package":"rsstp","seed":"1"}').hexdigest()
+    True
+    """
+    others = {key: value for key, value in metadata.items() if key != METADATA_CHECKSUM_KEY}
+    text = json.dumps(others, sort_keys=True, separators=(",", ":"), ensure_ascii=False)
+    return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()
 
 
 def parse_version(text: object) -> tuple[int, int]:

@@ -35,10 +35,10 @@ def _start(prog: str, module: str) -> int:
 
 
 def rsstp_sim() -> int:
-    """``rsstp-sim``: the simulator's command line (:func:`rsstp_sim.cli.main`)."""
-    return _start("rsstp-sim", "rsstp_sim.cli")
+    """``rsstp-sim``: the simulator's command line (:func:`rsstp_cli.sim.main`)."""
+    return _start("rsstp-sim", "rsstp_cli.sim")
 
 
 def rsstp_replay() -> int:
-    """``rsstp-replay``: the replay side's command line (:func:`rsstp_replay.cli.main`)."""
-    return _start("rsstp-replay", "rsstp_replay.cli")
+    """``rsstp-replay``: the replay side's command line (:func:`rsstp_cli.replay.main`)."""
+    return _start("rsstp-replay", "rsstp_cli.replay")

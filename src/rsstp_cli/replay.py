@@ -20,11 +20,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from rsstp_cli._commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_replay.table_files import TABLE_FORMATS, sidecar_path, write_table
 from rsstp_replay.tables import TABLES, recording_table
-from rsstp_sim.commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_sim.files import check_output
 from rsstp_sim.words import counted
 
@@ -123,6 +123,7 @@ def _cmd_info(args: argparse.Namespace) -> int:
             f"written by: rsstp {meta['package_version']} (Python {meta['python']}, "
             f"numpy {meta['numpy']}, mcap {meta['mcap']})"
         )
+        print(_metadata_text(recording))
     return 0
 
 
@@ -202,7 +203,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         bar.to(1)
         bar.stage("auditing")
         report = run_audits(loaded)
-        physics = check_physics(recording)
+        physics = check_physics(recording, loaded.steps())
         bar.to(2)
         truth = None
         if args.truth:
@@ -276,6 +277,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
         physics = check_physics(recording) if args.physics else None
     if args.json:
         document = findings.to_json()
+        document = {**document, "metadata_verified": recording.metadata_verified}
         if physics is not None:
             document = {**document, "physics": physics.to_json()}
         print(json.dumps(document, indent=2))
@@ -285,10 +287,23 @@ def _cmd_check(args: argparse.Namespace) -> int:
             f"{counted(versions, 'model version')}, {counted(events, 'event')}: every chunk read "
             "and checked"
         )
+        print(_metadata_text(recording))
         print(findings.to_text())
         if physics is not None:
             print(physics.to_text())
     return 0 if findings.holds and (physics is None or physics.holds) else 1
+
+
+def _metadata_text(recording: Recording) -> str:
+    if recording.metadata_verified:
+        return "metadata: verified by its checksum"
+    from rsstp_sim.recording.schemas import parse_version
+
+    version = max(recording.schema_versions.values(), key=parse_version)
+    return (
+        f"metadata: unverified (a schema {version} recording, written before the metadata "
+        "carried a checksum)"
+    )
 
 
 def _cmd_compare(args: argparse.Namespace) -> int:
@@ -558,7 +573,7 @@ def _build_parser() -> Parser:
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(func=_cmd_export)
 
-    from rsstp_sweep.commands import add_report_parser  # the sweep's report (no Dask needed)
+    from rsstp_cli.sweep import add_report_parser  # the sweep's report (no Dask needed)
 
     add_report_parser(sub)
     return parser

@@ -16,8 +16,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from rsstp_cli._commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_sim import graph
-from rsstp_sim.commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_sim.coupling import Runner, stop_text
 from rsstp_sim.errors import RecordingWriteError
 from rsstp_sim.files import check_output
@@ -351,7 +351,7 @@ def _build_parser() -> Parser:
 
     # The sweep records and audits: it sits above the simulator and the replay side, and is
     # imported only when the command runs.
-    from rsstp_sweep.commands import add_sweep_parser  # noqa: TID251
+    from rsstp_cli.sweep import add_sweep_parser
 
     add_sweep_parser(sub)
     return parser

@@ -70,7 +70,7 @@ def _positive(text: str) -> int:
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    from rsstp_sim.commandline import UsageError, progress
+    from rsstp_cli._commandline import UsageError, progress
     from rsstp_sweep.engine import RUNS_TABLE, run_sweep
     from rsstp_sweep.plan import load_sweep
 
@@ -78,7 +78,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         raise UsageError("--workers sizes the local cluster: give it or --scheduler, not both")
     sweep = load_sweep(args.sweep)
     _check_output(args.output)
-    prog = os.path.basename(sys.argv[0]) or "rsstp-sim"
+    prog = "rsstp-sim"
     failed: list[str] = []
     counts = {"done": 0, "reused": 0}
     with progress(len(sweep.runs), "sweep", unit="run", quiet=args.quiet) as bar:
@@ -113,7 +113,7 @@ def _check_output(output: str) -> None:
     import fsspec
     from fsspec.implementations.local import LocalFileSystem
 
-    from rsstp_sim.commandline import UsageError
+    from rsstp_cli._commandline import UsageError
 
     try:
         fs, root = fsspec.core.url_to_fs(output)
@@ -135,7 +135,7 @@ def _check_output(output: str) -> None:
 
 
 def _cmd_report(args: argparse.Namespace) -> int:
-    from rsstp_sim.commandline import UsageError
+    from rsstp_cli._commandline import UsageError
     from rsstp_sweep import report
 
     gates = [report.parse_gate(text) for text in args.fail_if]  # a bad gate before any work
