@@ -12,7 +12,7 @@ import bisect
 from array import array
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, cast
 
 import msgspec
 
@@ -90,14 +90,7 @@ class ChainCheck:
         assert model is not None
         patched = _patched(previous.transitions, model, touched)
         fields = {name: getattr(head, name) for name in head.__struct_fields__}
-        expected = ModelRecord(
-            **fields,
-            transitions=TransitionsRecord(
-                source=list(patched.source),
-                action=list(patched.action),
-                target=list(patched.target),
-            ),
-        )
+        expected = ModelRecord(**fields, transitions=patched.as_lists())
         if encode(expected) != data:
             return self._compare(decode(), touched, patched)
         return self._accept(msgspec.structs.replace(expected, transitions=patched), "")
@@ -197,8 +190,8 @@ def _patched(previous: TransitionsRecord, rebuilt: TransitionSystem, touched: se
             done = hi
         _extend(columns, source[done:], action[done:], target[done:])
     except OverflowError:  # an id past the model's own: the comparison names it
-        return _Compact(source=array("q"), action=array("q"), target=array("q"))
-    return _Compact(source=columns[0], action=columns[1], target=columns[2])
+        return _Compact.of(array("q"), array("q"), array("q"))
+    return _Compact.of(*columns)
 
 
 def _extend(columns: tuple[array[int], ...], *parts: Sequence[int]) -> None:
@@ -213,13 +206,22 @@ def _extend(columns: tuple[array[int], ...], *parts: Sequence[int]) -> None:
 
 class _Compact(TransitionsRecord, frozen=True, kw_only=True, gc=False):
     """Transitions in ``array.array`` columns of the narrowest signed type that holds the
-    model's ids (2 bytes each below 32,768 states, where a tuple's slot takes 8)."""
+    model's ids (2 bytes each below 32,768 states, where a tuple's slot takes 8). The fields
+    are declared as the record's tuples; here they hold arrays, sequences of ints too."""
+
+    @classmethod
+    def of(cls, source: array[int], action: array[int], target: array[int]) -> _Compact:
+        return cls(source=cast(Any, source), action=cast(Any, action), target=cast(Any, target))
 
     def as_lists(self) -> TransitionsRecord:
         """The same transitions in lists (what the JSON encoder writes)."""
-        columns = [self.source, self.action, self.target]
-        source, action, target = (c.tolist() for c in columns if isinstance(c, array))
-        return TransitionsRecord(source=source, action=action, target=target)
+        source, action, target = (
+            cast("array[int]", column).tolist()
+            for column in (self.source, self.action, self.target)
+        )
+        return TransitionsRecord(
+            source=cast(Any, source), action=cast(Any, action), target=cast(Any, target)
+        )
 
     def holds(self, other: TransitionsRecord) -> bool:
         """Whether ``other`` has the same transitions in the same order."""

@@ -235,9 +235,9 @@ class TransitionsRecord(_Record, frozen=True, kw_only=True, gc=False):
     ids). Parallel arrays keep a model message as compact as a list of triples, in a shape
     every JSON-Schema viewer can address."""
 
-    source: Sequence[int]
-    action: Sequence[int]
-    target: Sequence[int]
+    source: tuple[int, ...]
+    action: tuple[int, ...]
+    target: tuple[int, ...]
 
     def __len__(self) -> int:
         return len(self.source)
