@@ -191,7 +191,9 @@ class Walker:
         Undo the actions since the last known state (:meth:`retrace`), then take the states
         around it as candidates for where the agent is, most likely first, and follow the
         first one's path to the landmark; a candidate predicting a different sensation is
-        ruled out. When none is left, every state is a candidate again, after a random run.
+        ruled out. When none is left, every state is a candidate again, after a random run;
+        when every state was ruled out, the agent is where its hypothesis does not reach yet,
+        and it first wanders at random (climbs, with float feedback), twice as long each time.
         """
         h = self.h
         phase, self.phase = self.phase, "home"
@@ -206,9 +208,13 @@ class Walker:
         widened = not len(ids)
         if widened:
             ids = np.asarray(h.matching(sensation, feel), dtype=np.int64)
+        failed = wander = 0
         while True:
             usable = np.flatnonzero(h.distance[ids] < FAR)
-            if len(usable) and self._run_left <= 0:
+            if wander > 0:  # every state of the hypothesis ruled out: outside it, wander
+                wander -= 1
+                action = self.random_action()
+            elif len(usable) and self._run_left <= 0:
                 action = h.actions[int(h.toward[ids[usable[0]]])]
             elif climbing:  # climb the feedback for a while, instead of a random run
                 if (yield from self.climb(LONGEST_RUN * len(h.actions))):
@@ -234,6 +240,12 @@ class Walker:
                 if widened and self._run_left <= 0:
                     self.random_action()  # start a run
                     self._run_left += 1
+                    if not climbing:
+                        # Each time every state is ruled out, wander twice as long before
+                        # following their paths again: the agent is in a part of the world
+                        # its hypothesis does not hold yet, where their paths do not lead home.
+                        wander = LONGEST_RUN << min(failed, 20)
+                        failed += 1
                 widened = True
                 ids = np.asarray(h.matching(sensation, feel), dtype=np.int64)
 
