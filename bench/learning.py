@@ -5,6 +5,7 @@
     PYTHONPATH=src python bench/learning.py --no-aalpy
     PYTHONPATH=src python bench/learning.py --spread 10     # steps to learn over seeds 0-9
     PYTHONPATH=src python bench/learning.py --curve --max-n 1200 --no-aalpy   # steps / N^2
+    PYTHONPATH=src python bench/learning.py --curve --seeds 5 --no-aalpy      # seeds 0-4
 
 For each built-in scenario: the ground truth's minimal model (N states); the ``learner``
 strategy run until it is done (or its step budget is spent), its steps, seconds and whether its
@@ -26,10 +27,13 @@ on two-joint-30; each learner run under a minute.
 ``--curve``: steps to learn as a multiple of N^2 against N, on worlds of about 36, 119, 360,
 1,200 and 5,000 classes (:data:`CURVE`: the built-in one-joint-10, two-joint-30 and
 thesis-algo, then two links (2, 1) with one obstacle at 10 and at 5 degrees), each in its
-boolean form and its float twin (``mode = "float"``: the learner climbs the closeness), with
-AALpy's run_hW beside the boolean one unless ``--no-aalpy``; ``--max-n`` leaves out larger
-worlds. The budget is 4 N^2 steps; the seconds are the learner's own, warm (the truth is
-computed first).
+boolean form and its float twin (``mode = "float"``: the learner climbs the closeness and
+tells poses apart by it), one line per seed (``--seeds K``: seeds 0 .. K-1, default 1), with
+the float's steps as a share of the boolean's, and AALpy's run_hW beside the boolean one on
+seed 0 unless ``--no-aalpy`` (a world of the curve is handed to it as a scenario file);
+``--max-n`` leaves out larger worlds. The budget is 4 N^2 steps; the seconds are the
+learner's own, warm (the truth is computed first). Targets: every run equivalent within
+4 N^2; the float twin of the 1,200-class world in at most half the boolean's steps.
 
 ``--spread K``: the learner alone on each scenario with seeds ``0 .. K-1``, the steps to learn
 (least, median, most, and as multiples of N^2) and how many runs ended equivalent: the seed
@@ -45,10 +49,12 @@ import json
 import random
 import subprocess
 import sys
+import tempfile
 import time
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -376,11 +382,13 @@ CURVE: tuple[tuple[str, Any], ...] = (
 """The worlds of ``--curve``, smallest first."""
 
 
-def curve(max_n: int, seed: int, aalpy: bool, seconds: float, memory_gib: float) -> bool:
-    """Steps to learn / N^2 against N (see the module docstring); one line per world."""
+def curve(max_n: int, seeds: int, aalpy: bool, seconds: float, memory_gib: float) -> bool:
+    """Steps to learn / N^2 against N (see the module docstring); one line per world and
+    seed."""
     head = (
-        f"{'world':14s} {'N':>6s} | {'bool steps':>10s} {'x N^2':>6s} {'s':>7s} {'eq':>3s} | "
-        f"{'float steps':>11s} {'x N^2':>6s} {'s':>7s} {'eq':>3s} | AALpy hW"
+        f"{'world':14s} {'N':>6s} {'seed':>4s} | {'bool steps':>10s} {'x N^2':>6s} {'s':>7s} "
+        f"{'eq':>3s} | {'float steps':>11s} {'x N^2':>6s} {'s':>7s} {'eq':>3s} "
+        f"{'/bool':>5s} | AALpy hW"
     )
     print(head)
     print("-" * len(head))
@@ -393,20 +401,42 @@ def curve(max_n: int, seed: int, aalpy: bool, seconds: float, memory_gib: float)
             print(f"{name:14s} {n:>6,} | left out (--max-n {max_n:,})")
             continue
         budget = 4 * n**2
-        cells = []
-        for world in (scenario, _twin(scenario)):
-            row = run_learner(world, truth, budget, seed)
-            good &= row.equivalent and row.done
-            cells.append(
-                f"{row.steps:>{10 if not cells else 11},} {row.steps / n**2:>6.2f} "
-                f"{row.seconds:>7.1f} {'yes' if row.equivalent else 'NO':>3s}"
+        for seed in range(seeds):
+            cells = []
+            rows = []
+            for world in (scenario, _twin(scenario)):
+                row = run_learner(world, truth, budget, seed)
+                rows.append(row)
+                good &= row.equivalent and row.done
+                cells.append(
+                    f"{row.steps:>{10 if not cells else 11},} {row.steps / n**2:>6.2f} "
+                    f"{row.seconds:>7.1f} {'yes' if row.equivalent else 'NO':>3s}"
+                )
+            share = rows[1].steps / max(rows[0].steps, 1)
+            hw = "not run"
+            if aalpy and seed == 0:
+                found = _hw_on(name, scenario, seconds, seed, memory_gib)
+                hw = (
+                    f"{found.get('steps') or 0:,} steps, {found.get('seconds')} s: "
+                    f"{found['result']}"
+                )
+            print(
+                f"{name:14s} {n:>6,} {seed:>4d} | {cells[0]} | {cells[1]} {share:>5.2f} | {hw}",
+                flush=True,
             )
-        hw = "not run"
-        if aalpy and name in SCENARIOS:  # run_hW rebuilds the world by its built-in name
-            found = run_hw(name, seconds, seed, memory_gib)
-            hw = f"{found.get('steps') or 0:,} steps, {found.get('seconds')} s: {found['result']}"
-        print(f"{name:14s} {n:>6,} | {cells[0]} | {cells[1]} | {hw}", flush=True)
     return good
+
+
+def _hw_on(
+    name: str, scenario: Scenario, seconds: float, seed: int, memory_gib: float
+) -> dict[str, Any]:
+    """:func:`run_hw` on a built-in scenario by name, on another one by a scenario file."""
+    if name in SCENARIOS:
+        return run_hw(name, seconds, seed, memory_gib)
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / f"{name}.toml"
+        path.write_text(scenario.source, encoding="utf-8")
+        return run_hw(str(path), seconds, seed, memory_gib)
 
 
 def spread(names: Sequence[str], seeds: int) -> bool:
@@ -447,6 +477,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--spread", type=int, metavar="K", help="the learner over seeds 0..K-1")
     parser.add_argument("--curve", action="store_true", help="steps / N^2 against N")
     parser.add_argument("--max-n", type=int, default=10_000, help="--curve: the largest N")
+    parser.add_argument("--seeds", type=int, default=1, help="--curve: seeds 0 .. K-1")
     parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
     parser.add_argument("scenarios", nargs="*", default=list(SCENARIOS))
     args = parser.parse_args(argv)
@@ -456,7 +487,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.curve:
         ok = curve(
             args.max_n,
-            args.seed,
+            args.seeds,
             not args.no_aalpy and _aalpy_version() is not None,
             args.aalpy_seconds,
             args.aalpy_memory_gib,

@@ -52,7 +52,8 @@ def run(path: Path, *params: str) -> tuple[int, float, str]:
         command += ["--param", param]
     done = subprocess.run(command, capture_output=True, text=True, check=True)
     out = done.stdout
-    steps = int(re.search(r"^steps: (\d+)", out, re.M).group(1))  # type: ignore[union-attr]
+    found = re.search(r"^steps: ([\d,]+)", out, re.M)  # (thousands separated by commas)
+    steps = int(found.group(1).replace(",", ""))  # type: ignore[union-attr]
     seconds = float(re.search(r"^time: ([\d.]+) s", out, re.M).group(1))  # type: ignore[union-attr]
     return steps, seconds, out.splitlines()[1]
 

@@ -265,6 +265,14 @@ class TransitionSystem:
         """Every transition as ``(source, action, target)``, sorted."""
         return [(s, a, t) for s in self.states for a, t in self.transitions_from(s)]
 
+    def transitions_into(self, t: int) -> list[tuple[int, int]]:
+        """Every transition into ``t`` as ``(source, action)``, sorted."""
+        try:
+            into = self._in[t]
+        except KeyError:
+            raise ModelError(f"transitions_into: unknown state {t!r}") from None
+        return sorted((u, a) for a, sources in into.items() for u in sources)
+
     def transitions_from(self, s: int) -> list[tuple[int, int]]:
         """Every transition out of ``s`` as ``(action, target)``, sorted."""
         try:

@@ -110,7 +110,7 @@ def test_a_graphviz_crash_is_one_line(
             "graph",
             str(LEARNER),
             "--step",
-            "9000",
+            "8000",
             "-o",
             str(out),
             *extra,

@@ -778,7 +778,7 @@ def test_states_are_coloured_by_what_they_stood_for(learner: tuple[Recording, Rr
     }
     versions = recording.model_versions()
     seen = set()
-    for index in (len(versions) // 3, len(versions) - 1):
+    for index in (len(versions) // 2, len(versions) - 1):
         version = versions[index]
         at = version.step if index == len(versions) - 1 else versions[index + 1].step - 1
         for state in version.states:

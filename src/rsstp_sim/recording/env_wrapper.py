@@ -77,7 +77,10 @@ class RecordMcap(gymnasium.Wrapper[Any, Any, Any, Any]):
     :attr:`model` is it, and the recording has a model channel), else None. ``force``
     replaces existing recordings; ``chunk_size`` as for ``rsstp-sim record``. The recording's
     seed is the ``reset`` seed (the episode's index when there is none); its strategy is
-    :class:`GymnasiumAgent`, named ``gymnasium``.
+    :class:`GymnasiumAgent`, named ``gymnasium``. An episode that a strategy ended
+    (``terminated`` with ``info["stopped"]``, as a wrapped
+    :class:`~rsstp_sim.env_strategy.StrategyPolicy` returns it) ends its recording with the
+    stop event of a run the strategy stopped.
     """
 
     def __init__(
@@ -148,6 +151,9 @@ class RecordMcap(gymnasium.Wrapper[Any, Any, Any, Any]):
                 f"environment's at {list(info['angles_deg'])}: was the environment moved "
                 f"outside step()?"
             )
+        stopped = info.get("stopped")
+        if terminated and isinstance(stopped, str):  # a strategy ended the episode
+            recorder.runner.agent.stop(stopped)
         return observation, reward, terminated, truncated, info
 
     def close(self) -> None:

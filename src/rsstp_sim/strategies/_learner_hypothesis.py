@@ -26,6 +26,7 @@ __all__ = ["FAR", "Hypothesis"]
 
 IntArray = NDArray[np.int64]
 BoolArray = NDArray[np.bool_]
+FloatArray = NDArray[np.float64]
 
 FAR = np.iinfo(np.int64).max // 4
 """The distance to the landmark of a state with no confirmed path to it."""
@@ -39,6 +40,14 @@ class Hypothesis:
     world state ``s`` was created for: a fact of the trajectory, which defines ``s``.
     ``next[s, k]`` is the confirmed successor of ``s`` by ``actions[k]``, or -1.
 
+    ``feels`` (float feedback, ``mode = "float"``): ``feel[s]`` is the closeness the agent
+    felt at the world state ``s`` was created for (NaN: unknown), ``also_felt[s]`` the
+    feels of the states merged into ``s``.
+    Two world states felt differently are different poses, so a candidate whose feel differs
+    from the one felt is ruled out as one whose label differs is (:meth:`agree`): the states
+    are then poses, and the minimisation at the end merges those the sensation cannot tell
+    apart. Without ``feels`` the feel is never compared.
+
     ``rng`` (the run's generator) draws, once, the order in which the actions are tried
     when several shortest paths or several nearest states tie: a path keeps one preference
     all run long (a coherent sweep of the world; drawn anew at every search, the walks
@@ -51,8 +60,11 @@ class Hypothesis:
         actions: tuple[int, ...],
         landmark: int,
         rng: np.random.Generator | None = None,
+        *,
+        feels: bool = False,
     ) -> None:
         self.model = model
+        self.feels = feels
         order = np.arange(len(actions)) if rng is None else rng.permutation(len(actions))
         self._columns: list[int] = [int(k) for k in order]
         self._ordered = [actions[k] for k in self._columns]
@@ -62,6 +74,9 @@ class Hypothesis:
         self.next: IntArray = np.full((capacity, len(actions)), -1, dtype=np.int64)
         self.label: BoolArray = np.zeros(capacity, dtype=bool)
         self.alive: BoolArray = np.zeros(capacity, dtype=bool)
+        self.feel: FloatArray = np.full(capacity, np.nan)
+        self.also_felt: dict[int, set[float]] = {}
+        self._merged: BoolArray = np.zeros(capacity, dtype=bool)
         self.labels: dict[int, bool] = {}
         self.access: dict[int, tuple[int, ...]] = {}
         for s in model.states:
@@ -73,6 +88,8 @@ class Hypothesis:
         self.unconfirmed = len(model.states) * len(actions)
         self._distance: IntArray | None = None
         self._toward: IntArray | None = None
+        self._edits = 0
+        self._inverse: tuple[int, dict[int, int]] = (-1, {})
 
     # ----------------------------------------------------------------- queries
 
@@ -96,6 +113,34 @@ class Hypothesis:
         """The states predicting ``sensation``, by id."""
         return [int(s) for s in np.flatnonzero(self.alive & (self.label == sensation))]
 
+    def agree(self, states: IntArray, sensation: bool, feel: float) -> BoolArray:
+        """Which of ``states`` agree with what was sensed (and felt, with ``feels``)."""
+        same: BoolArray = self.label[states] == sensation
+        if self.feels:
+            felt = self.feel[states]
+            alike = np.isnan(felt) | (felt == feel)
+            other = np.flatnonzero(self._merged[states] & ~alike)
+            for i in other.tolist():
+                alike[i] = feel in self.also_felt[int(states[i])]
+            same &= alike
+        return same
+
+    def agrees(self, s: int, sensation: bool, feel: float) -> bool:
+        """Whether state ``s`` agrees with what was sensed (and felt, with ``feels``)."""
+        if self.labels[s] != sensation:
+            return False
+        if not self.feels:
+            return True
+        felt = float(self.feel[s])
+        if felt != felt or felt == feel:  # (NaN: unknown)
+            return True
+        return feel in self.also_felt.get(s, ())
+
+    def matching(self, sensation: bool, feel: float) -> list[int]:
+        """The states agreeing with what was sensed (and felt), by id."""
+        states = np.flatnonzero(self.alive)
+        return [int(s) for s in states[self.agree(states, sensation, feel)]]
+
     def step(
         self, start: IntArray, position: IntArray, action: int, via: tuple[int, int]
     ) -> IntArray:
@@ -111,16 +156,23 @@ class Hypothesis:
         return moved
 
     def consistent(
-        self, word: tuple[int, ...], outputs: tuple[bool, ...], via: tuple[int, int]
+        self,
+        word: tuple[int, ...],
+        outputs: tuple[bool, ...],
+        via: tuple[int, int],
+        feels: tuple[float, ...] = (),
     ) -> list[int]:
         """The states ``c`` from which ``word`` yields ``outputs`` (the first: ``c``'s own
-        label), if ``via`` leads to ``c`` (see :meth:`step`)."""
-        start = np.flatnonzero(self.alive & (self.label == outputs[0]))
+        label) and ``feels`` (with :attr:`feels`), if ``via`` leads to ``c`` (see
+        :meth:`step`)."""
+        felt = feels if self.feels and feels else (0.0,) * len(outputs)
+        start = np.flatnonzero(self.alive)
+        start = start[self.agree(start, outputs[0], felt[0])]
         position = start.copy()
-        for action, sensation in zip(word, outputs[1:], strict=True):
+        for action, sensation, feel in zip(word, outputs[1:], felt[1:], strict=True):
             moved = self.step(start, position, action, via)
             keep = moved >= 0
-            keep[keep] = self.label[moved[keep]] == sensation
+            keep[keep] = self.agree(moved[keep], sensation, feel)
             start, position = start[keep], moved[keep]
         return [int(s) for s in start]
 
@@ -128,28 +180,78 @@ class Hypothesis:
         return self.unconfirmed == 0
 
     def _guide(self) -> tuple[IntArray, IntArray]:
-        """Distances to the landmark over confirmed transitions, and the first step's column."""
+        """Distances to the landmark over confirmed transitions, and the first step's column.
+
+        Kept up to date as transitions are confirmed (:meth:`_added`); computed afresh (a
+        breadth-first search from the landmark, one numpy pass per distance) after a change
+        that can lengthen a path: a transition withdrawn or replaced, a merge.
+        """
         if self._distance is None or self._toward is None:
             n = len(self.label)
             distance = np.full(n, FAR, dtype=np.int64)
-            toward = np.full(n, -1, dtype=np.int64)
-            # By source, then in the run's action order: the first path found is kept.
-            sources, columns = np.nonzero(self.next[:, self._columns] >= 0)
-            columns = np.asarray(self._columns, dtype=np.int64)[columns]
-            incoming: dict[int, list[tuple[int, int]]] = {}
-            for s, k in zip(sources.tolist(), columns.tolist(), strict=True):
-                incoming.setdefault(int(self.next[s, k]), []).append((s, k))
             distance[self.landmark] = 0
-            queue = deque([self.landmark])
-            while queue:
-                t = queue.popleft()
-                for s, k in incoming.get(t, ()):
-                    if distance[s] == FAR:
-                        distance[s] = distance[t] + 1
-                        toward[s] = k
-                        queue.append(s)
-            self._distance, self._toward = distance, toward
+            reached = np.zeros(n, dtype=bool)
+            reached[self.landmark] = True
+            confirmed = self.next >= 0
+            targets = np.where(confirmed, self.next, self.landmark)
+            level = 0
+            while True:
+                level += 1
+                found = ~reached & self.alive & (confirmed & reached[targets]).any(axis=1)
+                if not found.any():
+                    break
+                distance[found] = level
+                reached |= found
+            self._distance = distance
+            self._toward = np.full(n, -1, dtype=np.int64)
+            self._aim(np.flatnonzero(distance < FAR))
         return self._distance, self._toward
+
+    def _aim(self, states: IntArray) -> None:
+        """``toward`` of ``states`` from the distances: the first action, in the run's order,
+        to a successor one step nearer the landmark (-1 at the landmark and out of reach)."""
+        distance, toward = self._distance, self._toward
+        assert distance is not None and toward is not None
+        if not len(states):
+            return
+        successors = self.next[states][:, self._columns]
+        ahead = np.where(successors >= 0, distance[np.maximum(successors, 0)], FAR)
+        nearer = ahead == (distance[states] - 1)[:, None]
+        first = nearer.argmax(axis=1)
+        columns = np.asarray(self._columns, dtype=np.int64)[first]
+        toward[states] = np.where(nearer.any(axis=1), columns, -1)
+
+    def _added(self, s: int, t: int) -> None:
+        """The confirmed transition ``s -> t`` is new: shorten the distances it shortens."""
+        distance = self._distance
+        if distance is None:
+            return
+        if distance[t] + 1 >= distance[s]:
+            self._aim(np.asarray([s], dtype=np.int64))
+            return
+        distance[s] = distance[t] + 1
+        changed = [s]
+        frontier = np.asarray([s], dtype=np.int64)
+        while len(frontier):
+            into = np.zeros(len(distance), dtype=bool)
+            into[frontier] = True
+            confirmed = self.next >= 0
+            sources, columns = np.nonzero(confirmed & into[np.maximum(self.next, 0)])
+            better = distance[self.next[sources, columns]] + 1
+            order = np.lexsort((better, sources))
+            sources, better = sources[order], better[order]
+            keep = np.ones(len(sources), dtype=bool)
+            keep[1:] = sources[1:] != sources[:-1]  # the least distance per source
+            sources, better = sources[keep], better[keep]
+            shorter = better < distance[sources]
+            frontier = sources[shorter]
+            distance[frontier] = better[shorter]
+            changed.extend(frontier.tolist())
+        touched = np.asarray(changed, dtype=np.int64)
+        into = np.zeros(len(distance), dtype=bool)
+        into[touched] = True
+        before = np.flatnonzero(((self.next >= 0) & into[np.maximum(self.next, 0)]).any(axis=1))
+        self._aim(np.union1d(touched, before))
 
     @property
     def distance(self) -> IntArray:
@@ -169,6 +271,11 @@ class Hypothesis:
     def nearest(self, source: int, wanted: set[int]) -> tuple[list[int], int] | None:
         """A shortest confirmed word from ``source`` to one of ``wanted``, and that state."""
         return self._search(source, wanted.__contains__)
+
+    def nearest_where(self, source: int, wanted: BoolArray) -> tuple[list[int], int] | None:
+        """:meth:`nearest`, the states wanted given as a mask over the state ids."""
+        flags: list[bool] = wanted.tolist()
+        return self._search(source, flags.__getitem__)
 
     def _search(self, source: int, is_goal: Callable[[int], bool]) -> tuple[list[int], int] | None:
         parent: dict[int, tuple[int, int]] = {}
@@ -211,8 +318,10 @@ class Hypothesis:
 
         ``b`` undoes ``a`` when, of the confirmed ``s -a-> t`` (``t != s``) with a confirmed
         ``t -b->``, most have ``t -b-> s``: learned from the agent's own experience, used to
-        guess, never to conclude.
+        guess, never to conclude. (Worked out again after each change of the hypothesis.)
         """
+        if self._inverse[0] == self._edits:
+            return self._inverse[1]
         states = np.flatnonzero(self.alive)
         inverse: dict[int, int] = {}
         for ka, a in enumerate(self.actions):
@@ -227,7 +336,13 @@ class Hypothesis:
                     best, best_count = kb, count
             if best >= 0:
                 inverse[a] = self.actions[best]
+        self._inverse = (self._edits, inverse)
         return inverse
+
+    def reversible(self) -> bool:
+        """Whether the confirmed transitions show an action undoing each action
+        (:meth:`inverses`): then no move leads into a part of the world the agent cannot leave."""
+        return len(self.inverses()) == len(self.actions)
 
     def reachable(self) -> set[int]:
         """The states reachable from the landmark over confirmed transitions."""
@@ -271,30 +386,39 @@ class Hypothesis:
     # ----------------------------------------------------------------- changes
 
     def _changed(self) -> None:
+        """A change that may lengthen paths to the landmark: the guide is worked out afresh."""
         self._distance = None
         self._toward = None
 
     def confirm(self, s: int, action: int, t: int) -> None:
         """Make ``s -action-> t`` the confirmed successor (replacing the model's conjecture)."""
+        self._edits += 1
         k = self.column[action]
-        if self.next[s, k] < 0:
+        before = int(self.next[s, k])
+        if before < 0:
             self.unconfirmed -= 1
         self.next[s, k] = t
         old = self.target(s, action)
         if old != t:
             self.model.delete(s, old, action)
             self.model.add(s, t, action)
-        self._changed()
+        if before < 0:
+            self._added(s, t)
+        elif before != t:
+            self._changed()
 
     def unconfirm(self, s: int, action: int) -> None:
         """Withdraw a confirmed successor; the model keeps it as a conjecture."""
+        self._edits += 1
         k = self.column[action]
         if self.next[s, k] >= 0:
             self.unconfirmed += 1
             self.next[s, k] = -1
             self._changed()
 
-    def create(self, s: int, action: int, sensation: bool, access: tuple[int, ...]) -> int:
+    def create(
+        self, s: int, action: int, sensation: bool, access: tuple[int, ...], feel: float = np.nan
+    ) -> int:
         """A new state for the world state ``s -action->`` leads to, by splitting the guess.
 
         The model's conjectured successor ``t`` of ``s`` by ``action`` turned out to stand for
@@ -302,9 +426,10 @@ class Hypothesis:
         would make the model nondeterministic are deleted. The new state keeps copies of
         ``t``'s transitions as its conjectures (a self-loop of ``t`` becomes its own).
         """
+        self._edits += 1
         model = self.model
         t = self.target(s, action)
-        incoming = [(u, a) for u, a, v in model.transitions() if v == t]
+        incoming = model.transitions_into(t)
         new = model.split(t)
         for u, a in incoming:
             if u == t:
@@ -322,20 +447,24 @@ class Hypothesis:
         self.alive[new] = True
         self.label[new] = sensation
         self.labels[new] = sensation
+        self.feel[new] = feel
         self.access[new] = access
         self.next[new] = -1
         self.unconfirmed += len(self.actions)
         k = self.column[action]
-        if self.next[s, k] < 0:
+        before = int(self.next[s, k])
+        if before < 0:
             self.unconfirmed -= 1
         self.next[s, k] = new
-        self._changed()
+        if before >= 0:
+            self._changed()
         return new
 
     def add_silent(self) -> int:
         """A new state for a part of the world that never senses: it predicts false, and every
         action leads back to it (confirmed). Made by splitting the landmark, its copied
         transitions then deleted."""
+        self._edits += 1
         model = self.model
         new = model.split(self.landmark)
         for u, a, v in model.transitions():
@@ -346,15 +475,24 @@ class Hypothesis:
         self._grow(new)
         self.alive[new] = True
         self.label[new] = False
+        self.feel[new] = np.nan
         self.labels[new] = False
         self.access[new] = ()
         self.next[new] = new
-        self._changed()
         return new
 
     def merge(self, keep: int, gone: int) -> None:
         """``gone`` is the same world state as ``keep``: the model's merge, then the arrays."""
+        self._edits += 1
         self.model.merge(keep, gone)
+        felt = self.also_felt.pop(gone, set())
+        felt.add(float(self.feel[gone]))
+        felt.discard(float(self.feel[keep]))
+        felt = {f for f in felt if f == f}
+        if felt:
+            self.also_felt.setdefault(keep, set()).update(felt)
+            self._merged[keep] = True
+        self._merged[gone] = False
         self.unconfirmed -= int(np.count_nonzero(self.next[gone] < 0))
         self.next[gone] = -1
         self.next[self.next == gone] = keep
@@ -371,6 +509,9 @@ class Hypothesis:
         for action in self.actions:
             for t in model.successors(gone, action):
                 model.delete(gone, t, action)
+        self.feel[gone] = self.feel[self.landmark]  # (the landmark keeps its feels)
+        self.also_felt.pop(gone, None)
+        self._merged[gone] = False
         self.merge(self.landmark, gone)
 
     def _grow(self, s: int) -> None:
@@ -383,6 +524,11 @@ class Hypothesis:
         self.next = grown
         self.label = np.concatenate([self.label, np.zeros(size - capacity, dtype=bool)])
         self.alive = np.concatenate([self.alive, np.zeros(size - capacity, dtype=bool)])
+        if self._distance is not None and self._toward is not None:
+            self._distance = np.concatenate([self._distance, np.full(size - capacity, FAR)])
+            self._toward = np.concatenate([self._toward, np.full(size - capacity, -1)])
+        self.feel = np.concatenate([self.feel, np.full(size - capacity, np.nan)])
+        self._merged = np.concatenate([self._merged, np.zeros(size - capacity, dtype=bool)])
 
     def minimise(self) -> list[tuple[int, int]]:
         """Merge the states the complete hypothesis cannot tell apart (Moore's refinement).

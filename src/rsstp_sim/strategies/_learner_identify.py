@@ -18,8 +18,14 @@ from rsstp_sim.strategies._learner_walk import Plan, Walker
 
 __all__ = ["Deferral", "Identifier", "Trace"]
 
-Trace = tuple[tuple[int, ...], tuple[bool, ...]]
-"""A test: its actions, and the sensations before the first and after each action."""
+Trace = tuple[tuple[int, ...], tuple[bool, ...], tuple[float, ...]]
+"""A test: its actions, the sensations before the first and after each action, and the
+float feedback felt there (empty when the agent has none)."""
+
+LOCATED_STEPS = 2
+"""With float feedback, a test ends when one candidate is left and it has agreed with what
+was sensed and felt for this many steps: the agent is located there
+(:meth:`Identifier.session`)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -31,6 +37,7 @@ class Deferral:
     access: tuple[int, ...]
     label: bool
     version: int
+    feel: float = 0.0
 
 
 class Identifier(Walker):
@@ -52,10 +59,12 @@ class Identifier(Walker):
         self.deferred.pop((q, a), None)
         self.h.confirm(q, a, t)
 
-    def new(self, q: int, a: int, label: bool, access: tuple[int, ...], *, here: bool) -> int:
-        """A new state for ``q -a->``; ``here``: the agent is at it now."""
+    def new(
+        self, q: int, a: int, label: bool, access: tuple[int, ...], *, here: bool, feel: float
+    ) -> int:
+        """A new state for ``q -a->``, felt ``feel``; ``here``: the agent is at it now."""
         self.deferred.pop((q, a), None)
-        new = self.h.create(q, a, label, access)
+        new = self.h.create(q, a, label, access, feel if self.h.feels else np.nan)
         self.made_by[new] = a
         self.count("new_states")
         if here:
@@ -72,6 +81,7 @@ class Identifier(Walker):
         access: tuple[int, ...],
         *,
         here: bool,
+        feel: float,
         exclude: frozenset[int] = frozenset(),
         route: tuple[int, ...] | None = None,
     ) -> Plan:
@@ -84,10 +94,12 @@ class Identifier(Walker):
         them (else the state is taken as new: a later merge undoes that if it was not).
         ``here``: the agent is at that world state now. ``exclude``: states already ruled
         out. ``route``: reach the world state again from the landmark by this word (else by a
-        confirmed path to ``q``).
+        confirmed path to ``q``). ``feel``: the float feedback felt there (with float
+        feedback, the candidates felt otherwise are ruled out, and a test may end with the
+        agent located, :meth:`session`).
         """
         h = self.h
-        candidates = set(h.with_label(label)) - exclude
+        candidates = set(h.matching(label, feel)) - exclude
         undo = h.inverses().get(a)
         ranked = self.predict(q, a, candidates, undo)
         tried: set[int] = set()
@@ -95,7 +107,7 @@ class Identifier(Walker):
         returned = came_back = False
         while True:
             if not candidates:
-                self.new(q, a, label, access, here=here)
+                self.new(q, a, label, access, here=here, feel=feel)
                 return
             distance = h.distance
             script: list[int] = []
@@ -121,12 +133,12 @@ class Identifier(Walker):
                         untried = [c for c in untried if h.next[c, column] < 0]
                         if not untried or len(untried) > self.doubts or tried - set(ranked):
                             self.count("taken_as_new")
-                            self.new(q, a, label, access, here=False)
+                            self.new(q, a, label, access, here=False, feel=feel)
                             return
                     if not untried:  # nothing can tell these candidates apart yet
                         self.count("deferred")
                         self.deferred[(q, a)] = Deferral(
-                            frozenset(candidates), access, label, h.version
+                            frozenset(candidates), access, label, h.version, feel
                         )
                         return
                     nearest = min(distance[c] for c in untried)
@@ -140,17 +152,22 @@ class Identifier(Walker):
                 if arrived:
                     self.confirm(q, a, h.landmark)
                     return
-                if arrived != label:  # q stands for two world states: start afresh
+                felt = self.feel()
+                if arrived != label or (h.feels and felt != feel):
+                    # q stands for two world states: start afresh
                     self.count("restarts")
-                    yield from self.identify(q, a, arrived, tuple(self.word), here=True)
+                    yield from self.identify(q, a, arrived, tuple(self.word), here=True, feel=felt)
                     return
             self.count("sessions")
             start = self.agent.step
-            survivors, candidates, at_landmark = yield from self.session(
+            survivors, candidates, at_landmark, located = yield from self.session(
                 (q, a), candidates, first, script, follow=follow
             )
-            self.record(q, a, label, start)
+            self.record(q, a, label, feel, start)
             here = False
+            if located is not None:  # by what it sensed and felt
+                self.confirm(q, a, located)
+                return
             if not follow:  # the way back
                 came_back = at_landmark
                 ranked = sorted(survivors) + ranked
@@ -204,14 +221,17 @@ class Identifier(Walker):
         script: list[int],
         *,
         follow: bool = True,
-    ) -> Generator[int, bool, tuple[set[int], set[int], bool]]:
+    ) -> Generator[int, bool, tuple[set[int], set[int], bool, int | None]]:
         """One test from the world state ``via`` led to: follow paths to the landmark.
 
         Plays ``script`` first; then (if ``follow``) follows ``first``'s path to the landmark,
         and the nearest remaining candidate's when ``first`` is ruled out. A candidate is
         followed on the hypothesis that it is the world state, ``via`` leading to it. Returns
         the candidates that reached the landmark with the world (if it was reached), the
-        candidates not ruled out, and whether the landmark was reached.
+        candidates not ruled out, whether the landmark was reached, and the candidate the
+        agent was located as (else None): with float feedback, when one candidate is left,
+        followed, agreeing with what was sensed and felt for :data:`LOCATED_STEPS` steps, the
+        test ends there and the agent believes it is where that candidate is now.
         """
         h = self.h
         ids = np.asarray(sorted(candidates), dtype=np.int64)
@@ -220,6 +240,7 @@ class Identifier(Walker):
         chosen = first
         script = list(script)
         at_landmark = False
+        taken = 0
         while len(ids) or script:
             if script:
                 action = script.pop(0)
@@ -240,24 +261,38 @@ class Identifier(Walker):
                     index = self.pick(usable[nearest].tolist())
                     chosen = int(ids[index])
                 action = h.actions[int(h.toward[position[index]])]
+                if position[index] == via[0] and action == via[1]:
+                    # Its path goes through ``via``, which leads back to it on this
+                    # hypothesis: followed, it would go round for ever.
+                    tracked[index] = False
+                    continue
             sensation = yield from self.move(action)
+            taken += 1
             moved = h.step(ids, position, action, via)
             tracked &= moved >= 0
             position = np.where(tracked, moved, position)
-            keep = ~tracked | (h.label[position] == sensation)
+            keep = ~tracked | h.agree(position, sensation, self.feel())
             ids, position, tracked = ids[keep], position[keep], tracked[keep]
             if sensation:
                 at_landmark = True
                 break
+            if h.feels and taken >= LOCATED_STEPS and len(ids) == 1 and tracked[0]:
+                self.belief = int(position[0])
+                self.beliefs[-1] = self.belief
+                return {int(ids[0])}, {int(ids[0])}, False, int(ids[0])
         survivors = {int(s) for s in ids[tracked]} if at_landmark else set()
-        return survivors, {int(s) for s in ids}, at_landmark
+        return survivors, {int(s) for s in ids}, at_landmark, None
 
-    def record(self, q: int, a: int, label: bool, start: int) -> None:
-        """Keep the test from ``q -a->`` made since step ``start``: actions and sensations."""
+    def record(self, q: int, a: int, label: bool, feel: float, start: int) -> None:
+        """Keep the test from ``q -a->`` made since step ``start``: actions, sensations (and
+        what was felt, with float feedback)."""
         memory = self.agent.memory
         actions = tuple(int(v) for v in memory.actions[start + 1 :].tolist())
         sensations = tuple(bool(v) for v in memory.sensations[start + 1 :].tolist())
-        self.traces.setdefault((q, a), []).append((actions, (label, *sensations)))
+        felt: tuple[float, ...] = ()
+        if self.h.feels:
+            felt = (feel, *(float(v) for v in memory.feedback[start + 1 :].tolist()))
+        self.traces.setdefault((q, a), []).append((actions, (label, *sensations), felt))
 
     def return_to(
         self, q: int, a: int, route: tuple[int, ...] | None

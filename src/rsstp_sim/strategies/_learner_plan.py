@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Generator
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR
@@ -86,7 +87,7 @@ class Learning(Identifier):
         if self.deferred:
             (q, a), deferral = min(self.deferred.items())
             self.count("forced")
-            self.new(q, a, deferral.label, deferral.access, here=False)
+            self.new(q, a, deferral.label, deferral.access, here=False, feel=deferral.feel)
             return
         reachable = h.reachable()
         garbage = [s for s in h.states() if s not in reachable]
@@ -133,23 +134,25 @@ class Learning(Identifier):
         belief = self.belief
         assert belief is not None
         distance = h.distance
-        rows, columns = np.nonzero(h.alive[:, None] & (h.next < 0))
-        open_pairs: dict[int, list[int]] = {}
-        for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
-            a = h.actions[k]
-            deferred = self.deferred.get((s, a))
-            if deferred is not None and (
-                deferred.version == h.version
-                or not any(u not in h.labels or distance[u] < FAR for u in deferred.candidates)
+        open_mask = h.alive[:, None] & (h.next < 0)
+        for (s, a), deferred in self.deferred.items():
+            # Put off until the model changed and a candidate can be tested.
+            if deferred.version == h.version or not any(
+                u not in h.labels or distance[u] < FAR for u in deferred.candidates
             ):
-                continue  # until the model changed and a candidate can be tested
-            open_pairs.setdefault(s, []).append(a)
-        if not open_pairs:
+                open_mask[s, h.column[a]] = False
+        wanted: NDArray[np.bool_] = np.asarray(open_mask.any(axis=1), dtype=bool)
+        if not wanted.any():
             return None
+        actions_of = h.actions
+
+        def open_actions(s: int) -> list[int]:
+            return [actions_of[k] for k in np.flatnonzero(open_mask[s]).tolist()]
+
         inverse = h.inverses()
 
         def first(s: int) -> int:
-            actions = open_pairs[s]
+            actions = open_actions(s)
             made_by = self.made_by.get(s)
             if made_by is None:
                 return self.pick(actions)
@@ -161,13 +164,13 @@ class Learning(Identifier):
             likely = [b for b in actions if b not in taken and b != made_by]
             return self.pick(likely or actions)
 
-        outside = [s for s in open_pairs if distance[s] == FAR]
-        if outside:
-            oldest = min(outside)
+        outside = np.flatnonzero(wanted & (distance[: len(wanted)] == FAR))
+        if len(outside):
+            oldest = int(outside[0])
             word = h.path(belief, oldest)
             if word is not None:
                 return word, (oldest, first(oldest))
-        found = h.nearest(belief, set(open_pairs))
+        found = h.nearest_where(belief, wanted)
         if found is not None:
             word, s = found
             return word, (s, first(s))
@@ -186,7 +189,7 @@ class Learning(Identifier):
         if sensation:
             self.confirm(q, a, self.h.landmark)
             return
-        yield from self.identify(q, a, sensation, tuple(self.word), here=True)
+        yield from self.identify(q, a, sensation, tuple(self.word), here=True, feel=self.feel())
 
     def confine(self, since: int) -> None:
         """A one-way world: no sensation since step ``since``, and the search for the landmark
@@ -239,11 +242,13 @@ class Learning(Identifier):
                 if t == h.landmark or (s, a) in self._checked:
                     continue
                 agreeing: set[int] | None = None
-                for word, outputs in self.traces.get((s, a), ()):
-                    found = set(h.consistent(word, outputs, (s, a)))
+                for word, outputs, felt in self.traces.get((s, a), ()):
+                    found = set(h.consistent(word, outputs, (s, a), felt))
                     agreeing = found if agreeing is None else agreeing & found
                 if agreeing != {t}:
                     doubtful.setdefault(s, []).append(a)
+                else:  # (verified while the model stays as it is)
+                    self._checked.add((s, a))
         if not doubtful:
             return None
         nearest = h.nearest(self.belief, set(doubtful))
@@ -264,7 +269,7 @@ class Learning(Identifier):
         if sensation:
             self.confirm(q, a, h.landmark)
         else:
-            yield from self.identify(q, a, sensation, tuple(self.word), here=True)
+            yield from self.identify(q, a, sensation, tuple(self.word), here=True, feel=self.feel())
         if h.confirmed(q, a) != before:
             self.count("corrected")
             self.agent.note(f"verification: state {q} by action {a} leads elsewhere")
@@ -284,37 +289,39 @@ class Learning(Identifier):
         ``i`` where it changes, and ``q_i -word[i]->`` is wrong.
         """
         h = self.h
-        word, trace = refuted.word, refuted.trace
+        word, trace, felt = refuted.word, refuted.trace, refuted.felt
         states = [h.landmark]
         for action in word:
             t = h.confirmed(states[-1], action)
             if t < 0:
                 return
             states.append(t)
-        observed = trace[-1]
-        if h.labels[states[-1]] == observed:
+        observed = (trace[-1], felt[-1] if h.feels else 0.0)
+        if h.agrees(states[-1], *observed):
             return
         low, high = 0, len(word)
-        low_trace = list(trace)
+        low_trace, low_felt = list(trace), list(felt)
         while high - low > 1:
             middle = (low + high) // 2
             prefix = h.access[states[middle]]
-            outputs = yield from self.query(prefix + word[middle:])
-            if outputs[-1] == observed:
-                low, low_trace = middle, outputs[len(prefix) :]
+            outputs, feels = yield from self.query(prefix + word[middle:])
+            if (outputs[-1], feels[-1]) == observed:
+                low = middle
+                low_trace, low_felt = outputs[len(prefix) :], feels[len(prefix) :]
             else:
                 high = middle
         q, a, wrong = states[low], word[low], states[low + 1]
-        label = low_trace[0]
+        label, feel = low_trace[0], low_felt[0]
         # The states the sensations after q -a-> rule out, besides the wrong one.
         excluded = {wrong}
-        ids = np.asarray([s for s in h.with_label(label) if s != wrong], dtype=np.int64)
+        ids = np.asarray([s for s in h.matching(label, feel) if s != wrong], dtype=np.int64)
         position = ids.copy()
-        for action, sensation in zip(word[low + 1 :], low_trace[1:], strict=True):
+        after = zip(word[low + 1 :], low_trace[1:], low_felt[1:], strict=True)
+        for action, sensation, felt_then in after:
             moved = h.next[position, h.column[action]]
             known = moved >= 0
             mismatch = known.copy()
-            mismatch[known] = h.label[moved[known]] != sensation
+            mismatch[known] = ~h.agree(moved[known], sensation, felt_then)
             excluded.update(int(s) for s in ids[mismatch])
             keep = known & ~mismatch
             ids, position = ids[keep], moved[keep]
@@ -327,17 +334,27 @@ class Learning(Identifier):
         access = h.access[q] + (a,)
         self.phase = "test"
         yield from self.identify(
-            q, a, label, access, here=False, exclude=frozenset(excluded), route=access
+            q,
+            a,
+            label,
+            access,
+            here=False,
+            feel=feel,
+            exclude=frozenset(excluded),
+            route=access,
         )
 
-    def query(self, word: tuple[int, ...]) -> Generator[int, bool, list[bool]]:
-        """From the landmark, play ``word``; the sensations after each action."""
+    def query(self, word: tuple[int, ...]) -> Generator[int, bool, tuple[list[bool], list[float]]]:
+        """From the landmark, play ``word``; the sensations after each action, and what was
+        felt (zeros without float feedback)."""
         yield from self.navigate(self.h.landmark)
         self.phase = "analyse"
         outputs: list[bool] = []
+        feels: list[float] = []
         for action in word:
             outputs.append((yield from self.move(action)))
-        return outputs
+            feels.append(self.feel())
+        return outputs, feels
 
     # ------------------------------------------------------------------ results
 

@@ -48,13 +48,17 @@ class Refuted(Exception):
     """The hypothesis predicted a wrong sensation on a confirmed path from the landmark.
 
     ``word`` is the action word walked from the landmark, ``trace`` the sensation after each
-    of its actions (the last one the mispredicted).
+    of its actions (the last one the mispredicted), ``felt`` the float feedback after each
+    (with float feedback: the feel may be the mispredicted).
     """
 
-    def __init__(self, word: tuple[int, ...], trace: tuple[bool, ...]) -> None:
+    def __init__(
+        self, word: tuple[int, ...], trace: tuple[bool, ...], felt: tuple[float, ...]
+    ) -> None:
         super().__init__(f"counterexample of length {len(word)}")
         self.word = word
         self.trace = trace
+        self.felt = felt
 
 
 class Confined(Exception):
@@ -70,7 +74,8 @@ class Confined(Exception):
 class Walker:
     """The agent walking its hypothesis.
 
-    Since the landmark was last seen the agent took ``word`` and sensed ``trace``;
+    Since the landmark was last seen the agent took ``word``, sensed ``trace`` and felt
+    ``felt`` (the float feedback; zeros when the agent has none);
     ``beliefs[i]`` is the state it believed it was at after ``word[i]`` (-1: unknown), and
     ``belief`` is where it believes it is now (None: lost). ``stats`` counts steps per
     ``phase`` and events.
@@ -78,9 +83,16 @@ class Walker:
 
     def __init__(self, agent: AgentView) -> None:
         self.agent = agent
-        self.h = Hypothesis(agent.model, agent.actions, landmark=agent.model.current, rng=agent.rng)
+        self.h = Hypothesis(
+            agent.model,
+            agent.actions,
+            landmark=agent.model.current,
+            rng=agent.rng,
+            feels=agent.float_feedback,
+        )
         self.word: list[int] = []
         self.trace: list[bool] = []
+        self.felt: list[float] = []
         self.beliefs: list[int] = []
         self.belief: int | None = None
         self.phase = "search"
@@ -95,24 +107,30 @@ class Walker:
     def count(self, key: str, n: int = 1) -> None:
         self.stats[key] = self.stats.get(key, 0) + n
 
+    def feel(self) -> float:
+        """The float feedback felt now (0.0 when the agent has none)."""
+        return float(self.agent.memory.feedback[-1]) if self.h.feels else 0.0
+
     def move(self, action: int, *, check: bool = False) -> Generator[int, bool, bool]:
         """Take ``action``; follow the belief. With ``check``, a wrong prediction of a
         confirmed transition raises :class:`Refuted` (else the agent is just lost)."""
         sensation = yield action
         self.count(f"steps_{self.phase}")
         self.agent.enter(PHASES[self.phase])
+        feel = self.feel()
         self.word.append(action)
         self.trace.append(sensation)
+        self.felt.append(feel)
         h = self.h
         belief = self.belief
         if belief is not None:
             t = h.confirmed(belief, action)
-            if t >= 0 and h.labels[t] == sensation:
+            if t >= 0 and h.agrees(t, sensation, feel):
                 self.belief = t
             else:
                 self.belief = None
                 if t >= 0 and check:
-                    refuted = Refuted(tuple(self.word), tuple(self.trace))
+                    refuted = Refuted(tuple(self.word), tuple(self.trace), tuple(self.felt))
                     if sensation:
                         self.at_landmark()
                     raise refuted
@@ -124,11 +142,15 @@ class Walker:
 
     def at_landmark(self) -> None:
         """The sensation is true: the agent is at the landmark, whatever it believed."""
-        self.belief = self.h.landmark
+        h = self.h
+        self.belief = h.landmark
         self.last_seen = self.agent.step
         self.seen = True
+        if h.feels and np.isnan(h.feel[h.landmark]):
+            h.feel[h.landmark] = self.feel()
         self.word.clear()
         self.trace.clear()
+        self.felt.clear()
         self.beliefs.clear()
 
     def pick(self, among: list[int]) -> int:
@@ -169,7 +191,9 @@ class Walker:
         Undo the actions since the last known state (:meth:`retrace`), then take the states
         around it as candidates for where the agent is, most likely first, and follow the
         first one's path to the landmark; a candidate predicting a different sensation is
-        ruled out. When none is left, every state is a candidate again, after a random run.
+        ruled out. When none is left, every state is a candidate again, after a random run;
+        when every state was ruled out, the agent is where its hypothesis does not reach yet,
+        and it first wanders at random (climbs, with float feedback), twice as long each time.
         """
         h = self.h
         phase, self.phase = self.phase, "home"
@@ -179,13 +203,18 @@ class Walker:
             return
         climbing = self.agent.float_feedback
         sensation = self.trace[-1] if self.trace else True
-        ids = np.asarray([s for s in near if h.labels[s] == sensation], dtype=np.int64)
+        feel = self.feel()
+        ids = np.asarray([s for s in near if h.agrees(s, sensation, feel)], dtype=np.int64)
         widened = not len(ids)
         if widened:
-            ids = np.asarray(h.with_label(sensation), dtype=np.int64)
+            ids = np.asarray(h.matching(sensation, feel), dtype=np.int64)
+        failed = wander = 0
         while True:
             usable = np.flatnonzero(h.distance[ids] < FAR)
-            if len(usable) and self._run_left <= 0:
+            if wander > 0:  # every state of the hypothesis ruled out: outside it, wander
+                wander -= 1
+                action = self.random_action()
+            elif len(usable) and self._run_left <= 0:
                 action = h.actions[int(h.toward[ids[usable[0]]])]
             elif climbing:  # climb the feedback for a while, instead of a random run
                 if (yield from self.climb(LONGEST_RUN * len(h.actions))):
@@ -193,7 +222,7 @@ class Walker:
                     return
                 self._run_left = 0
                 widened = True
-                ids = np.asarray(h.with_label(False), dtype=np.int64)
+                ids = np.asarray(h.matching(False, self.feel()), dtype=np.int64)
                 continue
             else:
                 action = self.random_action()
@@ -202,23 +231,32 @@ class Walker:
                 self.phase = phase
                 return
             self.check_confined()
+            feel = self.feel()
             moved = h.next[ids, h.column[action]]
             keep = moved >= 0
-            keep[keep] = h.label[moved[keep]] == sensation
+            keep[keep] = h.agree(moved[keep], sensation, feel)
             ids = moved[keep]
             if not len(ids):
                 if widened and self._run_left <= 0:
                     self.random_action()  # start a run
                     self._run_left += 1
+                    if not climbing:
+                        # Each time every state is ruled out, wander twice as long before
+                        # following their paths again: the agent is in a part of the world
+                        # its hypothesis does not hold yet, where their paths do not lead home.
+                        wander = LONGEST_RUN << min(failed, 20)
+                        failed += 1
                 widened = True
-                ids = np.asarray(h.with_label(sensation), dtype=np.int64)
+                ids = np.asarray(h.matching(sensation, feel), dtype=np.int64)
 
     def check_confined(self) -> None:
         """After a step of a search for the landmark: raise :class:`Confined` when the search
         has lasted 16 times as long as the run before it, :data:`CONFINED_STEPS`, and a run of
-        :data:`LONGEST_RUN` steps per state and action of the hypothesis. A heuristic: from
-        sensations alone, a part of the world that never senses cannot be told from a search
-        that has not yet found the sensed pose."""
+        :data:`LONGEST_RUN` steps per state and action of the hypothesis, unless the confirmed
+        transitions show an action undoing each action (:meth:`Hypothesis.reversible`): where
+        every move can be undone no part of the world is a trap, and the search goes on. A
+        heuristic: from sensations alone, a part of the world that never senses cannot be told
+        from a search that has not yet found the sensed pose."""
         searched = self.agent.step - self.last_seen
         if searched < self._confinement or self.confined is not None or not self.seen:
             return
@@ -226,9 +264,9 @@ class Walker:
         bound = max(
             CONFINED_STEPS, 16 * self.last_seen, LONGEST_RUN * len(h.labels) * len(h.actions)
         )
-        if searched >= bound:
+        if searched >= bound and not h.reversible():
             raise Confined(self.last_seen)
-        self._confinement = bound
+        self._confinement = max(bound, searched + CONFINED_STEPS)
 
     def climb(self, steps: int | None = None) -> Generator[int, bool, bool]:
         """With float feedback: climb the closeness to the sensed pose until it is sensed (True)

@@ -38,7 +38,18 @@ class LearnerStrategy(StrategyBase):
     When every transition is confirmed the hypothesis is minimised (``merge``), the tests kept
     for each transition are replayed against it and the doubtful ones taken again; then
     :attr:`done` is set and the learner ends the run (``agent.stop``): the recording ends
-    there, with an event saying so. With ``stop=False`` it goes on instead, walking its model
+    there, with an event saying so.
+
+    With float feedback (``mode = "float"``, :attr:`AgentView.float_feedback
+    <rsstp_sim.strategies.AgentView.float_feedback>`) the learner climbs the closeness where it
+    would search blind, and takes what it feels as part of what it observes: two world states
+    felt differently are different poses, so a candidate felt otherwise is ruled out at once
+    (in identification, homing, counterexamples and verification), and a test ends where one
+    candidate is left that agreed for two steps (the agent is located there, no walk back to the
+    landmark). Its states are then poses; the minimisation at the end merges those the
+    sensation cannot tell apart, so the model is over the sensation and its truth unchanged.
+
+    With ``stop=False`` it goes on instead, walking its model
     at random, every prediction checked (a refutation resumes learning). ``model.current`` is
     where the agent believes it is.
 
