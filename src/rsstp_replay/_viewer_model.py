@@ -23,11 +23,13 @@ a row:
   (:func:`labelled_states`; the id is in the entity path, shown on hover, everywhere);
 - ``Arrows2D``: one arrow per transition to another state, from the state towards the
   target (stopping short of it), coloured by action (:data:`ACTION_COLORS`), several actions
-  to the same target side by side;
-- at ``world/model/state/{id}/loops``, ``Points2D``: one small marker per self-loop ``s -a->
-  s`` (a move the model says leaves the state: what a blocked move is), placed around the
-  state in the direction of its action's colour wheel slot, so they are told apart from
-  arrows; ``world/model/state/{id}/poses``, ``LineStrips2D``: the thin lines to its poses.
+  to the same target side by side; and one short stub arrow per self-loop ``s -a-> s`` (a
+  move the model says leaves the state: what a blocked move is), from the state in the
+  direction of its action's colour wheel slot (:data:`LOOP_LENGTH`);
+- ``LineStrips2D``, once with the state's first row: the thin lines to its poses.
+
+One entity path per state: the web viewer's work grows with the paths (a thousand states on
+three paths each took it most of a minute).
 
 The current state is ``world/model/current``: a ring at its place, with a row at each step at
 which it changes, labelled ``now: {id}`` through a static annotation context (a class id per
@@ -66,6 +68,7 @@ __all__ = [
     "CURRENT",
     "LABEL_ROOM",
     "LEGEND",
+    "LOOP_LENGTH",
     "MODEL",
     "POSE_LINES",
     "ROLE_COLORS",
@@ -362,7 +365,7 @@ def _log_state(
     *,
     labelled: bool,
 ) -> int:
-    """The rows of one state's entity (and its loops), a clear where it was deleted;
+    """The rows of one state's entity, a clear where it was deleted;
     ``place_table`` is every state id, sorted, and its place."""
     path = state_path(state)
     x, y = places.places[state]
@@ -373,9 +376,7 @@ def _log_state(
             [palette.STATE if role is None else ROLE_COLORS[role] for _, _, role in alive],
             np.uint8,
         )
-        arrows, loops = _drawn_transitions(
-            state, [outs for _, outs, _ in alive], places, place_table
-        )
+        arrows = _drawn_transitions(state, [outs for _, outs, _ in alive], places, place_table)
         index = [rr.TimeColumn(TIMELINE, sequence=times)]
         stream.send_columns(
             path,
@@ -391,20 +392,11 @@ def _log_state(
                 ).partition(arrows.counts),
             ],
         )
-        stream.send_columns(
-            f"{path}/loops",
-            indexes=index,
-            columns=rr.Points2D.columns(
-                positions=loops.origins,
-                colors=loops.colors,
-                radii=np.full(len(loops.origins), -2.5, np.float32),  # ui points
-            ).partition(loops.counts),
-        )
         poses = places.poses.get(state)
-        if poses is not None:
+        if poses is not None:  # in the state's entity too, once: a path less per state
             strips = np.stack([np.broadcast_to([x, y], poses.shape), poses], axis=1)
             stream.send_columns(
-                f"{path}/poses",
+                path,
                 indexes=[rr.TimeColumn(TIMELINE, sequence=times[:1])],
                 columns=rr.LineStrips2D.columns(
                     strips=strips,
@@ -421,8 +413,8 @@ def _log_state(
 
 @dataclass(frozen=True, slots=True)
 class _Drawn:
-    """Markers of a state's rows, flat: each one's origin (and vector, for arrows) and colour,
-    and how many belong to each row."""
+    """The arrows of a state's rows, flat: each one's origin, vector and colour, and how
+    many belong to each row."""
 
     origins: _Floats
     vectors: _Floats
@@ -430,15 +422,19 @@ class _Drawn:
     counts: npt.NDArray[np.int64]
 
 
+LOOP_LENGTH = 1.5
+"""A self-loop's stub arrow, in units of the drawing scale (a fortieth of the arm's reach)."""
+
+
 def _drawn_transitions(
     state: int,
     rows: list[tuple[tuple[int, int], ...]],
     places: StatePlaces,
     place_table: tuple[npt.NDArray[np.int64], _Floats],
-) -> tuple[_Drawn, _Drawn]:
-    """For each row's transitions out of ``state``: an arrow per transition to another state
-    (:func:`_arrow`), a marker per self-loop, placed around the state in the direction of
-    its action's slot on the colour wheel."""
+) -> _Drawn:
+    """For each row's transitions out of ``state``, in order: an arrow per transition to
+    another state (:func:`_arrows`), and per self-loop a short stub arrow from the state in
+    the direction of its action's slot on the colour wheel."""
     x, y = places.places[state]
     scale = places.scale
     per_row = np.fromiter(map(len, rows), np.int64, len(rows))
@@ -447,25 +443,20 @@ def _drawn_transitions(
     actions, targets = flat[:, 0], flat[:, 1]
     colors = np.array(ACTION_COLORS, np.uint8)[actions % len(ACTION_COLORS)]
     loop = targets == state
-    # Self-loops: a marker at the action's angle.
+    origins = np.tile([x, y], (len(flat), 1)).astype(np.float64)
+    vectors = np.zeros((len(flat), 2))
     angle = 2 * np.pi * (actions[loop] % len(ACTION_COLORS)) / len(ACTION_COLORS)
-    loop_at = np.stack([x + scale * np.cos(angle), y + scale * np.sin(angle)], axis=1)
-    loops = _Drawn(
-        loop_at,
-        np.zeros_like(loop_at),
-        colors[loop],
-        np.bincount(row_of[loop], minlength=len(rows)),
-    )
-    # Arrows: each row's k-th arrow in slot k of that row's arrows.
+    vectors[loop] = LOOP_LENGTH * scale * np.stack([np.cos(angle), np.sin(angle)], axis=1)
+    # Arrows: each row's k-th arrow to another state in slot k of that row's arrows.
     ids, xy = place_table
     arrow_rows = row_of[~loop]
     counts = np.bincount(arrow_rows, minlength=len(rows))
     firsts = np.cumsum(counts) - counts
     slot = np.arange(len(arrow_rows)) - firsts[arrow_rows]
-    origins, vectors = _arrows(
+    origins[~loop], vectors[~loop] = _arrows(
         (x, y), xy[np.searchsorted(ids, targets[~loop])], slot, counts[arrow_rows], scale
     )
-    return _Drawn(origins, vectors, colors[~loop], counts), loops
+    return _Drawn(origins, vectors, colors, per_row)
 
 
 def _arrows(

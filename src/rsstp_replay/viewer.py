@@ -89,8 +89,6 @@ ENTITY_PATHS: tuple[str, ...] = (
     world_part.SENSOR,
     world_part.BLOCKED,
     model_part.STATES + "/{id}",
-    model_part.STATES + "/{id}/loops",
-    model_part.STATES + "/{id}/poses",
     model_part.CURRENT,
     model_part.LEGEND,
     plots_part.SENSATION,

@@ -19,7 +19,13 @@ from fakes import RandomRefiner
 from rerun.chunk import Chunk, RrdReader
 
 from rsstp_replay import _viewer_layout, viewer
-from rsstp_replay._viewer_model import ACTION_COLORS, LABEL_ROOM, POSE_LINES, state_places
+from rsstp_replay._viewer_model import (
+    ACTION_COLORS,
+    LABEL_ROOM,
+    LOOP_LENGTH,
+    POSE_LINES,
+    state_places,
+)
 from rsstp_replay.audits.consistency import audit_consistency, audit_consistency_by_version
 from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.truth import audit_truth
@@ -124,8 +130,6 @@ def test_entity_paths_and_rows_match_the_recording(reference: tuple[Recording, R
         "world/blocked",
         "world/model/current",
         "world/model/state/0",
-        "world/model/state/0/loops",
-        "world/model/state/0/poses",
         "plots/agent/sensation",
         "plots/agent/feedback",
         "plots/distance",
@@ -416,32 +420,40 @@ def test_a_state_has_a_row_where_it_changed_and_a_clear_where_it_went(
         assert rrd.cleared_at(path) == expected_clears[state], state
 
 
-def test_arrows_are_coloured_by_action_and_self_loops_are_markers(
+def test_arrows_are_coloured_by_action_and_self_loops_are_stubs(
     refined: tuple[Recording, Rrd],
 ) -> None:
+    """Each state's one entity: an arrow per transition, in the model's order, coloured by
+    action; one to another state points towards it, a self-loop is a stub of LOOP_LENGTH
+    drawing scales from the state in its action's direction on the colour wheel."""
     recording, rrd = refined
     final = recording.model_versions()[-1]
     step = recording.n_steps
-    places = state_places(
-        recording.steps(), recording.model_versions(), n_joints=3, reach=6.0
-    ).places
+    placed = state_places(recording.steps(), recording.model_versions(), n_joints=3, reach=6.0)
+    places, scale = placed.places, placed.scale
+    loops_seen = 0
     for state, outs in _outs(final).items():
         path = f"world/model/state/{state}"
-        arrows = [(a, t) for a, t in outs if t != state]
-        loops = [a for a, t in outs if t == state]
         colors = rrd.at(path, "Arrows2D:colors", step, default=[])
-        assert len(colors) == len(arrows)
-        for (a, t), color, vector in zip(
-            arrows, colors, rrd.at(path, "Arrows2D:vectors", step, default=[]), strict=True
-        ):
+        vectors = rrd.at(path, "Arrows2D:vectors", step, default=[])
+        origins = rrd.at(path, "Arrows2D:origins", step, default=[])
+        assert len(colors) == len(vectors) == len(origins) == len(outs)
+        for (a, t), color, vector, origin in zip(outs, colors, vectors, origins, strict=True):
             assert _rgb(color) == ACTION_COLORS[a % len(ACTION_COLORS)]
+            if t == state:
+                angle = 2 * np.pi * (a % len(ACTION_COLORS)) / len(ACTION_COLORS)
+                np.testing.assert_allclose(origin, places[state], atol=1e-5)
+                np.testing.assert_allclose(
+                    vector, LOOP_LENGTH * scale * np.array([np.cos(angle), np.sin(angle)]),
+                    atol=1e-5,
+                )  # fmt: skip
+                loops_seen += 1
+                continue
             towards = np.subtract(places[t], places[state])
             if np.hypot(*towards) > 0:  # points from the state towards its target
                 assert np.dot(vector, towards) > 0
-        loop_colors = rrd.at(f"{path}/loops", "Points2D:colors", step, default=[])
-        assert sorted(_rgb(c) for c in loop_colors) == sorted(
-            ACTION_COLORS[a % len(ACTION_COLORS)] for a in loops
-        )
+    assert loops_seen > 0
+    assert not any(path.endswith("/loops") for path in rrd.temporal)
 
 
 def _rgb(packed: int) -> tuple[int, int, int]:
@@ -471,7 +483,7 @@ def test_an_aliased_state_has_lines_to_its_poses(reference: tuple[Recording, Rrd
     the tips of the most visited of them."""
     recording, rrd = reference
     table = recording.steps()
-    (_, strips), *_ = rrd.column("world/model/state/0/poses", "LineStrips2D:strips")
+    (_, strips), *_ = rrd.column("world/model/state/0", "LineStrips2D:strips")
     assert len(strips) == POSE_LINES
     tips = {(round(x, 4), round(y, 4)) for x, y in table[["joint3_x", "joint3_y"]].to_numpy()}
     place = np.array(strips[0][0])
