@@ -461,7 +461,7 @@ def _log(
     )
 
 
-OVERVIEW_MAX_STEPS = 250_000
+OVERVIEW_MAX_STEPS = 100_000
 """Over this many steps shown, the arm, its blocked marker and the current state are an
 overview: shown every k-th step (and at the last), k the least that keeps them within this
 many rows, and the obstacle sensor is left out (the distances stay as plots); a
