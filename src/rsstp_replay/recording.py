@@ -20,7 +20,7 @@ import gc
 import operator
 import os
 import warnings
-from collections.abc import Callable, Generator, Iterator
+from collections.abc import Generator, Iterator
 from contextlib import closing, contextmanager
 from functools import partial
 from pathlib import Path
@@ -325,12 +325,7 @@ class Recording:
                 decode = partial(self._file.decode_one, topic, part, log_time, ref)
                 found.append(chain.head(head, part.tobytes(), decode))
         chain.finish()
-        expected = self.topic_counts.get(topic, 0)
-        if len(found) != expected:
-            raise CorruptRecording(
-                f"{self.path}: expected {expected} {topic} messages (the summary's count), "
-                f"found {len(found)}"
-            )
+        self._counted(topic, len(found))
         return tuple(found)
 
     def _timed(self, topic: str, record: _Stepped, log_time: int, ref: ChunkRef) -> _Stepped:
@@ -398,22 +393,24 @@ class Recording:
         self._check_open()
         return self._file.chunks(topic, step=step)
 
-    def _records(self, topic: str, keep: Callable[[Any], Any] | None = None) -> list[Any]:
-        """Every message of ``topic`` as its record (passed through ``keep`` as soon as it is
-        decoded), checked against its log time."""
+    def _records(self, topic: str) -> list[Any]:
+        """Every message of ``topic`` as its record, checked against its log time."""
         found: list[Any] = []
         for ref, _, parts, times in self._chunks(topic):
             records = self._file.decode_many(topic, parts, times, ref)
             for record, log_time in zip(records, times.tolist(), strict=True):
-                self._timed(topic, record, log_time, ref)
-                found.append(record if keep is None else keep(record))
+                found.append(self._timed(topic, record, log_time, ref))
+        self._counted(topic, len(found))
+        return found
+
+    def _counted(self, topic: str, found: int) -> None:
+        """``found`` messages of ``topic`` must be the summary's count."""
         expected = self.topic_counts.get(topic, 0)
-        if len(found) != expected:
+        if found != expected:
             raise CorruptRecording(
                 f"{self.path}: expected {expected} {topic} messages (the summary's count), "
-                f"found {len(found)}"
+                f"found {found}"
             )
-        return found
 
     def _decode_steps(
         self,

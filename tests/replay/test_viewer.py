@@ -728,7 +728,8 @@ def test_entity_paths_are_documented() -> None:
 
 @pytest.fixture(scope="module")
 def learner(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Recording, Rrd]]:
-    """The learner's reference recording (12,000 steps, learned at step 8,599), viewed."""
+    """The learner's reference recording (it stops at step 8,497, equivalent from 8,315),
+    viewed."""
     out = tmp_path_factory.mktemp("viewer") / "learner.rrd"
     with open_recording(LEARNER) as recording:
         view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
