@@ -16,6 +16,7 @@ from rsstp_sim.errors import StrategyError
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 from rsstp_sim.strategies import AgentView
+from rsstp_sim.strategies._learner_hypothesis import Hypothesis
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
@@ -361,6 +362,73 @@ def test_the_way_to_the_landmark_is_kept_up_to_date() -> None:
             assert int(h.toward[s]) == (nearer[0] if nearer else -1)
         checked += 1
     assert learner.done and checked >= 50
+
+
+def _separating_word_pair_by_pair(
+    successors: list[list[int]], labels: list[bool], actions: list[int], a: int, b: int
+) -> list[int] | None:
+    """The first shortest word found breadth first over ordered pairs, one pair at a time."""
+    if labels[a] != labels[b]:
+        return []
+    parent: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}
+    seen = {(a, b)}
+    queue = [(a, b)]
+    for pair in queue:
+        for k, action in enumerate(actions):
+            s, t = successors[pair[0]][k], successors[pair[1]][k]
+            if s < 0 or t < 0 or (s, t) in seen:
+                continue
+            parent[(s, t)] = (pair, action)
+            if labels[s] != labels[t]:
+                word, back = [action], pair
+                while back != (a, b):
+                    back, previous = parent[back]
+                    word.append(previous)
+                return word[::-1]
+            seen.add((s, t))
+            queue.append((s, t))
+    return None
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.integers(2, 12).flatmap(
+        lambda n: st.tuples(
+            st.lists(
+                st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
+            ),
+            st.lists(st.booleans(), min_size=n, max_size=n),
+            st.integers(0, n - 1),
+            st.integers(0, n - 1),
+            st.sets(st.integers(0, n - 1), max_size=n // 3),
+        )
+    )
+)
+def test_the_separating_word_is_the_first_shortest_one(
+    case: tuple[list[list[int]], list[bool], int, int, set[int]],
+) -> None:
+    # The learner tells two candidates apart by a shortest word over confirmed transitions
+    # (-1: not confirmed); the word it picks among the shortest is the one a pair-by-pair
+    # breadth-first search finds, and dead states (merged away) take no part.
+    successors, labels, a, b, dead = case
+    dead -= {a, b}
+    successors = [[-1 if t in dead else t for t in row] for row in successors]
+    actions = [7, 3, 5]
+    h = Hypothesis(TransitionSystem.universal(tuple(actions)), tuple(actions), landmark=0)
+    n = len(labels)
+    h._grow(n)
+    h.next[:n] = successors
+    h.label[:n] = labels
+    h.alive[:n] = [s not in dead for s in range(n)]
+    expected = _separating_word_pair_by_pair(successors, labels, actions, a, b)
+    assert h.separating_word(a, b) == expected
+    if expected:
+        ends = []
+        for start in (a, b):
+            for action in expected:
+                start = successors[start][actions.index(action)]
+            ends.append(labels[start])
+        assert ends[0] != ends[1]
 
 
 def test_notes_are_few() -> None:

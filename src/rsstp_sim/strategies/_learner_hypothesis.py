@@ -357,30 +357,54 @@ class Hypothesis:
         return seen
 
     def separating_word(self, a: int, b: int) -> list[int] | None:
-        """A shortest confirmed word after which ``a`` and ``b`` predict different sensations."""
+        """A shortest confirmed word after which ``a`` and ``b`` predict different sensations.
+
+        Breadth first over pairs of states, one numpy pass per level: a pair is kept unordered
+        (the same words tell ``(s, t)`` and ``(t, s)`` apart) and dropped once its two states
+        meet (no word tells a state from itself). Of the shortest words, the one found first
+        by the pairs in the order they were reached and the actions in their order, as a
+        pair-by-pair search would find it. None: nothing confirmed tells them apart.
+        """
         if self.label[a] != self.label[b]:
             return []
-        parent: dict[tuple[int, int], tuple[tuple[int, int], int]] = {}
-        start = (a, b)
-        seen = {start}
-        queue = deque([start])
-        while queue:
-            pair = queue.popleft()
-            row_a, row_b = self.next[pair[0]], self.next[pair[1]]
-            for k, action in enumerate(self.actions):
-                s, t = int(row_a[k]), int(row_b[k])
-                if s < 0 or t < 0 or (s, t) in seen:
-                    continue
-                parent[(s, t)] = (pair, action)
-                if self.label[s] != self.label[t]:
-                    word = [action]
-                    back = pair
-                    while back != start:
-                        back, previous = parent[back]
-                        word.append(previous)
-                    return word[::-1]
-                seen.add((s, t))
-                queue.append((s, t))
+        if a == b:
+            return None
+        alive = np.flatnonzero(self.alive)
+        m = len(alive)
+        index = np.full(len(self.label) + 1, -1, dtype=np.int64)  # (index[-1]: unconfirmed)
+        index[alive] = np.arange(m)
+        following = index[self.next[alive]]  # the compact successors, -1: unconfirmed
+        label = self.label[alive]
+        first, second = int(index[a]), int(index[b])
+        seen = np.zeros(m * m, dtype=bool)
+        seen[min(first, second) * m + max(first, second)] = True
+        low = np.asarray([first], dtype=np.int64)
+        high = np.asarray([second], dtype=np.int64)
+        levels: list[tuple[IntArray, IntArray]] = []  # per level: each pair's parent, action
+        width = len(self.actions)
+        while len(low):
+            s, t = following[low], following[high]  # (pairs, actions), pair by pair
+            known = (s >= 0) & (t >= 0) & (s != t)
+            apart = known & (label[np.maximum(s, 0)] != label[np.maximum(t, 0)])
+            if apart.any():
+                at = int(np.flatnonzero(apart.ravel())[0])
+                word = [self.actions[at % width]]
+                parent = at // width
+                for parents, actions in reversed(levels):
+                    word.append(self.actions[int(actions[parent])])
+                    parent = int(parents[parent])
+                return word[::-1]
+            found = np.flatnonzero(known.ravel())
+            s, t = s.ravel()[found], t.ravel()[found]
+            codes = np.minimum(s, t) * m + np.maximum(s, t)
+            codes, firsts = np.unique(codes, return_index=True)
+            fresh = ~seen[codes]
+            codes, firsts = codes[fresh], firsts[fresh]
+            seen[codes] = True
+            firsts.sort()  # the order in which the level reached them
+            reached = found[firsts]
+            levels.append((reached // width, reached % width))
+            low, high = np.minimum(s, t)[firsts], np.maximum(s, t)[firsts]
         return None
 
     # ----------------------------------------------------------------- changes
