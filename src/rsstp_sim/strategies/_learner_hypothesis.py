@@ -98,6 +98,13 @@ class Hypothesis:
         """Changes whenever the model does."""
         return self.model.version
 
+    @property
+    def edits(self) -> int:
+        """Changes whenever the confirmed successors, the states or their labels and feels do
+        (confirming a successor already confirmed is no change): what is worked out from
+        them alone holds while it stays the same."""
+        return self._edits
+
     def states(self) -> list[int]:
         return [int(s) for s in np.flatnonzero(self.alive)]
 
@@ -373,7 +380,7 @@ class Hypothesis:
         m = len(alive)
         index = np.full(len(self.label) + 1, -1, dtype=np.int64)  # (index[-1]: unconfirmed)
         index[alive] = np.arange(m)
-        following = index[self.next[alive]]  # the compact successors, -1: unconfirmed
+        following = index[self.next[alive]].astype(np.int32)  # compact; -1: unconfirmed
         label = self.label[alive]
         first, second = int(index[a]), int(index[b])
         seen = np.zeros(m * m, dtype=bool)
@@ -396,15 +403,15 @@ class Hypothesis:
                 return word[::-1]
             found = np.flatnonzero(known.ravel())
             s, t = s.ravel()[found], t.ravel()[found]
-            codes = np.minimum(s, t) * m + np.maximum(s, t)
-            codes, firsts = np.unique(codes, return_index=True)
-            fresh = ~seen[codes]
-            codes, firsts = codes[fresh], firsts[fresh]
+            low, high = np.minimum(s, t), np.maximum(s, t)
+            codes = low.astype(np.int64) * m + high
+            fresh = np.flatnonzero(~seen[codes])
+            codes, firsts = np.unique(codes[fresh], return_index=True)
             seen[codes] = True
-            firsts.sort()  # the order in which the level reached them
+            firsts = fresh[np.sort(firsts)]  # in the order in which the level reached them
             reached = found[firsts]
             levels.append((reached // width, reached % width))
-            low, high = np.minimum(s, t)[firsts], np.maximum(s, t)[firsts]
+            low, high = low[firsts], high[firsts]
         return None
 
     # ----------------------------------------------------------------- changes
@@ -416,9 +423,10 @@ class Hypothesis:
 
     def confirm(self, s: int, action: int, t: int) -> None:
         """Make ``s -action-> t`` the confirmed successor (replacing the model's conjecture)."""
-        self._edits += 1
         k = self.column[action]
         before = int(self.next[s, k])
+        if before != t:
+            self._edits += 1
         if before < 0:
             self.unconfirmed -= 1
         self.next[s, k] = t
@@ -433,9 +441,9 @@ class Hypothesis:
 
     def unconfirm(self, s: int, action: int) -> None:
         """Withdraw a confirmed successor; the model keeps it as a conjecture."""
-        self._edits += 1
         k = self.column[action]
         if self.next[s, k] >= 0:
+            self._edits += 1
             self.unconfirmed += 1
             self.next[s, k] = -1
             self._changed()

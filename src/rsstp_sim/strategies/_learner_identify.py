@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from rsstp_sim.strategies._base import AgentView
-from rsstp_sim.strategies._learner_hypothesis import FAR
+from rsstp_sim.strategies._learner_hypothesis import FAR, BoolArray
 from rsstp_sim.strategies._learner_walk import Plan, Walker
 
 __all__ = ["Deferral", "Identifier", "Trace"]
@@ -54,6 +54,8 @@ class Identifier(Walker):
         self.made_by: dict[int, int] = {}
         self.traces: dict[tuple[int, int], list[Trace]] = {}
         self.deferred: dict[tuple[int, int], Deferral] = {}
+        self._singles = np.zeros((0, len(self.h.actions)), dtype=np.int8)
+        self._singles_edits = -1
 
     def confirm(self, q: int, a: int, t: int) -> None:
         self.deferred.pop((q, a), None)
@@ -293,6 +295,40 @@ class Identifier(Walker):
         if self.h.feels:
             felt = (feel, *(float(v) for v in memory.feedback[start + 1 :].tolist()))
         self.traces.setdefault((q, a), []).append((actions, (label, *sensations), felt))
+        self._retest(q, a)
+
+    def drop_traces(self, q: int, a: int) -> list[Trace]:
+        """Forget the tests made from ``q -a->``; those there were."""
+        self._retest(q, a)
+        return self.traces.pop((q, a), [])
+
+    def _retest(self, q: int, a: int) -> None:
+        if q < len(self._singles):
+            self._singles[q, self.h.column[a]] = -1
+
+    def singled_out(self, wanted: BoolArray) -> BoolArray:
+        """For the (state, action column) pairs ``wanted`` (rows: state ids): whether the tests
+        kept for the pair, replayed from every state of the hypothesis, leave its confirmed
+        successor alone. (False elsewhere.)
+
+        Each pair is replayed once while the hypothesis's confirmed successors (its
+        :attr:`~Hypothesis.edits`) and the pair's tests stay as they are."""
+        h = self.h
+        n = len(wanted)
+        if self._singles_edits != h.edits or len(self._singles) < n:
+            self._singles = np.full((n, len(h.actions)), -1, dtype=np.int8)
+            self._singles_edits = h.edits
+        singles = self._singles[:n]
+        rows, columns = np.nonzero(wanted & (singles < 0))
+        for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
+            a = h.actions[k]
+            agreeing: set[int] | None = None
+            for word, outputs, felt in self.traces.get((s, a), ()):
+                found = set(h.consistent(word, outputs, (s, a), felt))
+                agreeing = found if agreeing is None else agreeing & found
+            singles[s, k] = agreeing == {int(h.next[s, k])}
+        single: BoolArray = wanted & (singles == 1)
+        return single
 
     def return_to(
         self, q: int, a: int, route: tuple[int, ...] | None

@@ -30,8 +30,11 @@ class Learning(Identifier):
         self.found = False
         self.first_landmark = 0
         self.done = False
-        self._checked: set[tuple[int, int]] = set()
+        self._checked = np.zeros((0, len(self.h.actions)), dtype=bool)
         self._checked_version = -1
+        self._settled = -1
+        """The hypothesis's :attr:`~Hypothesis.edits` when it was last found complete, with
+        every state reachable and none to merge."""
 
     def plan(self) -> Plan:
         agent = self.agent
@@ -89,25 +92,27 @@ class Learning(Identifier):
             self.count("forced")
             self.new(q, a, deferral.label, deferral.access, here=False, feel=deferral.feel)
             return
-        reachable = h.reachable()
-        garbage = [s for s in h.states() if s not in reachable]
-        if garbage:
-            for s in garbage:
-                h.discard(s)
-                self.forget(s, None)
-            self.count("discarded", len(garbage))
-            return
-        if not h.is_complete():  # pragma: no cover - every unconfirmed pair is a goal
-            raise AssertionError("incomplete hypothesis with nothing to explore")
-        merges = h.minimise()
-        if merges:
-            for keep, gone in merges:
-                self.forget(gone, keep)
-            self.count("merges", len(merges))
-            self.agent.note(f"minimised: {len(merges)} merges, {len(h.labels)} states")
-            if self.belief not in h.labels:
-                self.belief = None
-            return
+        if self._settled != h.edits:  # (a verification that changed nothing leaves it so)
+            reachable = h.reachable()
+            garbage = [s for s in h.states() if s not in reachable]
+            if garbage:
+                for s in garbage:
+                    h.discard(s)
+                    self.forget(s, None)
+                self.count("discarded", len(garbage))
+                return
+            if not h.is_complete():  # pragma: no cover - every unconfirmed pair is a goal
+                raise AssertionError("incomplete hypothesis with nothing to explore")
+            merges = h.minimise()
+            if merges:
+                for keep, gone in merges:
+                    self.forget(gone, keep)
+                self.count("merges", len(merges))
+                self.agent.note(f"minimised: {len(merges)} merges, {len(h.labels)} states")
+                if self.belief not in h.labels:
+                    self.belief = None
+                return
+            self._settled = h.edits
         suspect = self.suspect()
         if suspect is not None:
             yield from self.reverify(*suspect)
@@ -216,10 +221,10 @@ class Learning(Identifier):
         """State ``gone`` merged into ``keep`` (or discarded): move or drop what names it."""
         self.made_by.pop(gone, None)
         for a in self.h.actions:
-            traces = self.traces.pop((gone, a), None)
-            if traces and keep is not None:
+            traces = self.drop_traces(gone, a)
+            if traces and keep is not None:  # (the merge changed the edits: all are replayed)
                 self.traces.setdefault((keep, a), []).extend(traces)
-        self._checked.clear()
+        self._checked[:] = False
 
     # ------------------------------------------------------------- verification
 
@@ -228,33 +233,29 @@ class Learning(Identifier):
 
         Checked without moving: each test kept for ``q -a->`` is replayed from every state of
         the complete hypothesis; the transition is verified when its target is the only state
-        agreeing with all of them. A transition to the landmark needs no test.
+        agreeing with all of them (:meth:`~Identifier.singled_out`). A transition to the
+        landmark needs no test. A verified transition, or one taken again, stays checked
+        while the model stays as it is.
         """
         h = self.h
         assert self.belief is not None
+        n = len(h.label)
         if self._checked_version != h.version:
-            self._checked.clear()
+            self._checked[:] = False
             self._checked_version = h.version
-        doubtful: dict[int, list[int]] = {}
-        for s in h.states():
-            for k, a in enumerate(h.actions):
-                t = int(h.next[s, k])
-                if t == h.landmark or (s, a) in self._checked:
-                    continue
-                agreeing: set[int] | None = None
-                for word, outputs, felt in self.traces.get((s, a), ()):
-                    found = set(h.consistent(word, outputs, (s, a), felt))
-                    agreeing = found if agreeing is None else agreeing & found
-                if agreeing != {t}:
-                    doubtful.setdefault(s, []).append(a)
-                else:  # (verified while the model stays as it is)
-                    self._checked.add((s, a))
-        if not doubtful:
+        checked = self._checked_for(n)
+        todo = h.alive[:n, None] & (h.next[:n] != h.landmark) & ~checked
+        singled_out = self.singled_out(todo)
+        checked |= todo & singled_out
+        doubtful = todo & ~singled_out
+        states = np.flatnonzero(doubtful.any(axis=1))
+        if not len(states):
             return None
-        nearest = h.nearest(self.belief, set(doubtful))
+        nearest = h.nearest(self.belief, set(states.tolist()))
         if nearest is None:
             return None
-        return nearest[1], doubtful[nearest[1]][0]
+        s = nearest[1]
+        return s, h.actions[int(np.flatnonzero(doubtful[s])[0])]
 
     def reverify(self, q: int, a: int) -> Plan:
         """Take ``q -a->`` again and identify where it leads with the complete hypothesis."""
@@ -265,7 +266,7 @@ class Learning(Identifier):
         before = h.confirmed(q, a)
         sensation = yield from self.move(a)
         self.belief = None
-        self.traces.pop((q, a), None)
+        self.drop_traces(q, a)
         if sensation:
             self.confirm(q, a, h.landmark)
         else:
@@ -273,8 +274,16 @@ class Learning(Identifier):
         if h.confirmed(q, a) != before:
             self.count("corrected")
             self.agent.note(f"verification: state {q} by action {a} leads elsewhere")
-        self._checked.add((q, a))
+        self._checked_for(len(h.label))[q, h.column[a]] = True
         self._checked_version = h.version
+
+    def _checked_for(self, n: int) -> NDArray[np.bool_]:
+        """The checked transitions of states ``0 .. n-1``, by action column."""
+        if len(self._checked) < n:
+            grown = np.zeros((n, len(self.h.actions)), dtype=bool)
+            grown[: len(self._checked)] = self._checked
+            self._checked = grown
+        return self._checked[:n]
 
     # ---------------------------------------------------------- counterexamples
 
@@ -330,7 +339,7 @@ class Learning(Identifier):
             f"does not lead to state {wrong}"
         )
         h.unconfirm(q, a)
-        self.traces.pop((q, a), None)
+        self.drop_traces(q, a)
         access = h.access[q] + (a,)
         self.phase = "test"
         yield from self.identify(
