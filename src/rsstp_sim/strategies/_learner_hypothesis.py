@@ -89,6 +89,8 @@ class Hypothesis:
         self._distance: IntArray | None = None
         self._toward: IntArray | None = None
         self._edits = 0
+        self._rows_cache: list[list[int]] = []
+        self._rows_edits = -1
         self._inverse: tuple[int, dict[int, int]] = (-1, {})
 
     # ----------------------------------------------------------------- queries
@@ -285,27 +287,33 @@ class Hypothesis:
         return self._search(source, flags.__getitem__)
 
     def _search(self, source: int, is_goal: Callable[[int], bool]) -> tuple[list[int], int] | None:
-        parent: dict[int, tuple[int, int]] = {}
-        seen = {source}
-        queue = deque([source])
-        columns, actions = self._columns, self._ordered
-        while queue:
-            s = queue.popleft()
+        """Breadth first over the confirmed transitions, the actions in the run's order: the
+        word to the first state reached that ``is_goal``, and that state."""
+        parent: dict[int, tuple[int, int] | None] = {source: None}
+        queue = [source]
+        rows, actions = self._rows(), self._ordered
+        for s in queue:  # (the queue grows as it is read)
             if is_goal(s):
                 word: list[int] = []
-                t = s
-                while t != source:
-                    t, action = parent[t]
-                    word.append(action)
+                step = parent[s]
+                while step is not None:
+                    word.append(step[1])
+                    step = parent[step[0]]
                 word.reverse()
                 return word, s
-            row = self.next[s, columns].tolist()
-            for action, t in zip(actions, row, strict=True):
-                if t >= 0 and t not in seen:
-                    seen.add(t)
+            for action, t in zip(actions, rows[s], strict=True):
+                if t >= 0 and t not in parent:
                     parent[t] = (s, action)
                     queue.append(t)
         return None
+
+    def _rows(self) -> list[list[int]]:
+        """The confirmed successors as lists, the actions in the run's order (-1: none): kept
+        while :attr:`edits` stays the same, for searches that visit one state at a time."""
+        if self._rows_edits != self._edits:
+            self._rows_cache = self.next[:, self._columns].tolist()
+            self._rows_edits = self._edits
+        return self._rows_cache
 
     def around(self, source: int, radius: int) -> set[int]:
         """The states within ``radius`` confirmed transitions of ``source``, either way."""
