@@ -35,6 +35,13 @@ seed 0 unless ``--no-aalpy`` (a world of the curve is handed to it as a scenario
 learner's own, warm (the truth is computed first). Targets: every run equivalent within
 4 N^2; the float twin of the 1,200-class world in at most half the boolean's steps.
 
+``--record WORLD``: the user's path on a world of the curve (``--record two-links-10``, with
+``--float`` its twin, ``--seed``): its scenario file written, then ``rsstp-sim record`` with
+the learner and a budget of 4 N^2 steps, and ``rsstp-replay audit --truth`` of the recording,
+each cold in a fresh process: wall and CPU seconds, peak memory, the recording's size, where
+the run stopped and the audit's verdict. Target: the record of the 1,200-class world at most 2
+minutes.
+
 ``--spread K``: the learner alone on each scenario with seeds ``0 .. K-1``, the steps to learn
 (least, median, most, and as multiples of N^2) and how many runs ended equivalent: the seed
 reaches every choice the learner makes among equals, so the runs differ.
@@ -46,6 +53,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import random
 import subprocess
 import sys
@@ -427,6 +435,61 @@ def curve(max_n: int, seeds: int, aalpy: bool, seconds: float, memory_gib: float
     return good
 
 
+def record(name: str, seed: int, *, float_mode: bool) -> bool:
+    """``rsstp-sim record`` then ``rsstp-replay audit --truth`` of a world of the curve, cold;
+    prints one line each, returns whether the recording's final model is the truth's."""
+    from _cold import measure_cpu
+
+    makers = dict(CURVE)
+    if name not in makers:
+        sys.exit(f"--record: expected one of {', '.join(makers)}, got {name!r}")
+    scenario = makers[name]()
+    if float_mode:
+        scenario = _twin(scenario)
+    n = compute_truth(scenario).n_classes
+    sim, replay = (
+        str(Path(sys.executable).parent / command) for command in ("rsstp-sim", "rsstp-replay")
+    )
+    with tempfile.TemporaryDirectory() as folder:
+        toml = Path(folder) / f"{scenario.name}.toml"
+        toml.write_text(scenario.source, encoding="utf-8")
+        mcap = str(Path(folder) / f"{scenario.name}.mcap")
+        budget = str(4 * n * n)
+        commands = {
+            "record": [
+                sim,
+                "record",
+                str(toml),
+                "--strategy",
+                "learner",
+                "--steps",
+                budget,
+                "--seed",
+                str(seed),
+                "--quiet",
+                "-o",
+                mcap,
+            ],
+            "audit --truth": [replay, "audit", mcap, "--truth", "--json", "--quiet"],
+        }
+        print(
+            f"{scenario.name} ({'float' if float_mode else 'boolean'}), N = {n:,}, seed {seed}, "
+            f"load average {os.getloadavg()[0]:.1f}"
+        )
+        for what, command in commands.items():
+            wall, cpu, peak = measure_cpu(command)
+            print(f"  {what:14s} {wall:7.1f} s wall {cpu:7.1f} s CPU {peak:5.2f} GiB", flush=True)
+        size = Path(mcap).stat().st_size
+        done = subprocess.run(
+            commands["audit --truth"], capture_output=True, text=True, check=False
+        )
+    audit = json.loads(done.stdout)
+    stopped = audit["summary"]["stopped"]
+    stop = "its budget spent" if stopped is None else f"stopped at step {stopped['step']:,}"
+    print(f"  {size / 1e6:.0f} MB; {stop}; {audit['verdict']['text']}")
+    return bool(audit["truth"]["final_equivalent"])
+
+
 def _hw_on(
     name: str, scenario: Scenario, seconds: float, seed: int, memory_gib: float
 ) -> dict[str, Any]:
@@ -478,12 +541,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--curve", action="store_true", help="steps / N^2 against N")
     parser.add_argument("--max-n", type=int, default=10_000, help="--curve: the largest N")
     parser.add_argument("--seeds", type=int, default=1, help="--curve: seeds 0 .. K-1")
+    parser.add_argument("--record", metavar="WORLD", help="record and audit a world of the curve")
+    parser.add_argument("--float", action="store_true", help="--record: the float twin")
     parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
     parser.add_argument("scenarios", nargs="*", default=list(SCENARIOS))
     args = parser.parse_args(argv)
     if args.hw_child:
         _hw_child(args.hw_child, args.aalpy_seconds, args.seed, args.aalpy_memory_gib)
         return 0
+    if args.record:
+        return 0 if record(args.record, args.seed, float_mode=args.float) else 1
     if args.curve:
         ok = curve(
             args.max_n,
