@@ -1,11 +1,12 @@
 """Step messages into columns: many messages per decoder call, numpy arrays preallocated.
 
-The messages of one chunk are joined into one JSON array and decoded by msgspec into typed
-structs (``gc=False``: no garbage-collector tracking for millions of small objects); their
-fields are then copied column by column into numpy arrays sized for the whole recording, and
-the structs are dropped before the next chunk. The structs check types and ranges while
-decoding (integers stay integers, angles in ``0..359``, feedback in ``[0, 1]``); shapes and
-the rules between fields are checked on the columns.
+The messages of one chunk are joined into one JSON array (one copy of their bytes) and
+decoded by msgspec into typed structs (``gc=False``: no garbage-collector tracking for
+millions of small objects); their fields are then copied column by column into numpy arrays
+sized for the whole recording, and the structs are dropped before the next chunk. The
+structs check types and ranges while decoding (integers stay integers, angles in
+``0..359``, feedback in ``[0, 1]``); shapes and the rules between fields are checked on the
+columns.
 
 The joint positions and obstacle distances of a step are a function of its angles and the
 scenario (what the recorder computed them with, :mod:`rsstp_sim.geometry`). Parsing their
@@ -28,6 +29,7 @@ import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_replay.errors import BadStep, ReplayError
 from rsstp_sim.geometry import ArmGeometry, joint_positions, obstacle_distances
+from rsstp_sim.recording.records import json_array
 
 __all__ = [
     "BLOCKED_COLUMNS",
@@ -190,7 +192,7 @@ class StepColumns:
             return
         batch, one = _DECODERS[self.truth]
         try:
-            rows: list[Any] = batch.decode(b"[" + b",".join(parts) + b"]")
+            rows: list[Any] = batch.decode(json_array(parts))
         except (msgspec.DecodeError, RecursionError):
             rows = []
         if len(rows) != len(parts):  # find the culprit, one message at a time

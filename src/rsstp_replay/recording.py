@@ -48,7 +48,7 @@ from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
-from rsstp_sim.recording.records import EventRecord, ModelRecord
+from rsstp_sim.recording.records import EventRecord, ModelRecord, json_array
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
@@ -312,7 +312,7 @@ class Recording:
         found: list[ModelRecord] = []
         for ref, _, parts, times in self._chunks(topic):
             try:
-                heads = HEADS.decode(b"[" + b",".join(parts) + b"]")
+                heads = HEADS.decode(json_array(parts))
             except (msgspec.DecodeError, RecursionError):  # decoded whole below: named there
                 heads = None
             if heads is None or len(heads) != len(parts):
