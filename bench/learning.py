@@ -31,7 +31,8 @@ boolean form and its float twin (``mode = "float"``: the learner climbs the clos
 tells poses apart by it), one line per seed (``--seeds K``: seeds 0 .. K-1, default 1), with
 the float's steps as a share of the boolean's, and AALpy's run_hW beside the boolean one on
 seed 0 unless ``--no-aalpy`` (a world of the curve is handed to it as a scenario file);
-``--max-n`` leaves out larger worlds. The budget is 4 N^2 steps; the seconds are the
+``--max-n`` leaves out larger worlds, ``--min-n`` smaller ones, ``--mode bool`` (or
+``float``) runs one twin only. The budget is 4 N^2 steps; the seconds are the
 learner's own, warm (the truth is computed first). Targets: every run equivalent within
 4 N^2; the float twin of the 1,200-class world in at most half the boolean's steps.
 
@@ -390,9 +391,19 @@ CURVE: tuple[tuple[str, Any], ...] = (
 """The worlds of ``--curve``, smallest first."""
 
 
-def curve(max_n: int, seeds: int, aalpy: bool, seconds: float, memory_gib: float) -> bool:
+def curve(
+    max_n: int,
+    seeds: int,
+    aalpy: bool,
+    seconds: float,
+    memory_gib: float,
+    *,
+    min_n: int = 0,
+    modes: Sequence[str] = ("bool", "float"),
+) -> bool:
     """Steps to learn / N^2 against N (see the module docstring); one line per world and
-    seed."""
+    seed, the worlds of ``min_n`` to ``max_n`` classes, the boolean world and (or) its
+    float twin (``modes``)."""
     head = (
         f"{'world':14s} {'N':>6s} {'seed':>4s} | {'bool steps':>10s} {'x N^2':>6s} {'s':>7s} "
         f"{'eq':>3s} | {'float steps':>11s} {'x N^2':>6s} {'s':>7s} {'eq':>3s} "
@@ -405,22 +416,26 @@ def curve(max_n: int, seeds: int, aalpy: bool, seconds: float, memory_gib: float
         scenario = make()
         truth = compute_truth(scenario)
         n = truth.n_classes
-        if n > max_n:
-            print(f"{name:14s} {n:>6,} | left out (--max-n {max_n:,})")
+        if not min_n <= n <= max_n:
+            print(f"{name:14s} {n:>6,} | left out (--min-n {min_n:,} --max-n {max_n:,})")
             continue
         budget = 4 * n**2
         for seed in range(seeds):
             cells = []
             rows = []
-            for world in (scenario, _twin(scenario)):
+            for mode, world in (("bool", scenario), ("float", _twin(scenario))):
+                width = 10 if not cells else 11
+                if mode not in modes:
+                    cells.append(f"{'not run':>{width}s} {'':>6s} {'':>7s} {'':>3s}")
+                    continue
                 row = run_learner(world, truth, budget, seed)
                 rows.append(row)
                 good &= row.equivalent and row.done
                 cells.append(
-                    f"{row.steps:>{10 if not cells else 11},} {row.steps / n**2:>6.2f} "
+                    f"{row.steps:>{width},} {row.steps / n**2:>6.2f} "
                     f"{row.seconds:>7.1f} {'yes' if row.equivalent else 'NO':>3s}"
                 )
-            share = rows[1].steps / max(rows[0].steps, 1)
+            share = f"{rows[1].steps / max(rows[0].steps, 1):>5.2f}" if len(rows) == 2 else "    -"
             hw = "not run"
             if aalpy and seed == 0:
                 found = _hw_on(name, scenario, seconds, seed, memory_gib)
@@ -429,7 +444,7 @@ def curve(max_n: int, seeds: int, aalpy: bool, seconds: float, memory_gib: float
                     f"{found['result']}"
                 )
             print(
-                f"{name:14s} {n:>6,} {seed:>4d} | {cells[0]} | {cells[1]} {share:>5.2f} | {hw}",
+                f"{name:14s} {n:>6,} {seed:>4d} | {cells[0]} | {cells[1]} {share} | {hw}",
                 flush=True,
             )
     return good
@@ -541,6 +556,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--curve", action="store_true", help="steps / N^2 against N")
     parser.add_argument("--max-n", type=int, default=10_000, help="--curve: the largest N")
     parser.add_argument("--seeds", type=int, default=1, help="--curve: seeds 0 .. K-1")
+    parser.add_argument("--min-n", type=int, default=0, help="--curve: the smallest N")
+    parser.add_argument(
+        "--mode", choices=("both", "bool", "float"), default="both", help="--curve: which twin"
+    )
     parser.add_argument("--record", metavar="WORLD", help="record and audit a world of the curve")
     parser.add_argument("--float", action="store_true", help="--record: the float twin")
     parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
@@ -558,6 +577,8 @@ def main(argv: Sequence[str] | None = None) -> int:
             not args.no_aalpy and _aalpy_version() is not None,
             args.aalpy_seconds,
             args.aalpy_memory_gib,
+            min_n=args.min_n,
+            modes=("bool", "float") if args.mode == "both" else (args.mode,),
         )
         return 0 if ok else 1
     if args.spread is not None:

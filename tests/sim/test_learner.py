@@ -314,6 +314,25 @@ def test_with_float_feedback_the_learner_needs_at_most_half_the_steps() -> None:
         assert 2 * felt_runner.step_index <= blind_runner.step_index
 
 
+TRAP = parse_scenario(
+    'name = "trap"\n[arm]\nlengths = [1.0]\ninitial_deg = [90]\nstep_deg = 5\n'
+    "[[obstacles]]\ncenter = [0.613, 0.514]\nradius = 0.1\n"
+    '[feedback]\ntarget_deg = [0]\nmode = "float"\n'
+)
+"""One link from 90 degrees, the sensed pose at 0 behind an obstacle at about 40: climbing the
+closeness ends against the obstacle, and the way round starts with 27 steps downhill, more
+than a random run's 16."""
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_with_float_feedback_a_local_maximum_wider_than_a_run_is_left(seed: int) -> None:
+    truth = compute_truth(TRAP)
+    budget = 4 * truth.n_classes**2
+    learner, runner = learn(TRAP, budget, seed=seed)
+    assert learner.done and runner.step_index < budget
+    assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
 def test_every_seed_learns_the_two_joint_world() -> None:
     # Seed 8 once went round for ever in a test whose path to the landmark led through the
     # transition being identified (back to the candidate itself, on that hypothesis).

@@ -369,7 +369,9 @@ class Learning(Identifier):
 
     def start_state(self) -> int | None:
         """The state the run started in: the only one from which the steps before the
-        landmark was first seen replay through the model; None if several or none do."""
+        landmark was first seen replay through the model (what was sensed, and felt with float
+        feedback: a walk into a wall can bring two starts to one state); None if several or
+        none do."""
         h = self.h
         if not self.found:
             return self.agent.model.current
@@ -377,11 +379,13 @@ class Learning(Identifier):
         first = self.first_landmark
         actions = memory.actions[1 : first + 1].tolist()
         sensations = memory.sensations[: first + 1].tolist()
-        candidates = np.asarray(h.with_label(sensations[0]), dtype=np.int64)
+        felt = memory.feedback[: first + 1].tolist() if h.feels else [0.0] * (first + 1)
+        candidates = np.flatnonzero(h.alive)
+        candidates = candidates[h.agree(candidates, sensations[0], felt[0])]
         position = candidates.copy()
-        for action, sensation in zip(actions, sensations[1:], strict=True):
+        for action, sensation, feel in zip(actions, sensations[1:], felt[1:], strict=True):
             position = h.next[position, h.column[action]]
             keep = position >= 0
-            keep[keep] = h.label[position[keep]] == sensation
+            keep[keep] = h.agree(position[keep], sensation, feel)
             candidates, position = candidates[keep], position[keep]
         return int(candidates[0]) if len(candidates) == 1 else None

@@ -193,7 +193,9 @@ class Walker:
         first one's path to the landmark; a candidate predicting a different sensation is
         ruled out. When none is left, every state is a candidate again, after a random run;
         when every state was ruled out, the agent is where its hypothesis does not reach yet,
-        and it first wanders at random (climbs, with float feedback), twice as long each time.
+        and it first wanders at random, twice as long each time. With float feedback it climbs
+        the closeness instead; when a climb fails (a local maximum), it wanders, twice as long
+        after each failed climb.
         """
         h = self.h
         phase, self.phase = self.phase, "home"
@@ -220,7 +222,12 @@ class Walker:
                 if (yield from self.climb(LONGEST_RUN * len(h.actions))):
                     self.phase = phase
                     return
+                # A local maximum the climb's short runs do not leave (an obstacle's shadow, in a
+                # part of the world the hypothesis does not hold yet): wander at random, twice as
+                # long after each failed climb, then follow the candidates or climb again.
                 self._run_left = 0
+                wander = LONGEST_RUN << min(failed, 20)
+                failed += 1
                 widened = True
                 ids = np.asarray(h.matching(False, self.feel()), dtype=np.int64)
                 continue
@@ -275,7 +282,10 @@ class Walker:
         Coordinate ascent: keep taking an action while the feedback grows; when it falls, undo
         the action (when the confirmed transitions say which action undoes it) and try another;
         when no action makes it grow (a local maximum: an obstacle in the way), a random run
-        of one action, then climb again.
+        of one action, then climb again. Met again, a local maximum is left by a random walk
+        (runs of random actions) of :data:`LONGEST_RUN` steps, then twice as many each time: a
+        maximum whose slopes are wider than one run (the far side of an obstacle, the long way
+        round) is left in the end.
         """
         memory = self.agent.memory
         inverse = self.h.inverses()
@@ -283,13 +293,16 @@ class Walker:
         end = None if steps is None else self.agent.step + steps
         tried: set[int] = set()
         action: int | None = None
+        escapes = 0
         while end is None or self.agent.step < end:
             if action is None:
                 untried = [b for b in actions if b not in tried]
                 if not untried:  # a local maximum: leave it at random, then climb again
                     self._run_left = 0
                     run = [self.random_action()]
-                    while self._run_left > 0:
+                    walk = 0 if escapes == 0 else LONGEST_RUN << min(escapes - 1, 20)
+                    escapes += 1
+                    while self._run_left > 0 or len(run) < walk:
                         run.append(self.random_action())
                     for step_action in run:
                         if (yield from self.move(step_action)):
