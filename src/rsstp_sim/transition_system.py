@@ -132,6 +132,7 @@ class TransitionSystem:
         "_ops",
         "_states_sorted",
         "_index",
+        "_rows",
     )
     __hash__ = None  # type: ignore[assignment]
 
@@ -152,6 +153,9 @@ class TransitionSystem:
         self._ops: list[Operation] = []
         self._states_sorted: tuple[int, ...] | None = None
         self._index: dict[int, int] | None = None
+        # _rows[s]: s's transitions as (sources, actions, targets) columns, sorted; dropped
+        # when they change (every change of a transition goes through _link and _unlink).
+        self._rows: dict[int, tuple[tuple[int, ...], tuple[int, ...], tuple[int, ...]]] = {}
 
     @classmethod
     def universal(cls, actions: Iterable[int]) -> TransitionSystem:
@@ -264,6 +268,25 @@ class TransitionSystem:
     def transitions(self) -> list[tuple[int, int, int]]:
         """Every transition as ``(source, action, target)``, sorted."""
         return [(s, a, t) for s in self.states for a, t in self.transitions_from(s)]
+
+    def transition_columns(self) -> tuple[list[int], list[int], list[int]]:
+        """Every transition as three columns, sources, actions and targets, in the order of
+        :meth:`transitions`. Each state's part is kept until its transitions change: a model
+        that changes a few states at a time gives its columns at the cost of joining them."""
+        sources: list[int] = []
+        actions: list[int] = []
+        targets: list[int] = []
+        rows, out = self._rows, self._out
+        for s in self.states:
+            row = rows.get(s)
+            if row is None:
+                pairs = sorted(out[s].items())
+                moves = tuple(a for a, ts in pairs for _ in ts)
+                row = rows[s] = ((s,) * len(moves), moves, tuple(t for _, ts in pairs for t in ts))
+            sources.extend(row[0])
+            actions.extend(row[1])
+            targets.extend(row[2])
+        return sources, actions, targets
 
     def transitions_into(self, t: int) -> list[tuple[int, int]]:
         """Every transition into ``t`` as ``(source, action)``, sorted."""
@@ -396,6 +419,7 @@ class TransitionSystem:
                 self._unlink(u, a, t)
         del self._out[t]
         del self._in[t]
+        self._rows.pop(t, None)
         self._states_changed()
         for a, v in outgoing:
             self._link(s, a, s if v == t else v)
@@ -481,6 +505,7 @@ class TransitionSystem:
         other._ops = []
         other._states_sorted = self._states_sorted
         other._index = self._index
+        other._rows = dict(self._rows)
         return other
 
     def snapshot(self) -> dict[str, object]:
@@ -559,6 +584,7 @@ class TransitionSystem:
         if i < len(targets) and targets[i] == t:
             return False
         out[a] = targets[:i] + (t,) + targets[i:]
+        self._rows.pop(s, None)
         if len(targets) == 1:
             self._n_nondeterministic += 1
         self._in[t].setdefault(a, set()).add(s)
@@ -569,6 +595,7 @@ class TransitionSystem:
         targets = out.get(a, ())
         if t not in targets:
             return False
+        self._rows.pop(s, None)
         if len(targets) == 1:
             del out[a]
         else:

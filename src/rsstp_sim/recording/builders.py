@@ -191,17 +191,8 @@ def model_record(
     model: TransitionSystem, *, step: int, operations: Iterable[Operation]
 ) -> ModelRecord:
     """The ``rsstp.Model`` message: ``model`` as it is at ``step``, after ``operations``."""
-    transitions = tuple(model.transitions())
-    pairs = 0
-    run = 0
-    previous: tuple[int, int] | None = None
-    for s, a, _ in transitions:
-        if (s, a) == previous:
-            run += 1
-            if run == 2:
-                pairs += 1
-        else:
-            previous, run = (s, a), 1
+    source, action, target = model.transition_columns()
+    pairs = model.nondeterministic_pairs
     return ModelRecord(
         version=int(model.version),
         step=int(step),
@@ -210,9 +201,7 @@ def model_record(
         current=int(model.current),
         actions=model.actions,
         transitions=TransitionsRecord(
-            source=tuple(s for s, _, _ in transitions),
-            action=tuple(a for _, a, _ in transitions),
-            target=tuple(t for _, _, t in transitions),
+            source=tuple(source), action=tuple(action), target=tuple(target)
         ),
         operations=tuple(operation_record(op) for op in operations),
         deterministic=pairs == 0,

@@ -311,7 +311,7 @@ class Hypothesis:
         """The confirmed successors as lists, the actions in the run's order (-1: none): kept
         while :attr:`edits` stays the same, for searches that visit one state at a time."""
         if self._rows_edits != self._edits:
-            self._rows_cache = self.next[:, self._columns].tolist()
+            self._rows_cache = self.next[: self.model.next_id, self._columns].tolist()
             self._rows_edits = self._edits
         return self._rows_cache
 
