@@ -5,10 +5,9 @@ The recorder adds a million messages a second run. mcap's ``Writer.add_message``
 through a ``BytesIO`` for each one (about 4 us). :class:`ChunkedWriter` keeps a message
 as its 31-byte record header (one ``struct.pack``) beside its data, and its time and offset
 in arrays; a chunk's message indexes and the statistics are computed when the chunk ends,
-and the joining of the chunk's records, its CRC, compression and write are handed to the
-output, which does them on a second thread
-(:class:`~rsstp_sim.recording.output.SideFileWriter`: a join of a megabyte or more, zstd and
-file writes release the GIL).
+and the chunk's CRC, compression and write are handed to the output, which does them on a
+second thread (:class:`~rsstp_sim.recording.output.SideFileWriter`: zstd and file writes
+release the GIL).
 
 The other records (header, schemas, channels, metadata, attachments, the summary and
 footer) are the mcap library's own record classes, written where its ``Writer`` writes
@@ -216,20 +215,17 @@ class ChunkedWriter:
             self._message_counts[channel] = self._message_counts.get(channel, 0) + len(entries)
         self._messages += len(heads)
         self._chunks += 1
-        parts = self._records
+        records = b"".join(self._records)
         self._new_chunk()
-        self._out.write_later(self._chunk_bytes(parts, start, end, indexes))
+        self._out.write_later(self._chunk_bytes(records, start, end, indexes))
 
     def _chunk_bytes(
-        self, parts: list[bytes], start: int, end: int, indexes: list[tuple[int, bytes]]
+        self, records: bytes, start: int, end: int, indexes: list[tuple[int, bytes]]
     ) -> Callable[[int], bytes]:
-        """What builds the chunk record and its message indexes, given the chunk's offset:
-        its records are ``parts`` joined there (a join of a megabyte or more releases the GIL,
-        so the run goes on meanwhile)."""
+        """What builds the chunk record and its message indexes, given the chunk's offset."""
         compress, chunk_indexes = self._compress, self._chunk_indexes
 
         def build(offset: int) -> bytes:
-            records = b"".join(parts)
             crc = zlib.crc32(records)
             data = compress(records)
             length = _CHUNK_OVERHEAD + len(data)
