@@ -284,39 +284,6 @@ def test_is_deterministic_follows_every_operation() -> None:
     assert model.is_deterministic()
 
 
-@settings(max_examples=200, deadline=None)
-@given(
-    st.lists(
-        st.tuples(
-            st.sampled_from("adsmc"), st.integers(0, 9), st.integers(0, 9), st.integers(0, 2)
-        ),
-        max_size=40,
-    )
-)
-def test_transition_columns_follow_every_operation(script: list[tuple[str, int, int, int]]) -> None:
-    # The columns a model message is built from, kept per state between changes, are at every
-    # moment the model's transitions read afresh from its successors, sorted; a copy keeps them.
-    model = TransitionSystem(3, actions=(0, 1, 2))
-    for kind, i, j, a in script:
-        states = model.states
-        s, t = states[i % len(states)], states[j % len(states)]
-        if kind == "a":
-            model.add(s, t, a)
-        elif kind == "d":
-            model.delete(s, t, a)
-        elif kind == "s":
-            model.split(s)
-        elif kind == "m" and s != t:
-            model.merge(s, t)
-        elif kind == "c":
-            model = model.copy()
-        expected = sorted(
-            (u, b, v) for u in model.states for b in (0, 1, 2) for v in model.successors(u, b)
-        )
-        columns = model.transition_columns()
-        assert list(zip(*columns, strict=True)) == expected
-
-
 # ---------------------------------------------------------------- matrix
 
 
@@ -589,6 +556,24 @@ def test_replaying_drained_operations_rebuilds_the_model(
     assert all(op.changed for op in logged)
     assert_replays_to(before, logged, model)
     assert before.snapshot() == model.snapshot()
+
+
+@settings(max_examples=150, deadline=None)
+@given(models(), _ops)
+def test_transition_columns_follow_every_operation(
+    model: TransitionSystem, ops: list[tuple[str, int, int, int]]
+) -> None:
+    # The columns a model message is built from, kept per state between changes, are at every
+    # moment the model's transitions read afresh from its successors, sorted; a copy keeps them.
+    for op in ops:
+        model.transition_columns()  # (kept before the change)
+        _run(model, [op])
+        if op[1] % 5 == 0:
+            model = model.copy()
+        expected = sorted(
+            (u, b, v) for u in model.states for b in model.actions for v in model.successors(u, b)
+        )
+        assert list(zip(*model.transition_columns(), strict=True)) == expected
 
 
 @settings(max_examples=150, deadline=None)
