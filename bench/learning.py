@@ -68,6 +68,7 @@ from typing import Any
 
 import numpy as np
 
+from _cold import measure_cpu
 from rsstp_sim.coupling import Runner
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 from rsstp_sim.strategies.learner import LearnerStrategy
@@ -453,8 +454,6 @@ def curve(
 def record(name: str, seed: int, *, float_mode: bool) -> bool:
     """``rsstp-sim record`` then ``rsstp-replay audit --truth`` of a world of the curve, cold;
     prints one line each, returns whether the recording's final model is the truth's."""
-    from _cold import measure_cpu
-
     makers = dict(CURVE)
     if name not in makers:
         sys.exit(f"--record: expected one of {', '.join(makers)}, got {name!r}")

@@ -267,7 +267,7 @@ class TransitionSystem:
 
     def transitions(self) -> list[tuple[int, int, int]]:
         """Every transition as ``(source, action, target)``, sorted."""
-        return [(s, a, t) for s in self.states for a, t in self.transitions_from(s)]
+        return list(zip(*self.transition_columns(), strict=True))
 
     def transition_columns(self) -> tuple[list[int], list[int], list[int]]:
         """Every transition as three columns, sources, actions and targets, in the order of
@@ -276,13 +276,16 @@ class TransitionSystem:
         sources: list[int] = []
         actions: list[int] = []
         targets: list[int] = []
-        rows, out = self._rows, self._out
+        rows = self._rows
         for s in self.states:
             row = rows.get(s)
             if row is None:
-                pairs = sorted(out[s].items())
-                moves = tuple(a for a, ts in pairs for _ in ts)
-                row = rows[s] = ((s,) * len(moves), moves, tuple(t for _, ts in pairs for t in ts))
+                pairs = self.transitions_from(s)
+                row = rows[s] = (
+                    (s,) * len(pairs),
+                    tuple(a for a, _ in pairs),
+                    tuple(t for _, t in pairs),
+                )
             sources.extend(row[0])
             actions.extend(row[1])
             targets.extend(row[2])
