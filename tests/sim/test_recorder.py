@@ -15,7 +15,7 @@ import io
 import json
 import re
 import struct
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -43,6 +43,7 @@ from rsstp_sim import (
 )
 from rsstp_sim.recording import builders, records, schemas
 from rsstp_sim.recording import recorder as recorder_module
+from rsstp_sim.recording.chunks import Message
 from rsstp_sim.recording.recorder import Recorder, record
 from rsstp_sim.recording.records import EventRecord, ModelRecord, StepRecord
 from rsstp_sim.scenario import Scenario
@@ -569,10 +570,14 @@ class RunsOutOfMemory(Recorder):
     """A recorder whose step 6 meets a MemoryError (what a run under a memory limit meets,
     outside the strategy, which the runner names instead)."""
 
-    def _write_step(self, outcome: StepOutcome) -> None:
-        if outcome.step == 6:
-            raise MemoryError
-        super()._write_step(outcome)
+    def _step_messages(self, outcomes: Iterable[StepOutcome]) -> Iterator[Message]:
+        def until_six() -> Iterator[StepOutcome]:
+            for outcome in outcomes:
+                if outcome.step == 6:
+                    raise MemoryError
+                yield outcome
+
+        return super()._step_messages(until_six())
 
 
 def test_a_memory_error_under_force_leaves_the_old_recording(tmp_path: Path) -> None:

@@ -9,7 +9,7 @@ one to seven links.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from typing import ClassVar
 
 import pytest
@@ -24,6 +24,7 @@ from rsstp_sim import (
     load_scenario,
 )
 from rsstp_sim.recording import builders, records
+from rsstp_sim.recording.chunks import Message
 from rsstp_sim.recording.step_messages import StepMessages
 from rsstp_sim.scenario import Scenario, parse_scenario
 from rsstp_sim.strategies import Strategy, make_strategy
@@ -73,6 +74,15 @@ def expected_step(runner: Runner, outcome: StepOutcome | None) -> bytes:
     return records.encode(step_record_after(runner.world.current, runner.model, outcome))
 
 
+def live(runner: Runner, steps: int, taken: list[StepOutcome]) -> Iterator[StepOutcome]:
+    """Up to ``steps`` steps of ``runner``, each kept in ``taken`` as it is taken."""
+    for _ in range(steps):
+        if runner.stopped is not None:
+            return
+        taken.append(runner.step())
+        yield taken[-1]
+
+
 @pytest.mark.parametrize(("scenario_name", "strategy"), CASES, ids=[c[0] for c in CASES])
 def test_every_message_is_the_encoders(
     scenario_name: str, strategy: Callable[[], Strategy]
@@ -86,13 +96,25 @@ def test_every_message_is_the_encoders(
         model_version=runner.model.version,
     )
     assert head + tail == expected_step(runner, None)
+    taken: list[StepOutcome] = []
+    followed: list[int] = []  # the steps ``then`` was called for
+
+    def then(outcome: StepOutcome) -> Iterator[Message]:
+        followed.append(outcome.step)
+        yield (9, outcome.step, b"after", b"")
+
+    stream = messages.stream(
+        live(runner, 3000, taken), runner.world, runner.model, channel=4, waiting=(), then=then
+    )
     blocked = no_transition = 0
     versions = {runner.model.version}
-    for _ in range(3000):
-        if runner.stopped is not None:
-            break
-        outcome = runner.step()
-        head, tail = messages.step(outcome, runner.world.current, runner.model.version)
+    expected_then: list[int] = []
+    for channel, log_time, head, tail in stream:
+        outcome = taken[-1]
+        if channel == 9:  # then's message, right after its step's
+            assert (log_time, head) == (outcome.step, b"after")
+            continue
+        assert (channel, log_time) == (4, outcome.step * 1_000_000)
         assert head + tail == expected_step(runner, outcome), outcome
         if outcome.blocker is not None:
             blocked += 1
@@ -101,8 +123,11 @@ def test_every_message_is_the_encoders(
             )
             got = messages.blocked_event(outcome.step, outcome.action, outcome.blocker)
             assert got == records.encode(event)
+        if outcome.blocker is not None or outcome.no_transition:
+            expected_then.append(outcome.step)
         no_transition += outcome.no_transition
         versions.add(runner.model.version)
+    assert followed == expected_then
     # Each case shows what it is here for.
     if scenario_name in ("three-joint", "thesis-obstacles", "seven"):
         assert blocked
@@ -112,17 +137,52 @@ def test_every_message_is_the_encoders(
         assert len(versions) > 1
 
 
+def test_then_follows_every_step_while_something_waits() -> None:
+    runner = Runner(load_scenario("two-joint-30"), RandomStrategy(), seed=1)
+    waiting: list[int] = []
+    taken: list[StepOutcome] = []
+    followed: list[int] = []
+
+    def steps() -> Iterator[StepOutcome]:
+        for outcome in live(runner, 40, taken):
+            if outcome.step % 10 == 0:
+                waiting.append(1)  # as a model change or a note during the step would
+            yield outcome
+
+    def then(outcome: StepOutcome) -> Iterator[Message]:
+        followed.append(outcome.step)
+        waiting.clear()
+        return iter(())
+
+    stream = StepMessages().stream(
+        steps(), runner.world, runner.model, channel=1, waiting=waiting, then=then
+    )
+    assert len(list(stream)) == 40
+    plain = [o.step for o in taken if o.blocker is None and not o.no_transition]
+    assert len(plain) > 30
+    assert followed == [
+        o.step for o in taken if o.step % 10 == 0 or o.blocker is not None or o.no_transition
+    ]
+
+
 def test_past_its_bound_the_pose_cache_keeps_nothing_more_and_the_bytes_stay() -> None:
     """A world of many obstacles or a long run: once the cached parts reach the bound, the
     poses met after are encoded at each visit, to the same bytes."""
     runner = Runner(load_scenario("three-joint"), RandomStrategy(), seed=5)
     messages = StepMessages(cache_bytes=3000)  # a pose's parts are about 500 bytes
     poses = set()
-    for _ in range(500):
-        outcome = runner.step()
+    taken: list[StepOutcome] = []
+    stream = messages.stream(
+        live(runner, 500, taken),
+        runner.world,
+        runner.model,
+        channel=1,
+        waiting=(),
+        then=lambda _: iter(()),
+    )
+    for _, _, head, tail in stream:
         poses.add(runner.world.current)
-        head, tail = messages.step(outcome, runner.world.current, runner.model.version)
-        assert head + tail == expected_step(runner, outcome), outcome
+        assert head + tail == expected_step(runner, taken[-1]), taken[-1]
     assert len(poses) > 50
     sizes = [len(head) + len(tail) for head, tail, _ in messages._poses.values()]
     assert sum(sizes[:-1]) < 3000 <= sum(sizes)  # kept while below the bound, then no more

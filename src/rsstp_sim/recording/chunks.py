@@ -3,8 +3,10 @@
 The recorder adds a million messages a second run. mcap's ``Writer.add_message`` builds a
 ``Message`` object, updates the statistics and a message index and writes eight fields
 through a ``BytesIO`` for each one (about 4 us). :class:`ChunkedWriter` keeps a message
-as its 31-byte record header (one ``struct.pack``) beside its data, and its time and offset
-in arrays; a chunk's message indexes and the statistics are computed when the chunk ends,
+as its 31-byte record header (one ``struct.pack``) beside its data, in a loop over an
+iterable of messages (:meth:`ChunkedWriter.add_messages`: a producer that is a generator
+hands each message over without a call); a chunk's message indexes (times and offsets) and
+the statistics are computed with numpy when the chunk ends,
 and the chunk's CRC, compression and write are handed to the output, which does them on a
 second thread (:class:`~rsstp_sim.recording.output.SideFileWriter`: zstd and file writes
 release the GIL).
@@ -20,7 +22,7 @@ from __future__ import annotations
 
 import struct
 import zlib
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import Protocol
 
 import numpy as np
@@ -45,7 +47,10 @@ from mcap.records import (
 
 from rsstp_sim.errors import RecordingError
 
-__all__ = ["ChunkOutput", "ChunkedWriter"]
+__all__ = ["ChunkOutput", "ChunkedWriter", "Message"]
+
+Message = tuple[int, int, bytes, bytes]
+"""A message to add: its channel id, log time, and bytes as ``data`` and ``tail``."""
 
 MAGIC = b"\x89MCAP0\r\n"
 _MESSAGE = struct.Struct("<BQHIQQ").pack  # opcode, length, channel, sequence, log, publish time
@@ -184,11 +189,27 @@ class ChunkedWriter:
         """Add a message (publish time = log time, sequence 0) to the chunk being built: its
         bytes are ``data + tail`` (a tail shared by many messages is not copied for each).
         The record header is the message's whole index entry until the chunk ends."""
-        size = len(data) + len(tail)
-        self._records += (_MESSAGE(5, size + 22, channel_id, 0, log_time, log_time), data, tail)
-        self._size += size + _MESSAGE_OVERHEAD
-        if self._size > self._chunk_size:
-            self._end_chunk()
+        self.add_messages(((channel_id, log_time, data, tail),))
+
+    def add_messages(self, messages: Iterable[Message]) -> None:
+        """:meth:`add_message` for each ``(channel_id, log_time, data, tail)`` of
+        ``messages``, in order. Nothing else may add to this writer while ``messages`` runs
+        (a generator hands its messages over here, its other messages with them); the
+        messages taken before an error from ``messages`` are kept."""
+        pack, limit = _MESSAGE, self._chunk_size
+        records, size = self._records, self._size
+        try:
+            for channel_id, log_time, data, tail in messages:
+                length = len(data) + len(tail)
+                records += (pack(5, length + 22, channel_id, 0, log_time, log_time), data, tail)
+                size += length + _MESSAGE_OVERHEAD
+                if size > limit:
+                    self._size = size
+                    self._end_chunk()
+                    records, size = self._records, self._size
+        finally:
+            if records is self._records:  # (not when the chunk's hand-off failed)
+                self._size = size
 
     def _end_chunk(self) -> None:
         """Hand the chunk over (its CRC, compression and write follow on the output's side)."""

@@ -17,6 +17,7 @@ import fcntl
 import io
 import os
 import queue
+import sys
 import threading
 from collections.abc import Callable
 from pathlib import Path
@@ -36,6 +37,13 @@ class SideFileWriter:
     so the next hand-off waits for it; a SIGKILL loses at most the chunk in flight and the
     one being built, and every chunk on disk is whole, written with one ``write`` (its
     message indexes with it).
+
+    While the thread runs, the interpreter's switch interval is at most
+    :data:`SWITCH_INTERVAL` (``sys.setswitchinterval``; the one before is put back when the
+    last such thread ends). The thread needs the GIL back after each of its CRC, zstd and
+    write calls, and waits up to a switch interval each time while the run holds it: at the
+    default 5 ms, three such waits a chunk leave the run waiting for the thread at each
+    hand-off (a third of ``record``'s time at 1,000,000 steps, ``bench/record_vs_run.py``).
 
     A write error is raised by the next call (the next chunk's hand-off, at most a chunk
     later) and kept in ``error``; nothing is written after it. ``safe_steps`` is the last
@@ -68,6 +76,7 @@ class SideFileWriter:
             raise self.error
         if self._thread is None:
             self._thread = threading.Thread(target=self._work, name="rsstp-chunks", daemon=True)
+            _switch_sooner()
             self._thread.start()
         self._jobs.put((build, mark))
 
@@ -117,7 +126,33 @@ class SideFileWriter:
             self._jobs.put(None)
             self._thread.join()
             self._thread = None
+            _switch_as_before()
         self._raw.close()
+
+
+SWITCH_INTERVAL = 0.0005
+"""Seconds: the longest switch interval while a chunk thread runs (the default is 0.005)."""
+
+_switching = threading.Lock()
+_threads = 0  # chunk threads running
+_interval_before = 0.0  # the switch interval when the first of them started
+
+
+def _switch_sooner() -> None:
+    global _threads, _interval_before
+    with _switching:
+        if _threads == 0:
+            _interval_before = sys.getswitchinterval()
+            sys.setswitchinterval(min(_interval_before, SWITCH_INTERVAL))
+        _threads += 1
+
+
+def _switch_as_before() -> None:
+    global _threads
+    with _switching:
+        _threads -= 1
+        if _threads == 0:
+            sys.setswitchinterval(_interval_before)
 
 
 def open_side_file(path: Path, *, force: bool) -> io.FileIO:

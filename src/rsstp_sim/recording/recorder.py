@@ -15,9 +15,10 @@ runner's callbacks and writes:
 written, so the same scenario, strategy and seed give the same bytes.
 
 Speed: a step's message comes from per-pose templates
-(:mod:`~rsstp_sim.recording.step_messages`), goes into a chunk with little Python per message
-(:mod:`~rsstp_sim.recording.chunks`: the mcap ``Writer``'s bytes), and each chunk's CRC,
-compression and write run on a second thread (:mod:`~rsstp_sim.recording.output`).
+(:mod:`~rsstp_sim.recording.step_messages`); a run's messages are a generator that the chunk
+writer consumes, with little Python per message (:mod:`~rsstp_sim.recording.chunks`: the
+mcap ``Writer``'s bytes); each chunk's CRC, compression and write run on a second thread
+(:mod:`~rsstp_sim.recording.output`).
 
 Crash safety: the recording goes to a locked side file, renamed onto the output only when
 finished (:mod:`rsstp_sim.recording.output`). :meth:`Recorder.request_stop` (what the CLI's
@@ -31,7 +32,7 @@ import io
 import json
 import os
 import platform
-from collections.abc import Callable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, replace
 from importlib import metadata
@@ -41,7 +42,7 @@ from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.errors import RecordingError, RecordingWriteError, RsstpError
 from rsstp_sim.files import side_file
 from rsstp_sim.recording import builders, records
-from rsstp_sim.recording.chunks import ChunkedWriter
+from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter, open_side_file
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_MEDIA_TYPE,
@@ -66,6 +67,7 @@ DEFAULT_CHUNK_SIZE = 1024 * 1024
 """Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
 
 _VERSION_KEYS = ("package_version", "python", "numpy", "shapely", "mcap")
+
 
 
 def environment_versions() -> dict[str, str]:
@@ -122,11 +124,11 @@ class Recorder:
         if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1024:
             raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
         self.path = Path(path)
-        self._pending_events: list[tuple[int, bytes]] = []  # (step, message)
-        # (step, operations): the model message is built when the step is written,
-        # since the runner also reports changes made during its own reset, before
-        # ``self.runner`` exists.
-        self._pending_models: list[tuple[int, tuple[Operation, ...]]] = []
+        # What waits for the next step's message to be written, in order: (step, event
+        # message) and (step, operations) of a model change, whose message is built when the
+        # step is written, since the runner also reports changes made during its own reset,
+        # before ``self.runner`` exists.
+        self._waiting: list[tuple[int, bytes | tuple[Operation, ...]]] = []
         self._topics = {t: name for t, name in TOPICS.items() if model or t != "/rsstp/model"}
         self.runner = Runner(
             scenario,
@@ -146,9 +148,6 @@ class Recorder:
         self._raw = open_side_file(self.path, force=force)
         self._file = SideFileWriter(self._raw, lambda: self.runner.step_index)
         self._writer = ChunkedWriter(self._file, chunk_size=chunk_size)
-        # What every step uses, looked up once.
-        self._world, self._model = self.runner.world, self.runner.model
-        self._step_message, self._add_step = self._messages.step, self._writer.add_message
         self._closed = False
         try:
             self._write_header(scenario, strategy, seed)
@@ -168,15 +167,15 @@ class Recorder:
         # state and the action); the runner's events add the strategy notes.
         if event.kind == "note":
             note = builders.note_event(event.step, event.text, event.data)
-            self._pending_events.append((event.step, records.encode(note)))
+            self._waiting.append((event.step, records.encode(note)))
 
     def _on_model_change(self, step: int, operations: Sequence[Operation]) -> None:
         if "/rsstp/model" not in self._topics:
             raise RecordingError(
                 f"step {step}: the model changed in a run recorded without a model channel"
             )
-        self._pending_models.append((step, tuple(operations)))
-        self._pending_events.extend(
+        self._waiting.append((step, tuple(operations)))
+        self._waiting.extend(
             (step, records.encode(event)) for event in builders.operation_events(step, operations)
         )
 
@@ -223,16 +222,34 @@ class Recorder:
             strategy_origin=origin,
         )
         self._add("/rsstp/scenario", 0, records.encode(record))
-        if not self._pending_models and "/rsstp/model" in self._topics:
-            self._pending_models.append((0, ()))  # step 0 always has the initial model
+        if "/rsstp/model" in self._topics and not any(
+            isinstance(change, tuple) for _, change in self._waiting
+        ):
+            self._waiting.append((0, ()))  # step 0 always has the initial model
         self._write_step_zero()
 
     def _add(self, topic: str, step: int, data: bytes, tail: bytes = b"") -> None:
-        self._writer.add_message(self._channels[topic], step * STEP_NS, data, tail)
-        self._counts[topic] += 1
+        self._writer.add_message(*self._message(topic, step, data, tail))
 
-    def _lead_events(self, outcome: StepOutcome) -> None:
-        """The world acted first, then the internal transition: their events lead the step's."""
+    def _message(self, topic: str, step: int, data: bytes, tail: bytes = b"") -> Message:
+        self._counts[topic] += 1
+        return self._channels[topic], step * STEP_NS, data, tail
+
+    def _step_messages(self, outcomes: Iterable[StepOutcome]) -> Iterator[Message]:
+        """The messages of each step of ``outcomes``, in file order."""
+        return self._messages.stream(
+            outcomes,
+            self.runner.world,
+            self.runner.model,
+            channel=self._step_channel,
+            waiting=self._waiting,
+            then=self._after_step,
+        )
+
+    def _after_step(self, outcome: StepOutcome) -> Iterator[Message]:
+        """The messages after a step's own: the model's, then the events. Of the events, the
+        world's (blocked) and the internal transition's (no transition) lead: they came
+        first."""
         t = outcome.step
         lead = []
         if outcome.blocker is not None:
@@ -242,17 +259,20 @@ class Recorder:
                 t, state=outcome.state_before, action=outcome.action
             )
             lead.append((t, records.encode(event)))
-        self._pending_events[:0] = lead
+        self._waiting[:0] = lead
+        return self._pending(t)
 
-    def _flush_pending(self, step: int) -> None:
+    def _pending(self, step: int) -> Iterator[Message]:
+        """The model messages (built now), then the events, that wait for ``step``."""
         model = self.runner.model
-        for model_step, operations in self._pending_models:
-            record = builders.model_record(model, step=model_step, operations=operations)
-            self._add("/rsstp/model", step, records.encode(record))
-        for event_step, event in self._pending_events:
-            self._add("/rsstp/event", event_step, event)
-        self._pending_models.clear()
-        self._pending_events.clear()
+        for model_step, change in self._waiting:
+            if isinstance(change, tuple):
+                record = builders.model_record(model, step=model_step, operations=change)
+                yield self._message("/rsstp/model", step, records.encode(record))
+        for event_step, change in self._waiting:
+            if isinstance(change, bytes):
+                yield self._message("/rsstp/event", event_step, change)
+        self._waiting.clear()
 
     def _write_step_zero(self) -> None:
         runner = self.runner
@@ -262,7 +282,7 @@ class Recorder:
             model_version=runner.model.version,
         )
         self._add("/rsstp/step", 0, *message)
-        self._flush_pending(0)
+        self._writer.add_messages(self._pending(0))
 
     # -- running ------------------------------------------------------------------
 
@@ -279,20 +299,37 @@ class Recorder:
         the file ends with an event saying so, at that step, of a budget of ``steps``.
         """
         _check_steps(steps)
-        step, write, agent = self.runner.step, self._write_step, self.runner.agent
         self._budget = self.runner.step_index + steps
-        done = 0
-        try:
-            with self._closed_on_failure():
-                while done < steps and not self._stop and agent.stopped is None:
-                    write(step())
-                    done += 1
-                    if progress is not None and not done & 4095:
-                        progress(done)
-        finally:
-            self._counts["/rsstp/step"] += done
+        with self._closed_on_failure():
+            self._write(self._outcomes(steps, progress))
         self.close()
         return self.result()
+
+    def _outcomes(
+        self, steps: int, progress: Callable[[int], None] | None
+    ) -> Iterator[StepOutcome]:
+        """Take up to ``steps`` steps (fewer after a stop request, or when the strategy ends
+        the run), counted as they are taken."""
+        step, agent = self.runner.step, self.runner.agent
+        done = 0
+        try:
+            while done < steps and not self._stop and agent.stopped is None:
+                yield step()
+                done += 1
+                if progress is not None and not done & 4095:
+                    progress(done)
+        finally:
+            self._counts["/rsstp/step"] += done
+
+    def _write(self, outcomes: Iterator[StepOutcome]) -> None:
+        """Write the messages of the steps ``outcomes`` takes."""
+        messages = self._step_messages(outcomes)
+        try:
+            self._writer.add_messages(messages)
+        finally:  # a failed write: the steps are counted now, not when collected
+            messages.close()
+            if isinstance(outcomes, Generator):
+                outcomes.close()
 
     def _write_stop(self) -> None:
         """The event that ends a run the strategy stopped: its last message."""
@@ -306,7 +343,7 @@ class Recorder:
         """Take and record one step; the file stays open until :meth:`close`."""
         with self._closed_on_failure():
             outcome = self.runner.step()
-            self._write_step(outcome)
+            self._write(iter((outcome,)))
         self._counts["/rsstp/step"] += 1
         return outcome
 
@@ -321,15 +358,6 @@ class Recorder:
             self.runner.agent.stopped,
             self._budget,
         )
-
-    def _write_step(self, outcome: StepOutcome) -> None:
-        t = outcome.step
-        head, tail = self._step_message(outcome, self._world.current, self._model.version)
-        self._add_step(self._step_channel, t * STEP_NS, head, tail)
-        if outcome.blocker is not None or outcome.no_transition:
-            self._lead_events(outcome)
-        if self._pending_models or self._pending_events:
-            self._flush_pending(t)
 
     @contextmanager
     def _closed_on_failure(self) -> Iterator[None]:

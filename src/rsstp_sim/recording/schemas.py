@@ -22,12 +22,12 @@ import json
 import re
 from collections.abc import Mapping
 from importlib import resources
-from typing import Any
-
-from jsonschema import Draft202012Validator
-from jsonschema.exceptions import best_match
+from typing import TYPE_CHECKING, Any
 
 from rsstp_sim.recording.records import RecordFormatError
+
+if TYPE_CHECKING:
+    from jsonschema import Draft202012Validator
 
 __all__ = [
     "ATTACHMENT_MEDIA_TYPE",
@@ -150,6 +150,8 @@ def validate(name: str, instance: Mapping[str, Any]) -> None:
 
     Raises :class:`RecordFormatError` naming the field path of the most relevant error.
     """
+    from jsonschema.exceptions import best_match  # (not imported by a recording run)
+
     error = best_match(validator(name).iter_errors(instance))
     if error is not None:
         path = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in error.absolute_path)
@@ -203,4 +205,6 @@ def _schema_bytes(name: str) -> bytes:
 
 @functools.cache
 def _validator(name: str) -> Draft202012Validator:
+    from jsonschema import Draft202012Validator
+
     return Draft202012Validator(json.loads(_schema_bytes(name)))

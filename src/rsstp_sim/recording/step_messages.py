@@ -18,15 +18,19 @@ float feedback, one to seven links).
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable, Iterator, Sized
 from typing import TYPE_CHECKING
 
 from rsstp_sim.recording import builders
+from rsstp_sim.recording.chunks import Message
 from rsstp_sim.recording.records import encode, encode_json
+from rsstp_sim.recording.schemas import STEP_NS
 
 if TYPE_CHECKING:
     from rsstp_sim.coupling import StepOutcome
     from rsstp_sim.geometry import Blocker
-    from rsstp_sim.world import Pose
+    from rsstp_sim.transition_system import TransitionSystem
+    from rsstp_sim.world import Pose, World
 
 __all__ = ["POSE_CACHE_BYTES", "StepMessages"]
 
@@ -80,20 +84,39 @@ class StepMessages:
         head, moved, _ = self._poses.get(pose) or self._parts(pose)
         return _FIRST_HEAD % (internal_state, head, model_version), moved
 
-    def step(self, outcome: StepOutcome, pose: Pose, model_version: int) -> tuple[bytes, bytes]:
-        """The message of the step ``outcome`` tells, ending at ``pose``: head and tail."""
-        step, action, state_before, state_after, blocker, no_transition, _ = outcome
-        head, moved, cut = self._poses.get(pose) or self._parts(pose)
-        first = _HEAD % (step, action, state_before, state_after, head, model_version)
-        if blocker is None and not no_transition:
-            return first, moved
-        tail = _TAIL % (
-            b"true" if no_transition else b"false",
-            moved[len(_MOVED) : cut],
-            _UNBLOCKED if blocker is None else self._blocked(blocker),
-            moved[cut + len(_UNBLOCKED) : -2],
-        )
-        return first, tail
+    def stream(
+        self,
+        outcomes: Iterable[StepOutcome],
+        world: World,
+        model: TransitionSystem,
+        *,
+        channel: int,
+        waiting: Sized,
+        then: Callable[[StepOutcome], Iterable[Message]],
+    ) -> Iterator[Message]:
+        """The messages of each step of ``outcomes``, as it is taken: its ``rsstp.Step``
+        message on ``channel`` (at the world's pose and the model's version after the step),
+        then, if the step was blocked, found no transition, or ``waiting`` is not empty, the
+        messages of ``then(outcome)``."""
+        kept, parts_of = self._poses.get, self._parts
+        for outcome in outcomes:
+            t, action, state_before, state_after, blocker, no_transition, _ = outcome
+            pose = world.current
+            head, moved, cut = kept(pose) or parts_of(pose)
+            first = _HEAD % (t, action, state_before, state_after, head, model.version)
+            if blocker is None and not no_transition:
+                yield channel, t * STEP_NS, first, moved
+                if waiting:
+                    yield from then(outcome)
+                continue
+            tail = _TAIL % (
+                b"true" if no_transition else b"false",
+                moved[len(_MOVED) : cut],
+                _UNBLOCKED if blocker is None else self._blocked(blocker),
+                moved[cut + len(_UNBLOCKED) : -2],
+            )
+            yield channel, t * STEP_NS, first, tail
+            yield from then(outcome)
 
     def _blocked(self, blocker: Blocker) -> bytes:
         truth = self._blocked_truth.get(blocker)
