@@ -58,14 +58,21 @@ import os
 import pstats
 import tempfile
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
-from rsstp_sim import RandomStrategy, Runner, builtin_scenarios, load_scenario
+from rsstp_sim import (
+    Pose,
+    RandomStrategy,
+    Runner,
+    StepOutcome,
+    builtin_scenarios,
+    load_scenario,
+)
 from rsstp_sim.recording.chunks import ChunkedWriter
 from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.recorder import DEFAULT_CHUNK_SIZE, Recorder
@@ -251,6 +258,14 @@ def _add_chunked(data: list[bytes], path: Path) -> None:
     output.close()
 
 
+class _Replayed:
+    """The world and the model as :meth:`StepMessages.stream` reads them, for steps taken
+    before: the pose after each step, the model's version 0."""
+
+    current: Pose
+    version = 0
+
+
 def _isolated_parts(steps: int, repeats: int) -> None:
     scenario = float_mode("three-joint")
     runner = Runner(scenario, RandomStrategy(), seed=SEED)
@@ -265,11 +280,18 @@ def _isolated_parts(steps: int, repeats: int) -> None:
     step_s = _best(repeats, simulate)
     runner.reset()
     outcomes = [(runner.step(), runner.world.current) for _ in range(steps)]
-    step_message = StepMessages().step
     data: list[bytes] = []
 
     def encode() -> None:
-        data[:] = [b"".join(step_message(o, pose, 0)) for o, pose in outcomes]
+        at = _Replayed()
+
+        def replayed() -> Iterator[StepOutcome]:
+            for outcome, pose in outcomes:
+                at.current = pose
+                yield outcome
+
+        stream = StepMessages().stream(replayed(), at, at, channel=1, waiting=(), then=lambda _: ())
+        data[:] = [head + tail for _, _, head, tail in stream]
 
     encode_s = _best(repeats, encode)
     add_s = _best(repeats, lambda: _add_all(data, CompressionType.NONE))
@@ -281,7 +303,7 @@ def _isolated_parts(steps: int, repeats: int) -> None:
     print(f"The parts alone (warm, {steps:,} steps, best of {repeats}, us/step):")
     rows: list[tuple[str, float]] = [
         ("Runner.step (the simulation, unrecorded)", step_s),
-        ("step message bytes (StepMessages.step, joined)", encode_s),
+        ("step message bytes (StepMessages.stream, joined)", encode_s),
         ("mcap Writer.add_message, no compression, to memory", add_s),
         ("zstd chunk compression (add_message zstd - none)", add_zstd_s - add_s),
         ("the recorder's ChunkedWriter, zstd on its thread, to a file", chunked_s),

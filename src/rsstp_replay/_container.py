@@ -33,6 +33,7 @@ from mcap.records import Attachment, Channel, Metadata, Schema
 
 from rsstp_replay.errors import CorruptRecording, NotARecording
 from rsstp_sim.files import irregular
+from rsstp_sim.switching import sooner_switches
 
 __all__ = ["MESSAGE_TIME", "RECORD", "ChunkRef", "Container", "chunk_records", "open_container"]
 
@@ -107,7 +108,8 @@ class Container:
     def chunks_data(self, refs: Sequence[ChunkRef]) -> Generator[bytes, None, None]:
         """:meth:`chunk_data` of each chunk of ``refs``, in order, the next one read,
         decompressed and checked on a second thread (file reads, zstd and CRCs release the
-        GIL) while the caller works on this one; an error is raised where its chunk comes."""
+        GIL; the switch interval is short meanwhile: :mod:`rsstp_sim.switching`) while the
+        caller works on this one; an error is raised where its chunk comes."""
         if len(refs) < 2:
             with self.open() as stream:
                 yield from (self.chunk_data(stream, ref) for ref in refs)
@@ -115,6 +117,7 @@ class Container:
         with (
             self.open() as stream,
             ThreadPoolExecutor(max_workers=1, thread_name_prefix="rsstp-chunks") as ahead,
+            sooner_switches(),
         ):
             coming = ahead.submit(self.chunk_data, stream, refs[0])
             try:

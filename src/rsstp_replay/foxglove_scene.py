@@ -41,7 +41,7 @@ from __future__ import annotations
 import io
 import math
 import os
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
 from importlib import metadata as distributions
 from pathlib import Path
@@ -75,7 +75,7 @@ from rsstp_replay.errors import ReplayError
 from rsstp_sim import __version__, palette
 from rsstp_sim.files import written_whole
 from rsstp_sim.geometry import ArmGeometry
-from rsstp_sim.recording.chunks import ChunkedWriter
+from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.words import counted
@@ -205,25 +205,28 @@ def _write_scene(
         )
     )
     writer.add_metadata("rsstp.scene", metadata)
-    add = writer.add_message
-    add(static, 0, draw.static_scene().encode())
-    add(transforms, 0, draw.fixed_transforms().encode())
-    log_events = _EventLogs(events, lambda at, data: add(logs, at, data))
-    messages = PoseMessages(
-        lambda row: draw.arm(None, poses.points[row].tolist()),
-        lambda row: draw.links(None, poses.angles_deg[row].tolist()),
-        cached=_CACHED_POSES,
-    )
-    at, next_event = messages.at, log_events.next_step
-    for row, (step, code) in enumerate(poses.rows()):
-        if step > next_event:
-            log_events.write_before(step)
-            next_event = log_events.next_step
-        head, tail, links = at(step, code, row)
-        log_time = step * STEP_NS
-        add(arm, log_time, head, tail)
-        add(transforms, log_time, links)
-    log_events.write_before(math.inf)
+
+    def messages() -> Iterator[Message]:
+        yield static, 0, draw.static_scene().encode(), b""
+        yield transforms, 0, draw.fixed_transforms().encode(), b""
+        log_events = _EventLogs(events, logs)
+        poses_at = PoseMessages(
+            lambda row: draw.arm(None, poses.points[row].tolist()),
+            lambda row: draw.links(None, poses.angles_deg[row].tolist()),
+            cached=_CACHED_POSES,
+        ).at
+        next_event = log_events.next_step
+        for row, (step, code) in enumerate(poses.rows()):
+            if step > next_event:
+                yield from log_events.before(step)
+                next_event = log_events.next_step
+            head, tail, links = poses_at(step, code, row)
+            log_time = step * STEP_NS
+            yield arm, log_time, head, tail
+            yield transforms, log_time, links, b""
+        yield from log_events.before(math.inf)
+
+    writer.add_messages(messages())
     writer.finish()
 
 
@@ -235,20 +238,19 @@ def _sdk_version() -> str:
 
 
 class _EventLogs:
-    """The events as ``foxglove.Log`` messages, handed to ``write(log_time, data)`` in step
-    order."""
+    """The events as ``foxglove.Log`` messages on ``channel``, in step order."""
 
-    def __init__(self, events: pd.DataFrame, write: Callable[[int, bytes], None]) -> None:
+    def __init__(self, events: pd.DataFrame, channel: int) -> None:
         self.steps: list[int] = events["step"].to_numpy(np.int64).tolist()
         self.kinds: list[str] = events["kind"].astype(str).tolist()
         self.texts: list[str] = events["text"].astype(str).tolist()
-        self.write = write
+        self.channel = channel
         self.written = 0
         self.next_step: float = self.steps[0] if self.steps else math.inf
         """The step of the next event not yet written."""
 
-    def write_before(self, step: float) -> None:
-        """Write the events of the steps before ``step`` not yet written."""
+    def before(self, step: float) -> Iterator[Message]:
+        """The messages of the events of the steps before ``step`` not yet written."""
         steps, kinds, texts = self.steps, self.kinds, self.texts
         while self.written < len(steps) and steps[self.written] < step:
             at, kind = steps[self.written], kinds[self.written]
@@ -256,9 +258,9 @@ class _EventLogs:
             message = Log(
                 timestamp=_timestamp(at), level=level, message=texts[self.written], name=kind
             )
-            self.write(at * STEP_NS, message.encode())
             self.written += 1
-        self.next_step = steps[self.written] if self.written < len(steps) else math.inf
+            self.next_step = steps[self.written] if self.written < len(steps) else math.inf
+            yield self.channel, at * STEP_NS, message.encode(), b""
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ import io
 import json
 import re
 import struct
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Generator, Iterable, Iterator, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, ClassVar
@@ -43,7 +43,7 @@ from rsstp_sim import (
 )
 from rsstp_sim.recording import builders, records, schemas
 from rsstp_sim.recording import recorder as recorder_module
-from rsstp_sim.recording.chunks import Message
+from rsstp_sim.recording.chunks import Message as ChunkMessage
 from rsstp_sim.recording.recorder import Recorder, record
 from rsstp_sim.recording.records import EventRecord, ModelRecord, StepRecord
 from rsstp_sim.scenario import Scenario
@@ -570,7 +570,9 @@ class RunsOutOfMemory(Recorder):
     """A recorder whose step 6 meets a MemoryError (what a run under a memory limit meets,
     outside the strategy, which the runner names instead)."""
 
-    def _step_messages(self, outcomes: Iterable[StepOutcome]) -> Iterator[Message]:
+    def _step_messages(
+        self, outcomes: Iterable[StepOutcome]
+    ) -> Generator[ChunkMessage, None, None]:
         def until_six() -> Iterator[StepOutcome]:
             for outcome in outcomes:
                 if outcome.step == 6:

@@ -17,13 +17,14 @@ import fcntl
 import io
 import os
 import queue
-import sys
 import threading
 from collections.abc import Callable
+from contextlib import ExitStack
 from pathlib import Path
 
 from rsstp_sim.errors import RecordingError
 from rsstp_sim.files import irregular, side_file
+from rsstp_sim.switching import sooner_switches
 
 __all__ = ["SideFileWriter", "open_side_file"]
 
@@ -38,12 +39,8 @@ class SideFileWriter:
     one being built, and every chunk on disk is whole, written with one ``write`` (its
     message indexes with it).
 
-    While the thread runs, the interpreter's switch interval is at most
-    :data:`SWITCH_INTERVAL` (``sys.setswitchinterval``; the one before is put back when the
-    last such thread ends). The thread needs the GIL back after each of its CRC, zstd and
-    write calls, and waits up to a switch interval each time while the run holds it: at the
-    default 5 ms, three such waits a chunk leave the run waiting for the thread at each
-    hand-off (a third of ``record``'s time at 1,000,000 steps, ``bench/record_vs_run.py``).
+    While the thread runs, the switch interval is short (:mod:`rsstp_sim.switching`), so the
+    thread gets the GIL back soon after each of its calls.
 
     A write error is raised by the next call (the next chunk's hand-off, at most a chunk
     later) and kept in ``error``; nothing is written after it. ``safe_steps`` is the last
@@ -63,6 +60,7 @@ class SideFileWriter:
             queue.SimpleQueue()
         )
         self._thread: threading.Thread | None = None
+        self._switching = ExitStack()  # while the thread runs
 
     def write(self, data: bytes) -> None:
         self._wait()
@@ -76,7 +74,7 @@ class SideFileWriter:
             raise self.error
         if self._thread is None:
             self._thread = threading.Thread(target=self._work, name="rsstp-chunks", daemon=True)
-            _switch_sooner()
+            self._switching.enter_context(sooner_switches())
             self._thread.start()
         self._jobs.put((build, mark))
 
@@ -126,33 +124,8 @@ class SideFileWriter:
             self._jobs.put(None)
             self._thread.join()
             self._thread = None
-            _switch_as_before()
+            self._switching.close()
         self._raw.close()
-
-
-SWITCH_INTERVAL = 0.0005
-"""Seconds: the longest switch interval while a chunk thread runs (the default is 0.005)."""
-
-_switching = threading.Lock()
-_threads = 0  # chunk threads running
-_interval_before = 0.0  # the switch interval when the first of them started
-
-
-def _switch_sooner() -> None:
-    global _threads, _interval_before
-    with _switching:
-        if _threads == 0:
-            _interval_before = sys.getswitchinterval()
-            sys.setswitchinterval(min(_interval_before, SWITCH_INTERVAL))
-        _threads += 1
-
-
-def _switch_as_before() -> None:
-    global _threads
-    with _switching:
-        _threads -= 1
-        if _threads == 0:
-            sys.setswitchinterval(_interval_before)
 
 
 def open_side_file(path: Path, *, force: bool) -> io.FileIO:

@@ -69,7 +69,6 @@ DEFAULT_CHUNK_SIZE = 1024 * 1024
 _VERSION_KEYS = ("package_version", "python", "numpy", "shapely", "mcap")
 
 
-
 def environment_versions() -> dict[str, str]:
     """The versions a recording's metadata names: this package, Python and key libraries."""
 
@@ -235,7 +234,7 @@ class Recorder:
         self._counts[topic] += 1
         return self._channels[topic], step * STEP_NS, data, tail
 
-    def _step_messages(self, outcomes: Iterable[StepOutcome]) -> Iterator[Message]:
+    def _step_messages(self, outcomes: Iterable[StepOutcome]) -> Generator[Message, None, None]:
         """The messages of each step of ``outcomes``, in file order."""
         return self._messages.stream(
             outcomes,

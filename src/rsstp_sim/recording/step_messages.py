@@ -18,7 +18,7 @@ float feedback, one to seven links).
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator, Sized
+from collections.abc import Callable, Generator, Iterable, Sized
 from typing import TYPE_CHECKING
 
 from rsstp_sim.recording import builders
@@ -93,7 +93,7 @@ class StepMessages:
         channel: int,
         waiting: Sized,
         then: Callable[[StepOutcome], Iterable[Message]],
-    ) -> Iterator[Message]:
+    ) -> Generator[Message, None, None]:
         """The messages of each step of ``outcomes``, as it is taken: its ``rsstp.Step``
         message on ``channel`` (at the world's pose and the model's version after the step),
         then, if the step was blocked, found no transition, or ``waiting`` is not empty, the
