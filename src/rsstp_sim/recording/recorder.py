@@ -292,7 +292,7 @@ class Recorder:
     def run(self, steps: int, *, progress: Callable[[int], None] | None = None) -> RecordResult:
         """Take and record ``steps`` steps, then finish the file.
 
-        ``progress`` is called with the number of steps done every 4096 steps.
+        ``progress`` is called with the number of steps done every 4,096 steps and at the end.
         Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`. When
         the strategy ends the run (:attr:`Runner.stopped <rsstp_sim.coupling.Runner.stopped>`),
         the file ends with an event saying so, at that step, of a budget of ``steps``.
@@ -313,9 +313,12 @@ class Recorder:
         done = 0
         try:
             while done < steps and not self._stop and agent.stopped is None:
-                yield step()
-                done += 1
-                if progress is not None and not done & 4095:
+                for _ in range(min(4096, steps - done)):
+                    yield step()
+                    done += 1
+                    if self._stop or agent.stopped is not None:
+                        break
+                if progress is not None:
                     progress(done)
         finally:
             self._counts["/rsstp/step"] += done

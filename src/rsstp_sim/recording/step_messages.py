@@ -5,6 +5,8 @@ blocked move. Most of a step's JSON depends on the pose alone (its sensation, fe
 ground truth), so :class:`StepMessages` encodes that once per pose and a step's own numbers
 with one ``%`` format. A message comes as two parts, the step's head and the pose's tail,
 which the chunk writer joins with the rest of the chunk (the tail is not copied per step).
+A step that moved (most steps) has a head of its four numbers alone: its tail, the pose's
+part with the model's version in it, is kept per pose while the version stays.
 A blocked event's JSON after its step number depends on the action and the blocker alone,
 and is encoded once per pair.
 
@@ -35,11 +37,12 @@ if TYPE_CHECKING:
 __all__ = ["POSE_CACHE_BYTES", "StepMessages"]
 
 POSE_CACHE_BYTES = 128 * 1024 * 1024
-"""The most bytes of poses' encoded parts kept for the poses met again (three-joint's 39,232
-poses take 23 MB; a pose among 1,000 obstacles 60 KB, its 3,000 distances): the poses met
-after that are encoded at each visit."""
+"""The most bytes of poses' encoded parts and tails kept for the poses met again
+(three-joint's 39,232 poses take 23 MB of parts and as much of tails; a pose among 1,000
+obstacles 60 KB, its 3,000 distances): the poses met after that are encoded at each visit."""
 
-_HEAD = b'{"step":%d,"agent":{"action":%d,"state_before":%d,"internal_state":%d%b%d'
+_STEP = b'{"step":%d,"agent":{"action":%d,"state_before":%d,"internal_state":%d'
+_HEAD = _STEP + b"%b%d"
 _FIRST_HEAD = b'{"step":0,"agent":{"internal_state":%d%b%d'
 _AGENT = b',"sensation":%b,"feedback":%b,"model_version":'
 _MOVED = b',"no_transition":false},"truth":{'
@@ -62,6 +65,10 @@ class StepMessages:
         self._truth: tuple[bytes, bytes] | None = None  # templates around "blocked"
         self._blocked_truth: dict[Blocker, bytes] = {}
         self._blocked_events: dict[tuple[int, Blocker], bytes] = {}
+        # pose -> a plain step's tail at model version ``_version`` (see _tail)
+        self._version = -1
+        self._tails: dict[Pose, bytes] = {}
+        self._tail_bytes = 0
 
     def _parts(self, pose: Pose) -> tuple[bytes, bytes, int]:
         angles, positions, distances = pose.truth_values()
@@ -78,6 +85,23 @@ class StepMessages:
             self._poses[pose] = parts
             self._room -= len(head) + len(moved)
         return parts
+
+    def _new_version(self, version: int) -> dict[Pose, bytes]:
+        """Drop the tails kept for the version before: the model changed."""
+        self._room += self._tail_bytes
+        self._version, self._tails, self._tail_bytes = version, {}, 0
+        return self._tails
+
+    def _tail(self, pose: Pose) -> bytes:
+        """A plain step's message after its own numbers, at ``pose`` and the current version:
+        the pose's agent part, the version and the rest, one bytes object."""
+        head, moved, _ = self._poses.get(pose) or self._parts(pose)
+        tail = b"%b%d%b" % (head, self._version, moved)
+        if self._room > 0:
+            self._tails[pose] = tail
+            self._room -= len(tail)
+            self._tail_bytes += len(tail)
+        return tail
 
     def first(self, pose: Pose, *, internal_state: int, model_version: int) -> tuple[bytes, bytes]:
         """Step 0's message (the reset, at ``pose``): head and tail."""
@@ -99,16 +123,22 @@ class StepMessages:
         then, if the step was blocked, found no transition, or ``waiting`` is not empty, the
         messages of ``then(outcome)``."""
         kept, parts_of = self._poses.get, self._parts
+        version, tails = self._version, self._tails
         for outcome in outcomes:
             t, action, state_before, state_after, blocker, no_transition, _ = outcome
             pose = world.current
-            head, moved, cut = kept(pose) or parts_of(pose)
-            first = _HEAD % (t, action, state_before, state_after, head, model.version)
             if blocker is None and not no_transition:
-                yield channel, t * STEP_NS, first, moved
+                if model.version != version:
+                    version, tails = model.version, self._new_version(model.version)
+                tail = tails.get(pose)
+                if tail is None:
+                    tail = self._tail(pose)
+                yield channel, t * STEP_NS, _STEP % (t, action, state_before, state_after), tail
                 if waiting:
                     yield from then(outcome)
                 continue
+            head, moved, cut = kept(pose) or parts_of(pose)
+            first = _HEAD % (t, action, state_before, state_after, head, model.version)
             tail = _TAIL % (
                 b"true" if no_transition else b"false",
                 moved[len(_MOVED) : cut],
