@@ -33,7 +33,7 @@ import json
 import os
 import platform
 from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
-from contextlib import contextmanager
+from contextlib import closing, contextmanager
 from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
@@ -299,14 +299,16 @@ class Recorder:
         """
         _check_steps(steps)
         self._budget = self.runner.step_index + steps
-        with self._closed_on_failure():
-            self._write(self._outcomes(steps, progress))
+        # Closed as soon as the writing ends, so that the steps taken are counted then.
+        outcomes = self._outcomes(steps, progress)
+        with self._closed_on_failure(), closing(outcomes):
+            self._write(outcomes)
         self.close()
         return self.result()
 
     def _outcomes(
         self, steps: int, progress: Callable[[int], None] | None
-    ) -> Iterator[StepOutcome]:
+    ) -> Generator[StepOutcome, None, None]:
         """Take up to ``steps`` steps (fewer after a stop request, or when the strategy ends
         the run), counted as they are taken."""
         step, agent = self.runner.step, self.runner.agent
@@ -323,15 +325,10 @@ class Recorder:
         finally:
             self._counts["/rsstp/step"] += done
 
-    def _write(self, outcomes: Iterator[StepOutcome]) -> None:
+    def _write(self, outcomes: Iterable[StepOutcome]) -> None:
         """Write the messages of the steps ``outcomes`` takes."""
-        messages = self._step_messages(outcomes)
-        try:
+        with closing(self._step_messages(outcomes)) as messages:
             self._writer.add_messages(messages)
-        finally:  # a failed write: the steps are counted now, not when collected
-            messages.close()
-            if isinstance(outcomes, Generator):
-                outcomes.close()
 
     def _write_stop(self) -> None:
         """The event that ends a run the strategy stopped: its last message."""
@@ -345,7 +342,7 @@ class Recorder:
         """Take and record one step; the file stays open until :meth:`close`."""
         with self._closed_on_failure():
             outcome = self.runner.step()
-            self._write(iter((outcome,)))
+            self._write((outcome,))
         self._counts["/rsstp/step"] += 1
         return outcome
 

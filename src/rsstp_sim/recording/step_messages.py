@@ -61,7 +61,7 @@ class StepMessages:
         # pose -> (the agent part after internal_state, the tail of a step that moved with
         # a transition, where its truth's "blocked" field starts in that tail)
         self._poses: dict[Pose, tuple[bytes, bytes, int]] = {}
-        self._room = cache_bytes  # bytes the kept parts may still take
+        self._room = cache_bytes  # bytes the kept parts and tails may still take
         self._truth: tuple[bytes, bytes] | None = None  # templates around "blocked"
         self._blocked_truth: dict[Blocker, bytes] = {}
         self._blocked_events: dict[tuple[int, Blocker], bytes] = {}
