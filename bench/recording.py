@@ -247,7 +247,7 @@ def _add_all(data: list[bytes], compression: CompressionType) -> None:
 
 
 def _add_chunked(data: list[bytes], path: Path) -> None:
-    output = SideFileWriter(io.FileIO(path, "w"), lambda: 0)
+    output = SideFileWriter(io.FileIO(path, "w"))
     writer = ChunkedWriter(output, chunk_size=DEFAULT_CHUNK_SIZE)
     writer.start(profile="", library="bench")
     channel = writer.register_channel("/rsstp/step", "json", 0)

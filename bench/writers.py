@@ -74,7 +74,7 @@ class CountingSideFile(SideFileWriter):
     """The recorder's side file writer, counting the writes."""
 
     def __init__(self, path: Path) -> None:
-        super().__init__(io.FileIO(path, "w"), lambda: 0)
+        super().__init__(io.FileIO(path, "w"))
         self.writes = 0
 
     def _write(self, data: bytes, mark: int) -> None:

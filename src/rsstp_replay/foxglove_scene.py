@@ -161,7 +161,7 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
     draw = _Drawing(scenario)
 
     with written_whole(out) as side:
-        output = SideFileWriter(io.FileIO(side, "w"), lambda: 0)
+        output = SideFileWriter(io.FileIO(side, "w"))
         try:
             writer = ChunkedWriter(output, chunk_size=_CHUNK_SIZE)
             _write_scene(writer, draw, poses, events, metadata)

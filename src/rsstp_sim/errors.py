@@ -13,6 +13,7 @@ __all__ = [
     "OutputError",
     "RecordingError",
     "RecordingWriteError",
+    "ChunkProcessFailed",
     "ActionError",
     "EnvError",
     "RecordFormatError",
@@ -66,6 +67,10 @@ class RecordingWriteError(RecordingError):
         super().__init__(message)
         self.safe_steps = safe_steps
         self.side_file = side_file
+
+
+class ChunkProcessFailed(RecordingError):
+    """The helper process that builds a long run's chunks failed, or ended before the run."""
 
 
 class ActionError(RsstpError):

@@ -33,7 +33,7 @@ class InMemory:
     def write(self, data: bytes) -> None:
         self.data += data
 
-    def write_later(self, build: Callable[[int], bytes]) -> None:
+    def write_later(self, build: Callable[[int], bytes], end_time: int) -> None:
         self.data += build(len(self.data))
 
     def tell(self) -> int:
@@ -115,7 +115,7 @@ def test_a_long_file_reads_back_with_its_crcs(tmp_path: Path) -> None:
     messages = [(i % 3, (i // 2) * 1000, b'{"i":%d}' % i, b"x" * (i % 97)) for i in range(20_000)]
     plan = Plan([b"{}", b"{ }"], [1, 2, 1], [{"k": "v"}], [b"text"], messages, 4096)
     path = tmp_path / "out.mcap"
-    output = SideFileWriter(io.FileIO(path, "w"), lambda: 0)
+    output = SideFileWriter(io.FileIO(path, "w"))
     with_chunked(plan, output)
     output.close()
     assert path.read_bytes() == with_mcap(plan)
@@ -144,22 +144,23 @@ class FailingFile(io.FileIO):
 def test_a_write_error_on_the_thread_surfaces_at_the_next_hand_off(tmp_path: Path) -> None:
     raw = FailingFile(tmp_path / "out.mcap", "w")
     raw.limit = 3000
-    steps = iter(range(1, 10**6))
-    output = SideFileWriter(raw, lambda: next(steps))  # each hand-off a step later
+    output = SideFileWriter(raw)
     sizes: list[int] = []
 
     def chunk(size: int) -> Callable[[int], bytes]:
         sizes.append(size)
         return lambda offset: b"c" * size
 
-    output.write(b"h" * 100)  # mark 0
-    output.write_later(chunk(1000))  # written, mark 1
-    output.write_later(chunk(1000))  # written, mark 2
-    output.write_later(chunk(1000))  # fails on the thread
+    output.write(b"h" * 100)
+    assert output.safe_steps == 0
+    # A chunk whose last message is of step 3 (log time 3 ms) holds steps 1 and 2 whole.
+    output.write_later(chunk(1000), 3_000_000)  # written: steps to 2 safe
+    output.write_later(chunk(1000), 7_000_000)  # written: steps to 6 safe
+    output.write_later(chunk(1000), 9_000_000)  # fails on the thread
     with pytest.raises(OSError, match="No space left") as raised:
-        output.write_later(chunk(1000))
+        output.write_later(chunk(1000), 12_000_000)
     assert raised.value is output.error
-    assert output.safe_steps == 2
+    assert output.safe_steps == 6
     with pytest.raises(OSError, match="No space left"):
         output.tell()
     output.close()

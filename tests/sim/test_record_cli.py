@@ -207,7 +207,9 @@ def test_same_bytes_across_processes_and_hash_seeds(tmp_path: Path) -> None:
 # ----------------------------------------------------------------- crash safety
 
 
-def start_long_recording(out: Path) -> subprocess.Popen[str]:
+def start_long_recording(out: Path, *, session: bool = False) -> subprocess.Popen[str]:
+    """A recording of 2,000,000 steps (its chunks built by a helper process); ``session``:
+    in a process group of its own, as a command started from a terminal is."""
     return subprocess.Popen(
         [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint", "--strategy", "random"]
         + ["--steps", "2000000", "--seed", "1", "-o", str(out), "--chunk-size", str(CHUNK_SIZE)],
@@ -215,7 +217,30 @@ def start_long_recording(out: Path) -> subprocess.Popen[str]:
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
+        start_new_session=session,
     )
+
+
+def helpers_of(pid: int) -> list[int]:
+    """The helper processes (chunk_process) that process ``pid`` started."""
+    found = []
+    for entry in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            stat = Path(f"/proc/{entry}/stat").read_text()
+            command = Path(f"/proc/{entry}/cmdline").read_bytes()
+        except OSError:  # ended meanwhile
+            continue
+        if int(stat.rpartition(")")[2].split()[1]) == pid and b"chunk_process" in command:
+            found.append(int(entry))
+    return found
+
+
+def wait_until_gone(pids: list[int]) -> None:
+    deadline = time.monotonic() + 10
+    while any(Path(f"/proc/{pid}").exists() for pid in pids):
+        if time.monotonic() > deadline:
+            pytest.fail(f"helper processes {pids} outlived their recorder")
+        time.sleep(0.02)
 
 
 def side(out: Path) -> Path:
@@ -236,12 +261,22 @@ def wait_for_chunks(proc: subprocess.Popen[str], out: Path, *, min_bytes: int) -
     pytest.fail(f"{out} did not grow past {min_bytes} bytes in {TIMEOUT_S} s")
 
 
-def stop_recording(out: Path, sig: signal.Signals) -> subprocess.CompletedProcess[str]:
-    proc = start_long_recording(out)
+def stop_recording(
+    out: Path, sig: signal.Signals, *, group: bool = False
+) -> subprocess.CompletedProcess[str]:
+    """Stop a long recording with ``sig``, sent to its process alone or (``group``) to its
+    process group, as Ctrl-C in a terminal sends SIGINT: its helper gets it too."""
+    proc = start_long_recording(out, session=group)
     try:
         wait_for_chunks(proc, out, min_bytes=3 * CHUNK_SIZE)
-        proc.send_signal(sig)
+        helpers = helpers_of(proc.pid)
+        assert len(helpers) == 1
+        if group:
+            os.killpg(proc.pid, sig)
+        else:
+            proc.send_signal(sig)
         stdout, stderr = proc.communicate(timeout=TIMEOUT_S)
+        wait_until_gone(helpers)
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -258,10 +293,13 @@ def step_numbers(messages: Sequence[tuple[str, bytes]]) -> list[int]:
     return steps
 
 
+@pytest.mark.parametrize("group", [False, True], ids=["process", "group"])
 @pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
-def test_sigint_and_sigterm_finish_the_file(tmp_path: Path, sig: signal.Signals) -> None:
+def test_sigint_and_sigterm_finish_the_file(
+    tmp_path: Path, sig: signal.Signals, group: bool
+) -> None:
     out = tmp_path / "long.mcap"
-    done = stop_recording(out, sig)
+    done = stop_recording(out, sig, group=group)
     assert done.returncode == 128 + sig.value
     assert "Traceback" not in done.stderr
     assert done.stdout == ""
@@ -320,6 +358,8 @@ def test_sigkill_keeps_every_complete_chunk(tmp_path: Path) -> None:
     proc = start_long_recording(out)
     try:
         wait_for_chunks(proc, out, min_bytes=4 * CHUNK_SIZE)
+        helpers = helpers_of(proc.pid)
+        assert len(helpers) == 1
         # Stopped first, so that the kill cannot land inside a write() (which would leave a
         # partial record): the file is then exactly what the process had handed to the OS.
         proc.send_signal(signal.SIGSTOP)
@@ -327,6 +367,7 @@ def test_sigkill_keeps_every_complete_chunk(tmp_path: Path) -> None:
         assert os.WIFSTOPPED(status)
         proc.kill()
         proc.communicate(timeout=TIMEOUT_S)
+        wait_until_gone(helpers)  # its pipe closed: the helper ended too
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -401,9 +442,11 @@ def test_a_second_writer_on_the_same_output_is_refused(tmp_path: Path) -> None:
     assert out.read_bytes().endswith(MCAP_MAGIC) and not side(out).exists()
 
 
-def test_a_file_size_limit_is_one_line_saying_what_is_safe(tmp_path: Path) -> None:
+@pytest.mark.parametrize("steps", ["50000", "500000"], ids=["alone", "helped"])
+def test_a_file_size_limit_is_one_line_saying_what_is_safe(tmp_path: Path, steps: str) -> None:
     """EFBIG (RLIMIT_FSIZE in the child): exit 1, one line; the side file holds the steps it
-    names, and a reader recovers exactly those."""
+    names, and a reader recovers exactly those. A run of 500,000 steps builds its chunks in
+    a helper process, and the recorder writes them."""
     import resource
 
     out = tmp_path / "run.mcap"
@@ -413,7 +456,7 @@ def test_a_file_size_limit_is_one_line_saying_what_is_safe(tmp_path: Path) -> No
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
 
     done = subprocess.run(
-        [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint", "--steps", "50000",
+        [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint", "--steps", steps,
          "-o", str(out)],
         env=cli_env(), capture_output=True, text=True, timeout=TIMEOUT_S, preexec_fn=small_files,
     )  # fmt: skip
@@ -428,18 +471,22 @@ def test_a_file_size_limit_is_one_line_saying_what_is_safe(tmp_path: Path) -> No
         assert rec.n_steps == safe > 0
 
 
-def test_a_full_disk_is_one_line_saying_what_is_safe(tmp_path: Path) -> None:
-    """ENOSPC on a real 512 KiB tmpfs (mounting needs root: CI runs as root)."""
+@pytest.mark.parametrize(
+    ("steps", "size"), [("30000", "512k"), ("300000", "8m")], ids=["alone", "helped"]
+)
+def test_a_full_disk_is_one_line_saying_what_is_safe(tmp_path: Path, steps: str, size: str) -> None:
+    """ENOSPC on a real small tmpfs (mounting needs root: CI runs as root); the run of
+    300,000 steps (some 22 MB) builds its chunks in a helper process."""
     if os.geteuid() != 0:
         pytest.skip("needs root to mount a small tmpfs (CI runs as root)")
     disk = tmp_path / "disk"
     disk.mkdir()
-    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=512k", "tmpfs", str(disk)])
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(disk)])
     if mounted.returncode != 0:
         pytest.skip("this machine refuses to mount a tmpfs")
     try:
         out = disk / "run.mcap"
-        done = rsstp_record("three-joint", "--steps", "30000", "-o", out)
+        done = rsstp_record("three-joint", "--steps", steps, "-o", out)
         assert done.returncode == 1, done.stderr
         assert "No space left on device; steps 1 to " in done.stderr
         assert len(done.stderr.splitlines()) == 1 and not out.exists()

@@ -43,9 +43,9 @@ from rsstp_sim import (
 )
 from rsstp_sim.recording import builders, records, schemas
 from rsstp_sim.recording import recorder as recorder_module
-from rsstp_sim.recording.chunks import Message as ChunkMessage
 from rsstp_sim.recording.recorder import Recorder, record
 from rsstp_sim.recording.records import EventRecord, ModelRecord, StepRecord
+from rsstp_sim.recording.step_messages import Block
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.strategies import Strategy
 from rsstp_sim.transition_system import TransitionSystem
@@ -570,16 +570,16 @@ class RunsOutOfMemory(Recorder):
     """A recorder whose step 6 meets a MemoryError (what a run under a memory limit meets,
     outside the strategy, which the runner names instead)."""
 
-    def _step_messages(
-        self, outcomes: Iterable[StepOutcome]
-    ) -> Generator[ChunkMessage, None, None]:
+    def _step_blocks(
+        self, outcomes: Iterable[StepOutcome], *, steps: int
+    ) -> Generator[Block, None, None]:
         def until_six() -> Iterator[StepOutcome]:
             for outcome in outcomes:
                 if outcome.step == 6:
                     raise MemoryError
                 yield outcome
 
-        return super()._step_messages(until_six())
+        return super()._step_blocks(until_six(), steps=steps)
 
 
 def test_a_memory_error_under_force_leaves_the_old_recording(tmp_path: Path) -> None:

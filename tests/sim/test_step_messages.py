@@ -25,7 +25,7 @@ from rsstp_sim import (
 )
 from rsstp_sim.recording import builders, records
 from rsstp_sim.recording.chunks import Message
-from rsstp_sim.recording.step_messages import StepMessages
+from rsstp_sim.recording.step_messages import BlockMessages, StepMessages, Steps
 from rsstp_sim.scenario import Scenario, parse_scenario
 from rsstp_sim.strategies import Strategy, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
@@ -74,18 +74,27 @@ def expected_step(runner: Runner, outcome: StepOutcome | None) -> bytes:
     return records.encode(step_record_after(runner.world.current, runner.model, outcome))
 
 
-def live(runner: Runner, steps: int, taken: list[StepOutcome]) -> Iterator[StepOutcome]:
-    """Up to ``steps`` steps of ``runner``, each kept in ``taken`` as it is taken."""
+def live(
+    runner: Runner, steps: int, taken: list[StepOutcome], expected: list[bytes] | None = None
+) -> Iterator[StepOutcome]:
+    """Up to ``steps`` steps of ``runner``, each kept in ``taken`` as it is taken, with its
+    message's bytes in ``expected``."""
     for _ in range(steps):
         if runner.stopped is not None:
             return
         taken.append(runner.step())
+        if expected is not None:
+            expected.append(expected_step(runner, taken[-1]))
         yield taken[-1]
 
 
+STEP, EVENT, THEN = 4, 8, 9  # the channels here
+
+
 @pytest.mark.parametrize(("scenario_name", "strategy"), CASES, ids=[c[0] for c in CASES])
+@pytest.mark.parametrize("block_steps", [1, 37, 4096])
 def test_every_message_is_the_encoders(
-    scenario_name: str, strategy: Callable[[], Strategy]
+    scenario_name: str, strategy: Callable[[], Strategy], block_steps: int
 ) -> None:
     scenario = seven_links() if scenario_name == "seven" else load_scenario(scenario_name)
     runner = Runner(scenario, strategy(), seed=3)
@@ -97,55 +106,61 @@ def test_every_message_is_the_encoders(
     )
     assert head + tail == expected_step(runner, None)
     taken: list[StepOutcome] = []
+    expected: list[bytes] = []
     followed: list[int] = []  # the steps ``then`` was called for
 
     def then(outcome: StepOutcome) -> Iterator[Message]:
         followed.append(outcome.step)
-        yield (9, outcome.step, b"after", b"")
+        yield (THEN, outcome.step, b"after", b"")
 
-    stream = messages.stream(
-        live(runner, 3000, taken), runner.world, runner.model, channel=4, waiting=(), then=then
+    blocks = messages.blocks(
+        live(runner, 3000, taken, expected),
+        runner.world,
+        runner.model,
+        channel=STEP,
+        waiting=(),
+        then=then,
+        steps=block_steps,
     )
-    blocked = no_transition = 0
-    versions = {runner.model.version}
-    expected_then: list[int] = []
-    for channel, log_time, head, tail in stream:
-        outcome = taken[-1]
-        if channel == 9:  # then's message, right after its step's
-            assert (log_time, head) == (outcome.step, b"after")
-            continue
-        assert (channel, log_time) == (4, outcome.step * 1_000_000)
-        assert head + tail == expected_step(runner, outcome), outcome
-        if outcome.blocker is not None:
-            blocked += 1
-            event = builders.blocked_event(
-                outcome.step, action=outcome.action, blocker=outcome.blocker
-            )
-            got = messages.blocked_event(outcome.step, outcome.action, outcome.blocker)
-            assert got == records.encode(event)
-        if outcome.blocker is not None or outcome.no_transition:
-            expected_then.append(outcome.step)
-        no_transition += outcome.no_transition
-        versions.add(runner.model.version)
-    assert followed == expected_then
+    got = [(ch, t, data + tail) for ch, t, data, tail in BlockMessages(STEP, EVENT).of(blocks)]
+    # The independent order: each step's message; then, for a step with no transition,
+    # then's message (its events are the recorder's); for a blocked step, its event.
+    want: list[tuple[int, int, bytes]] = []
+    for outcome, step_bytes in zip(taken, expected, strict=True):
+        t = outcome.step
+        want.append((STEP, t * 1_000_000, step_bytes))
+        if outcome.no_transition:
+            want.append((THEN, t, b"after"))
+        elif outcome.blocker is not None:
+            event = builders.blocked_event(t, action=outcome.action, blocker=outcome.blocker)
+            want.append((EVENT, t * 1_000_000, records.encode(event)))
+            got_event = messages.blocked_event(t, outcome.action, outcome.blocker)
+            assert got_event == records.encode(event)  # the recorder's, for a whole step
+    assert got == want
+    assert followed == [o.step for o in taken if o.no_transition]
+    assert messages.column_events == sum(
+        o.blocker is not None and not o.no_transition for o in taken
+    )
     # Each case shows what it is here for.
     if scenario_name in ("three-joint", "thesis-obstacles", "seven"):
-        assert blocked
+        assert any(o.blocker is not None for o in taken)
     if scenario_name == "one-joint-10":
-        assert no_transition
+        assert any(o.no_transition for o in taken)
     if scenario_name in ("two-joint-30", "thesis-algo"):
-        assert len(versions) > 1
+        assert len({record.split(b'"model_version":')[1][:4] for record in expected}) > 1
 
 
 def test_then_follows_every_step_while_something_waits() -> None:
-    runner = Runner(load_scenario("two-joint-30"), RandomStrategy(), seed=1)
+    """While something waits (a model change, a note), a step's messages are whole and
+    ``then`` follows it, a blocked step's included (its event comes from ``then``)."""
+    runner = Runner(load_scenario("three-joint"), RandomStrategy(), seed=1)
     waiting: list[int] = []
     taken: list[StepOutcome] = []
     followed: list[int] = []
 
     def steps() -> Iterator[StepOutcome]:
-        for outcome in live(runner, 40, taken):
-            if outcome.step % 10 == 0:
+        for outcome in live(runner, 400, taken):
+            if outcome.step % 10 == 0 or outcome.blocker is not None and outcome.step % 2:
                 waiting.append(1)  # as a model change or a note during the step would
             yield outcome
 
@@ -154,15 +169,18 @@ def test_then_follows_every_step_while_something_waits() -> None:
         waiting.clear()
         return iter(())
 
-    stream = StepMessages().stream(
-        steps(), runner.world, runner.model, channel=1, waiting=waiting, then=then
+    messages = StepMessages()
+    blocks = messages.blocks(
+        steps(), runner.world, runner.model, channel=STEP, waiting=waiting, then=then, steps=64
     )
-    assert len(list(stream)) == 40
-    plain = [o.step for o in taken if o.blocker is None and not o.no_transition]
-    assert len(plain) > 30
-    assert followed == [
-        o.step for o in taken if o.step % 10 == 0 or o.blocker is not None or o.no_transition
-    ]
+    got = list(BlockMessages(STEP, EVENT).of(blocks))
+    assert [m[1] // 1_000_000 for m in got if m[0] == STEP] == [o.step for o in taken]
+    waited = [o.step for o in taken if o.step % 10 == 0 or o.blocker is not None and o.step % 2]
+    assert followed == waited
+    blocked = [o.step for o in taken if o.blocker is not None and o.step not in waited]
+    assert blocked  # blocked steps of both kinds
+    assert [m[1] // 1_000_000 for m in got if m[0] == EVENT] == blocked
+    assert messages.column_events == len(blocked)
 
 
 def test_past_its_bound_the_pose_cache_keeps_nothing_more_and_the_bytes_stay() -> None:
@@ -170,21 +188,30 @@ def test_past_its_bound_the_pose_cache_keeps_nothing_more_and_the_bytes_stay() -
     poses met after are encoded at each visit, to the same bytes."""
     runner = Runner(load_scenario("three-joint"), RandomStrategy(), seed=5)
     messages = StepMessages(cache_bytes=3000)  # a pose's parts are about 500 bytes
-    poses = set()
     taken: list[StepOutcome] = []
-    stream = messages.stream(
-        live(runner, 500, taken),
-        runner.world,
-        runner.model,
-        channel=1,
-        waiting=(),
-        then=lambda _: iter(()),
+    expected: list[bytes] = []
+    blocks = list(
+        messages.blocks(
+            live(runner, 500, taken, expected),
+            runner.world,
+            runner.model,
+            channel=STEP,
+            waiting=(),
+            then=lambda _: iter(()),
+            steps=50,
+        )
     )
-    for _, _, head, tail in stream:
-        poses.add(runner.world.current)
-        assert head + tail == expected_step(runner, taken[-1]), taken[-1]
-    assert len(poses) > 50
-    # The poses' parts and the steps' tails (at the one model version) share the bound.
+    got = [data + tail for ch, _, data, tail in BlockMessages(STEP, EVENT).of(blocks) if ch == STEP]
+    assert got == expected
+    poses = {record.split(b'"truth":')[1] for record in expected}
+    assert len(poses) > 50  # many poses, past the few the bound keeps
+    # The poses' parts and the tails given (at the one model version) share the bound.
     sizes = [len(head) + len(tail) for head, tail, _ in messages._poses.values()]
-    sizes += [len(tail) for tail in messages._tails.values()]
+    sizes += [
+        len(t)
+        for block in blocks
+        for item in block
+        if isinstance(item, Steps)
+        for t in item.new_tails
+    ]
     assert 3000 <= sum(sizes) < 3000 + max(sizes)  # kept while below the bound, then no more

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from rsstp_sim.errors import RecordingError
 from rsstp_sim.files import irregular, side_file
+from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.switching import sooner_switches
 
 __all__ = ["SideFileWriter", "open_side_file"]
@@ -44,14 +45,13 @@ class SideFileWriter:
 
     A write error is raised by the next call (the next chunk's hand-off, at most a chunk
     later) and kept in ``error``; nothing is written after it. ``safe_steps`` is the last
-    step whose messages are all in chunks on disk: the step before the one being recorded
-    when the last chunk written was handed over (a chunk ends inside a step, whose other
-    messages follow in the next).
+    step whose messages are all in chunks on disk: the step before the latest step with a
+    message in the last chunk written (a chunk ends inside a step, whose other messages
+    follow in the next; a message's log time is its step's, ``step * STEP_NS``).
     """
 
-    def __init__(self, raw: io.FileIO, steps_done: Callable[[], int]) -> None:
+    def __init__(self, raw: io.FileIO) -> None:
         self._raw = raw
-        self._steps_done = steps_done
         self._position = raw.tell()
         self.safe_steps = 0
         self.error: BaseException | None = None  # the write error, told apart from others
@@ -64,10 +64,10 @@ class SideFileWriter:
 
     def write(self, data: bytes) -> None:
         self._wait()
-        self._write(data, self._mark())
+        self._write(data, self.safe_steps)
 
-    def write_later(self, build: Callable[[int], bytes]) -> None:
-        mark = self._mark()
+    def write_later(self, build: Callable[[int], bytes], end_time: int) -> None:
+        mark = max(0, end_time // STEP_NS - 1)
         self._free.acquire()  # the chunk before is written
         if self.error is not None:
             self._free.release()
@@ -81,9 +81,6 @@ class SideFileWriter:
     def tell(self) -> int:
         self._wait()
         return self._position
-
-    def _mark(self) -> int:
-        return max(0, self._steps_done() - 1)
 
     def _wait(self) -> None:
         """Until the chunk in flight is written; raise its error, if any."""

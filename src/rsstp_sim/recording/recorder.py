@@ -33,15 +33,21 @@ import json
 import os
 import platform
 from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Sequence
-from contextlib import closing, contextmanager
+from contextlib import closing, contextmanager, suppress
 from dataclasses import dataclass, replace
 from importlib import metadata
 from pathlib import Path
 
 from rsstp_sim.coupling import Event, Runner, StepOutcome
-from rsstp_sim.errors import RecordingError, RecordingWriteError, RsstpError
+from rsstp_sim.errors import (
+    ChunkProcessFailed,
+    RecordingError,
+    RecordingWriteError,
+    RsstpError,
+)
 from rsstp_sim.files import side_file
 from rsstp_sim.recording import builders, records
+from rsstp_sim.recording.chunk_process import ChunkProcess
 from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter, open_side_file
 from rsstp_sim.recording.schemas import (
@@ -56,15 +62,29 @@ from rsstp_sim.recording.schemas import (
     metadata_checksum,
     schema_bytes,
 )
-from rsstp_sim.recording.step_messages import StepMessages
+from rsstp_sim.recording.step_messages import Block, BlockMessages, StepMessages
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.strategies import Strategy, strategy_origin
 from rsstp_sim.transition_system import Operation
 
-__all__ = ["DEFAULT_CHUNK_SIZE", "RecordResult", "Recorder", "environment_versions", "record"]
+__all__ = [
+    "DEFAULT_CHUNK_SIZE",
+    "HELPER_STEPS",
+    "RecordResult",
+    "Recorder",
+    "environment_versions",
+    "record",
+]
 
 DEFAULT_CHUNK_SIZE = 1024 * 1024
 """Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
+
+HELPER_STEPS = 65_536
+"""A run of this many steps or more builds its chunks in a helper process by default
+(:meth:`Recorder.run`): the helper's start (about 0.2 s of the other core) pays for itself."""
+
+_BLOCK_STEPS = 64  # the steps whose messages are built before they go into the chunk
+_HELPER_BLOCK_STEPS = 4096  # ... before they go to the helper
 
 _VERSION_KEYS = ("package_version", "python", "numpy", "shapely", "mcap")
 
@@ -145,7 +165,7 @@ class Recorder:
         self._counts = dict.fromkeys(self._topics, 0)
         self.side_file = side_file(self.path)
         self._raw = open_side_file(self.path, force=force)
-        self._file = SideFileWriter(self._raw, lambda: self.runner.step_index)
+        self._file = SideFileWriter(self._raw)
         self._writer = ChunkedWriter(self._file, chunk_size=chunk_size)
         self._closed = False
         try:
@@ -192,6 +212,10 @@ class Recorder:
         for topic, name in self._topics.items():
             self._channels[topic] = writer.register_channel(topic, "json", schema_ids[name])
         self._step_channel = self._channels["/rsstp/step"]
+        # The channels of the steps and of their blocked events that StepMessages.blocks
+        # leaves in columns.
+        self._column_channels = (self._step_channel, self._channels["/rsstp/event"])
+        self._block_messages = BlockMessages(*self._column_channels)
         params = dict(strategy.params())
         origin = strategy_origin(strategy)
         if origin.distribution == "rsstp":  # ours: the version the metadata names
@@ -234,15 +258,19 @@ class Recorder:
         self._counts[topic] += 1
         return self._channels[topic], step * STEP_NS, data, tail
 
-    def _step_messages(self, outcomes: Iterable[StepOutcome]) -> Generator[Message, None, None]:
-        """The messages of each step of ``outcomes``, in file order."""
-        return self._messages.stream(
+    def _step_blocks(
+        self, outcomes: Iterable[StepOutcome], *, steps: int
+    ) -> Generator[Block, None, None]:
+        """The messages of each step of ``outcomes``, in file order, in blocks of ``steps``
+        steps."""
+        return self._messages.blocks(
             outcomes,
             self.runner.world,
             self.runner.model,
             channel=self._step_channel,
             waiting=self._waiting,
             then=self._after_step,
+            steps=steps,
         )
 
     def _after_step(self, outcome: StepOutcome) -> Iterator[Message]:
@@ -289,10 +317,19 @@ class Recorder:
         """Ask the run to end after the current step (safe from a signal handler)."""
         self._stop = True
 
-    def run(self, steps: int, *, progress: Callable[[int], None] | None = None) -> RecordResult:
+    def run(
+        self,
+        steps: int,
+        *,
+        progress: Callable[[int], None] | None = None,
+        helper: bool | None = None,
+    ) -> RecordResult:
         """Take and record ``steps`` steps, then finish the file.
 
         ``progress`` is called with the number of steps done every 4,096 steps and at the end.
+        ``helper``: build the chunks in a helper process beside the run
+        (:mod:`~rsstp_sim.recording.chunk_process`; the same bytes); by default when
+        ``steps`` is at least :data:`HELPER_STEPS`.
         Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`. When
         the strategy ends the run (:attr:`Runner.stopped <rsstp_sim.coupling.Runner.stopped>`),
         the file ends with an event saying so, at that step, of a budget of ``steps``.
@@ -301,8 +338,13 @@ class Recorder:
         self._budget = self.runner.step_index + steps
         # Closed as soon as the writing ends, so that the steps taken are counted then.
         outcomes = self._outcomes(steps, progress)
+        if helper is None:
+            helper = steps >= HELPER_STEPS
         with self._closed_on_failure(), closing(outcomes):
-            self._write(outcomes)
+            if helper:
+                self._write_helped(outcomes)
+            else:
+                self._write(outcomes)
         self.close()
         return self.result()
 
@@ -327,8 +369,46 @@ class Recorder:
 
     def _write(self, outcomes: Iterable[StepOutcome]) -> None:
         """Write the messages of the steps ``outcomes`` takes."""
-        with closing(self._step_messages(outcomes)) as messages:
-            self._writer.add_messages(messages)
+        with closing(self._step_blocks(outcomes, steps=_BLOCK_STEPS)) as blocks:
+            self._writer.add_messages(self._block_messages.of(blocks))
+
+    def _write_helped(self, outcomes: Iterable[StepOutcome]) -> None:
+        """:meth:`_write`, the chunks built in a helper process (in this one when none can
+        be started). A failure of the run keeps the steps before it, as :meth:`_write` does;
+        a failure of the helper or of the disk loses those it held."""
+        writer = self._writer
+        chunk = writer.hand_over()
+        self._messages.restart_tails()  # the helper's BlockMessages starts without any
+        try:
+            helper = ChunkProcess(
+                chunk, chunk_size=writer.chunk_size, channels=self._column_channels
+            )
+        except OSError:
+            writer.take_back(chunk)
+            self._write(outcomes)
+            return
+        try:
+            with closing(self._step_blocks(outcomes, steps=_HELPER_BLOCK_STEPS)) as blocks:
+                for block in blocks:
+                    for packed in helper.send(block):
+                        writer.add_packed(packed)
+        except BaseException as exc:
+            if not (exc is self._file.error or isinstance(exc, ChunkProcessFailed)):
+                with suppress(Exception):  # the run's own error is the one to tell
+                    self._end_helper(helper)
+            raise
+        else:
+            self._end_helper(helper)
+        finally:
+            helper.close()
+
+    def _end_helper(self, helper: ChunkProcess) -> None:
+        """Write the helper's last chunks and go on with the chunk it leaves open."""
+        packed, chunk = helper.finish()
+        for one in packed:
+            self._writer.add_packed(one)
+        self._writer.take_back(chunk)
+        self._messages.restart_tails()  # ours has not seen those the helper's got
 
     def _write_stop(self) -> None:
         """The event that ends a run the strategy stopped: its last message."""
@@ -352,7 +432,7 @@ class Recorder:
         return RecordResult(
             self.path,
             self.runner.step_index,
-            dict(self._counts),
+            dict(self.counts),
             self._stop,
             self.runner.agent.stopped,
             self._budget,
@@ -445,7 +525,9 @@ class Recorder:
 
     @property
     def counts(self) -> Mapping[str, int]:
-        return dict(self._counts)
+        counts = dict(self._counts)
+        counts["/rsstp/event"] += self._messages.column_events  # (not through _message)
+        return counts
 
 
 _MCAP_MAGIC = b"\x89MCAP0\r\n"

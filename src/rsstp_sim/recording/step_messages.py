@@ -7,6 +7,12 @@ with one ``%`` format. A message comes as two parts, the step's head and the pos
 which the chunk writer joins with the rest of the chunk (the tail is not copied per step).
 A step that moved (most steps) has a head of its four numbers alone: its tail, the pose's
 part with the model's version in it, is kept per pose while the version stays.
+
+The steps come in blocks (:meth:`StepMessages.blocks`) that say such a plain step in four
+integers, its action, states and tail number (:class:`Steps`), and give every other message
+whole; :class:`BlockMessages` turns blocks into messages, in this process or in the helper
+process that builds a long run's chunks (:mod:`~rsstp_sim.recording.chunk_process`), where
+the blocks go as a few integers a step.
 A blocked event's JSON after its step number depends on the action and the blocker alone,
 and is encoded once per pair.
 
@@ -21,7 +27,7 @@ float feedback, one to seven links).
 from __future__ import annotations
 
 from collections.abc import Callable, Generator, Iterable, Sized
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 from rsstp_sim.recording import builders
 from rsstp_sim.recording.chunks import Message
@@ -34,7 +40,7 @@ if TYPE_CHECKING:
     from rsstp_sim.transition_system import TransitionSystem
     from rsstp_sim.world import Pose, World
 
-__all__ = ["POSE_CACHE_BYTES", "StepMessages"]
+__all__ = ["POSE_CACHE_BYTES", "Block", "BlockMessages", "StepMessages", "Steps"]
 
 POSE_CACHE_BYTES = 128 * 1024 * 1024
 """The most bytes of poses' encoded parts and tails kept for the poses met again
@@ -48,6 +54,61 @@ _AGENT = b',"sensation":%b,"feedback":%b,"model_version":'
 _MOVED = b',"no_transition":false},"truth":{'
 _UNBLOCKED = b'"blocked":false'
 _TAIL = b',"no_transition":%b},"truth":{%b%b%b}}'
+_EVENT = b'{"step":%d'
+
+
+class Steps(NamedTuple):
+    """Plain steps in a row from step ``first``: ``columns`` holds each one's action, state
+    before, internal state and tail number, in turn. A tail number counts the tails of
+    ``epoch`` (one epoch a model version): ``new_tails`` are the next ones, in order. A
+    blocked step's number is ``~k``: its tail is number ``k`` and the tail of its ``blocked``
+    event, which follows it, number ``k + 1``."""
+
+    first: int
+    epoch: int
+    new_tails: list[bytes]
+    columns: list[int]
+
+
+Block = list["Steps | Message"]
+"""Steps' messages in order: plain steps as :class:`Steps`, every other message whole."""
+
+
+class BlockMessages:
+    """Turns blocks into messages, keeping the tails their :class:`Steps` gave: one a run
+    (or a helper's part of it), fed its blocks in order."""
+
+    def __init__(self, step_channel: int, event_channel: int) -> None:
+        self._channels = step_channel, event_channel
+        self._tails: list[bytes] = []
+        self._epoch = -1
+
+    def of(self, blocks: Iterable[Block]) -> Generator[Message, None, None]:
+        """The messages of ``blocks``, in order: a plain step's on the step channel, a
+        blocked step's event on the event channel."""
+        step_channel, event_channel = self._channels
+        tails = self._tails
+        for block in blocks:
+            for item in block:
+                if item.__class__ is not Steps:
+                    yield item  # type: ignore[misc]  # (a Message: not Steps)
+                    continue
+                first, epoch, new_tails, columns = item  # type: ignore[misc]
+                if epoch != self._epoch:
+                    tails = self._tails = []
+                    self._epoch = epoch
+                tails += new_tails
+                t = first
+                each = iter(columns)
+                for action, before, state, tail in zip(each, each, each, each, strict=True):
+                    head = _STEP % (t, action, before, state)
+                    if tail >= 0:
+                        yield step_channel, t * STEP_NS, head, tails[tail]
+                    else:
+                        at = t * STEP_NS
+                        yield step_channel, at, head, tails[~tail]
+                        yield event_channel, at, _EVENT % t, tails[-tail]  # (number ~tail + 1)
+                    t += 1
 
 
 class StepMessages:
@@ -65,10 +126,16 @@ class StepMessages:
         self._truth: tuple[bytes, bytes] | None = None  # templates around "blocked"
         self._blocked_truth: dict[Blocker, bytes] = {}
         self._blocked_events: dict[tuple[int, Blocker], bytes] = {}
-        # pose -> a plain step's tail at model version ``_version`` (see _tail)
+        # pose -> the number of a plain step's tail at model version ``_version`` (see
+        # _tail), counted in the ``_epoch`` th version met
         self._version = -1
-        self._tails: dict[Pose, bytes] = {}
+        self._epoch = 0
+        self._tail_ids: dict[Pose, int] = {}
+        self._blocked_ids: dict[tuple[Pose, int], int] = {}  # (pose, action) -> ~number
+        self._tails_given = 0  # tails numbered in this epoch
         self._tail_bytes = 0
+        self.column_events = 0
+        """Blocked events given as a blocked step's tail in :class:`Steps` (not by ``then``)."""
 
     def _parts(self, pose: Pose) -> tuple[bytes, bytes, int]:
         angles, positions, distances = pose.truth_values()
@@ -86,29 +153,29 @@ class StepMessages:
             self._room -= len(head) + len(moved)
         return parts
 
-    def _new_version(self, version: int) -> dict[Pose, bytes]:
+    def restart_tails(self) -> None:
+        """Number the tails from 0 again, in a new epoch: the blocks go to a new
+        :class:`BlockMessages` (a helper process's, or back from it)."""
+        self._new_version()
+
+    def _new_version(self) -> None:
         """Drop the tails kept for the version before: the model changed."""
         self._room += self._tail_bytes
-        self._version, self._tails, self._tail_bytes = version, {}, 0
-        return self._tails
+        self._epoch += 1
+        self._tail_ids, self._blocked_ids, self._tails_given, self._tail_bytes = {}, {}, 0, 0
 
-    def _tail(self, pose: Pose) -> bytes:
-        """A plain step's message after its own numbers, at ``pose`` and the current version:
+    def _tail(self, pose: Pose, version: int) -> bytes:
+        """A plain step's message after its own numbers, at ``pose`` and model ``version``:
         the pose's agent part, the version and the rest, one bytes object."""
         head, moved, _ = self._poses.get(pose) or self._parts(pose)
-        tail = b"%b%d%b" % (head, self._version, moved)
-        if self._room > 0:
-            self._tails[pose] = tail
-            self._room -= len(tail)
-            self._tail_bytes += len(tail)
-        return tail
+        return b"%b%d%b" % (head, version, moved)
 
     def first(self, pose: Pose, *, internal_state: int, model_version: int) -> tuple[bytes, bytes]:
         """Step 0's message (the reset, at ``pose``): head and tail."""
         head, moved, _ = self._poses.get(pose) or self._parts(pose)
         return _FIRST_HEAD % (internal_state, head, model_version), moved
 
-    def stream(
+    def blocks(
         self,
         outcomes: Iterable[StepOutcome],
         world: World,
@@ -117,36 +184,128 @@ class StepMessages:
         channel: int,
         waiting: Sized,
         then: Callable[[StepOutcome], Iterable[Message]],
-    ) -> Generator[Message, None, None]:
-        """The messages of each step of ``outcomes``, as it is taken: its ``rsstp.Step``
-        message on ``channel`` (at the world's pose and the model's version after the step),
-        then, if the step was blocked, found no transition, or ``waiting`` is not empty, the
-        messages of ``then(outcome)``."""
-        kept, parts_of = self._poses.get, self._parts
-        version, tails = self._version, self._tails
-        for outcome in outcomes:
-            t, action, state_before, state_after, blocker, no_transition, _ = outcome
-            pose = world.current
-            if blocker is None and not no_transition:
-                if model.version != version:
-                    version, tails = model.version, self._new_version(model.version)
-                tail = tails.get(pose)
-                if tail is None:
-                    tail = self._tail(pose)
-                yield channel, t * STEP_NS, _STEP % (t, action, state_before, state_after), tail
-                if waiting:
-                    yield from then(outcome)
-                continue
-            head, moved, cut = kept(pose) or parts_of(pose)
-            first = _HEAD % (t, action, state_before, state_after, head, model.version)
-            tail = _TAIL % (
-                b"true" if no_transition else b"false",
+        steps: int,
+    ) -> Generator[Block, None, None]:
+        """The messages of the steps of ``outcomes``, as each is taken, in blocks of
+        ``steps`` steps (the last one shorter): a step's ``rsstp.Step`` message (at the
+        world's pose and the model's version after the step), then, if the step was
+        blocked, found no transition, or ``waiting`` is not empty, the messages of
+        ``then(outcome)`` (built then). A step that moved by a transition, or was blocked
+        while nothing waits, goes into a :class:`Steps` while its tails are kept (then
+        ``then`` is not called for it: its only message after is its blocked event); the
+        other messages are whole, a step's on ``channel`` (the step channel of the
+        :class:`BlockMessages` they go to). When ``outcomes`` fails, the block so far comes
+        first."""
+        version, tail_ids = self._version, self._tail_ids
+        block: Block = []
+        columns: list[int] = []
+        fresh: list[bytes] = []
+        follows = -1  # the step that goes on ``columns``
+        taken = 0
+        try:
+            for outcome in outcomes:
+                t, action, state_before, state_after, blocker, no_transition, _ = outcome
+                pose = world.current
+                if not no_transition and (blocker is None or not waiting):
+                    if model.version != version:
+                        version = self._version = model.version
+                        self._new_version()
+                        tail_ids, follows = self._tail_ids, -1
+                    if t != follows:
+                        columns, fresh = [], []
+                        block.append(Steps(t, self._epoch, fresh, columns))
+                    tail: int | bytes | None
+                    if blocker is None:
+                        tail = tail_ids.get(pose)
+                        if tail is None:
+                            tail = self._new_tail(pose, version, fresh)
+                    else:
+                        tail = self._blocked_tail(pose, action, blocker, version, fresh)
+                    if tail.__class__ is int:
+                        columns += (action, state_before, state_after, tail)
+                        follows = t + 1
+                    elif blocker is None:  # not kept (the bound): the message whole
+                        head = _STEP % (t, action, state_before, state_after)
+                        block.append((channel, t * STEP_NS, head, tail))  # type: ignore[arg-type]
+                        follows = -1
+                    else:  # the same, and its event after it
+                        whole = self._blocked_step(outcome, pose, model.version)
+                        block.append((channel, t * STEP_NS, *whole))
+                        block += then(outcome)
+                        follows = -1
+                    if waiting:
+                        block += then(outcome)
+                        follows = -1
+                else:
+                    whole = self._blocked_step(outcome, pose, model.version)
+                    block.append((channel, t * STEP_NS, *whole))
+                    block += then(outcome)
+                    follows = -1
+                taken += 1
+                if taken == steps:
+                    yield block
+                    block, taken, follows = [], 0, -1
+        except GeneratorExit:
+            raise
+        except BaseException:
+            if block:
+                yield block
+            raise
+        if block:
+            yield block
+
+    def _blocked_step(self, outcome: StepOutcome, pose: Pose, version: int) -> tuple[bytes, bytes]:
+        """The message of a step that was blocked or found no transition: head and tail."""
+        t, action, state_before, state_after, blocker, no_transition, _ = outcome
+        head, moved, cut = self._poses.get(pose) or self._parts(pose)
+        first = _HEAD % (t, action, state_before, state_after, head, version)
+        rest = _TAIL % (
+            b"true" if no_transition else b"false",
+            moved[len(_MOVED) : cut],
+            _UNBLOCKED if blocker is None else self._blocked(blocker),
+            moved[cut + len(_UNBLOCKED) : -2],
+        )
+        return first, rest
+
+    def _blocked_tail(
+        self, pose: Pose, action: int, blocker: Blocker, version: int, fresh: list[bytes]
+    ) -> int | None:
+        """The number of a step blocked at ``pose`` by ``action`` at ``version`` (see
+        :class:`Steps`), its tails added to ``fresh`` if new; None past the bound."""
+        key = (pose, action)
+        number = self._blocked_ids.get(key)
+        if number is None:
+            if self._room <= 0:
+                return None
+            head, moved, cut = self._poses.get(pose) or self._parts(pose)
+            rest = _TAIL % (
+                b"false",
                 moved[len(_MOVED) : cut],
-                _UNBLOCKED if blocker is None else self._blocked(blocker),
+                self._blocked(blocker),
                 moved[cut + len(_UNBLOCKED) : -2],
             )
-            yield channel, t * STEP_NS, first, tail
-            yield from then(outcome)
+            step = b"%b%d%b" % (head, version, rest)
+            event = self._event_tail(action, blocker)
+            number = self._blocked_ids[key] = ~self._tails_given
+            fresh += (step, event)
+            self._tails_given += 2
+            self._room -= len(step) + len(event)
+            self._tail_bytes += len(step) + len(event)
+        self.column_events += 1
+        return number
+
+    def _new_tail(self, pose: Pose, version: int, fresh: list[bytes]) -> int | bytes:
+        """The tail number of ``pose`` at ``version``, its tail added to ``fresh``; or,
+        past the bound, the tail itself (not kept)."""
+        tail = self._tail(pose, version)
+        if self._room <= 0:
+            return tail
+        number = self._tail_ids[pose] = self._tails_given
+        fresh.append(tail)
+        self._tails_given += 1
+        self._room -= len(tail)
+        self._tail_bytes += len(tail)
+        return number
 
     def _blocked(self, blocker: Blocker) -> bytes:
         truth = self._blocked_truth.get(blocker)
@@ -157,12 +316,16 @@ class StepMessages:
 
     def blocked_event(self, step: int, action: int, blocker: Blocker) -> bytes:
         """The ``blocked`` event of ``action`` at ``step``."""
+        return _EVENT % step + self._event_tail(action, blocker)
+
+    def _event_tail(self, action: int, blocker: Blocker) -> bytes:
+        """The ``blocked`` event of ``action`` after its step number."""
         key = (action, blocker)
         tail = self._blocked_events.get(key)
         if tail is None:
             whole = encode(builders.blocked_event(0, action=action, blocker=blocker))
-            tail = self._blocked_events[key] = whole.removeprefix(b'{"step":0')
-        return b'{"step":%d%b' % (step, tail)
+            tail = self._blocked_events[key] = whole.removeprefix(_EVENT % 0)
+        return tail
 
 
 def _truth_templates(n: int, m: int) -> tuple[bytes, bytes]:

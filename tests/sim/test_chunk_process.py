@@ -1,0 +1,225 @@
+"""A long run's chunks built in a helper process: the same bytes, and failures said in a line.
+
+The recorder builds a long run's chunks in a helper process (``Recorder.run(helper=True)``,
+the default from ``HELPER_STEPS`` steps). Its file must be the one the recorder writes alone
+(which ``test_chunks.py`` and ``test_step_messages.py`` hold to mcap's ``Writer`` and the
+record encoder), whatever the run does: model changes, notes, blocked moves, steps with no
+transition, chunks of every size, steps recorded one at a time before and after. A helper
+that dies or fails is one line, and the recorder keeps the steps it had written; a helper
+that cannot start leaves the recorder to do the work alone. The signals and the disk's
+errors of a helped run are in ``test_record_cli.py``.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+from mcap.reader import make_reader
+
+from rsstp_sim import RandomStrategy, load_scenario
+from rsstp_sim.errors import ChunkProcessFailed, RecordingError
+from rsstp_sim.recording.chunk_process import ChunkProcess
+from rsstp_sim.recording.chunks import OpenChunk
+from rsstp_sim.recording.recorder import HELPER_STEPS, Recorder
+from rsstp_sim.recording.step_messages import Steps
+from rsstp_sim.strategies import make_strategy
+
+RUNS = [
+    # scenario, strategy, steps, chunk size: what the run has
+    ("three-joint", "random", 20_000, 4096),  # blocked moves, many small chunks
+    ("three-joint", "random", 9_000, 1 << 20),  # all in the first chunk: the helper's last
+    ("thesis-algo", "learner", 3_000, 2048),  # model changes, notes, phases
+    ("two-joint-30", "splitter", 3_000, 8192),  # splits, steps with no transition
+    ("thesis-obstacles", "roulette", 5_000, 3000),
+]
+
+
+def recorded(path: Path, scenario: str, strategy: str, *, chunk_size: int) -> Recorder:
+    return Recorder(
+        path, load_scenario(scenario), make_strategy(strategy), seed=4, chunk_size=chunk_size
+    )
+
+
+@pytest.mark.parametrize(("scenario", "strategy", "steps", "chunk_size"), RUNS)
+def test_a_helped_run_writes_the_bytes_of_a_run_alone(
+    tmp_path: Path, scenario: str, strategy: str, steps: int, chunk_size: int
+) -> None:
+    alone, helped = tmp_path / "alone.mcap", tmp_path / "helped.mcap"
+    first = recorded(alone, scenario, strategy, chunk_size=chunk_size).run(steps, helper=False)
+    second = recorded(helped, scenario, strategy, chunk_size=chunk_size).run(steps, helper=True)
+    assert helped.read_bytes() == alone.read_bytes()
+    assert second.messages == first.messages
+    with helped.open("rb") as stream:
+        summary = make_reader(stream).get_summary()
+    assert summary is not None and summary.statistics is not None
+    counts = summary.statistics.channel_message_counts
+    assert {c.topic: counts.get(c.id, 0) for c in summary.channels.values()} == second.messages
+
+
+def test_steps_one_at_a_time_then_a_helped_run(tmp_path: Path) -> None:
+    """The recorder hands the chunk its own steps were building to the helper, and takes
+    back the helper's last one for the stop event and the summary."""
+    files = []
+    for helper in (False, True):
+        path = tmp_path / f"{helper}.mcap"
+        recorder = recorded(path, "thesis-algo", "learner", chunk_size=4096)
+        for _ in range(300):
+            recorder.step()
+        recorder.run(2_000, helper=helper)
+        files.append(path.read_bytes())
+    assert files[0] == files[1]
+
+
+def test_a_long_run_is_helped_by_default(tmp_path: Path) -> None:
+    """From HELPER_STEPS steps: a helper process runs while the run does."""
+    recorder = Recorder(tmp_path / "run.mcap", load_scenario("two-joint-30"), RandomStrategy(),
+                        seed=1)  # fmt: skip
+    seen: list[list[int]] = []
+    recorder.run(HELPER_STEPS, progress=lambda done: seen.append(helpers()))
+    assert seen[0] and all(found == seen[0] for found in seen)  # one helper, all along
+    assert not alive(seen[0])
+    short = Recorder(tmp_path / "short.mcap", load_scenario("two-joint-30"), RandomStrategy(),
+                     seed=1)  # fmt: skip
+    seen.clear()
+    short.run(HELPER_STEPS - 1, progress=lambda done: seen.append(helpers()))
+    assert seen and not any(seen)
+
+
+def helpers() -> list[int]:
+    """The process ids of this process's helpers (its children running chunk_process)."""
+    found = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            stat = Path(f"/proc/{entry}/stat").read_text()
+            command = Path(f"/proc/{entry}/cmdline").read_bytes()
+        except OSError:  # ended meanwhile
+            continue
+        parent = int(stat.rpartition(")")[2].split()[1])
+        if parent == os.getpid() and b"rsstp_sim.recording.chunk_process" in command:
+            found.append(int(entry))
+    return found
+
+
+def alive(pids: list[int]) -> bool:
+    return any(Path(f"/proc/{pid}").exists() for pid in pids)
+
+
+def test_a_helper_killed_mid_run_is_one_line_and_the_steps_written_stay(tmp_path: Path) -> None:
+    path = tmp_path / "run.mcap"
+    recorder = recorded(path, "three-joint", "random", chunk_size=4096)
+    killed: list[int] = []
+
+    def kill_the_helper(done: int) -> None:
+        if done >= 4 * 4096 and not killed:
+            (pid,) = helpers()
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+
+    side = tmp_path / "run.mcap.partial"
+    said = (
+        "the helper process that builds the chunks ended before the run did (signal SIGKILL); "
+        f"the steps before it are in {side} (finished); {path} was not touched"
+    )
+    with pytest.raises(RecordingError, match=re.escape(said)):
+        recorder.run(200_000, progress=kill_the_helper, helper=True)
+    assert killed and not path.exists()
+    with side.open("rb") as stream:
+        reader = make_reader(stream)
+        steps = [
+            int(re.match(rb'\{"step":(\d+)', message.data)[1])  # type: ignore[index]
+            for _, channel, message in reader.iter_messages(log_time_order=False)
+            if channel.topic == "/rsstp/step"
+        ]
+    assert len(steps) > 4096  # the chunks written before the helper died
+    assert steps == list(range(len(steps)))
+
+
+def test_a_helper_that_fails_says_why_in_one_line() -> None:
+    helper = ChunkProcess(OpenChunk([], 0, 0), chunk_size=1024, channels=(1, 2))
+    try:
+        # A tail number no block gave: the helper's own code fails.
+        helper.send([Steps(1, 0, [b"}"], [0, 0, 0, 5])])
+        with pytest.raises(
+            ChunkProcessFailed,
+            match=r"^the helper process that builds the chunks failed: IndexError: list index",
+        ):
+            helper.finish()
+    finally:
+        helper.close()
+
+
+def test_a_helper_gives_back_the_chunk_it_was_given_when_nothing_came() -> None:
+    records = [b"a lead record"]
+    helper = ChunkProcess(OpenChunk(records, 1, 13), chunk_size=1024, channels=(1, 2))
+    try:
+        assert helper.finish() == ([], OpenChunk(records, 1, 13))
+    finally:
+        helper.close()
+
+
+def test_closing_a_helper_ends_it_at_once() -> None:
+    helper = ChunkProcess(OpenChunk([], 0, 0), chunk_size=1024, channels=(1, 2))
+    (pid,) = helpers()
+    started = time.monotonic()
+    helper.close()
+    assert time.monotonic() - started < 5 and not alive([pid])
+
+
+def test_no_helper_can_start_and_the_recorder_does_the_work(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    alone = tmp_path / "alone.mcap"
+    recorded(alone, "three-joint", "random", chunk_size=4096).run(6_000, helper=False)
+    monkeypatch.setattr(sys, "executable", str(tmp_path / "no-python-here"))
+    helped = tmp_path / "helped.mcap"
+    recorded(helped, "three-joint", "random", chunk_size=4096).run(6_000, helper=True)
+    assert helped.read_bytes() == alone.read_bytes()
+
+
+def test_the_helper_runs_this_process_code_wherever_it_was_imported_from(
+    tmp_path: Path,
+) -> None:
+    """A script that put a copy of the package on its path itself: its helper imports that
+    copy, not the installed one. The copy compresses at another zstd level, so a file whose
+    chunks came from the installed package would differ from the copy's run alone."""
+    copy = tmp_path / "copy"
+    shutil.copytree(Path(__file__).resolve().parents[2] / "src" / "rsstp_sim", copy / "rsstp_sim")
+    chunks = copy / "rsstp_sim" / "recording" / "chunks.py"
+    text = chunks.read_text()
+    assert "_ZSTD_LEVEL = 3" in text
+    chunks.write_text(text.replace("_ZSTD_LEVEL = 3", "_ZSTD_LEVEL = 9"))
+    script = tmp_path / "script.py"
+    script.write_text(
+        "import sys\n"
+        f"sys.path.insert(0, {str(copy)!r})\n"
+        "import rsstp_sim\n"
+        f"assert rsstp_sim.__file__.startswith({str(copy)!r})\n"
+        "from rsstp_sim import RandomStrategy, load_scenario\n"
+        "from rsstp_sim.recording.recorder import Recorder\n"
+        "recorder = Recorder(sys.argv[1], load_scenario('three-joint'), RandomStrategy(), seed=4,\n"
+        "                    chunk_size=4096)\n"
+        "recorder.run(5_000, helper=sys.argv[2] == 'helped')\n"
+    )
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    files = []
+    for how in ("alone", "helped"):
+        out = tmp_path / f"{how}.mcap"
+        done = subprocess.run(
+            [sys.executable, str(script), str(out), how], env=env, capture_output=True, text=True
+        )
+        assert done.returncode == 0, done.stderr
+        files.append(out.read_bytes())
+    assert files[0] == files[1]
+    installed = tmp_path / "installed.mcap"
+    recorded(installed, "three-joint", "random", chunk_size=4096).run(5_000, helper=False)
+    assert installed.read_bytes() != files[0]  # the copy's level shows
