@@ -15,7 +15,8 @@ The helper is ``python -m rsstp_sim.recording.chunk_process`` on two pipes. It i
 SIGINT and SIGTERM (Ctrl-C reaches the whole process group: the recorder ends the run, then
 the helper), and it ends as soon as the recorder's end of its pipe closes, so a killed
 recorder leaves no helper behind. A killed recorder loses the steps not yet back from the
-helper (a few blocks); what it wrote stays a readable prefix.
+helper (the blocks in the pipe and the helper's chunk: ``bench/kill_loss.py``); what it wrote
+stays a readable prefix.
 """
 
 from __future__ import annotations
@@ -47,9 +48,9 @@ from rsstp_sim.recording.step_messages import Block, BlockMessages
 
 __all__ = ["ChunkProcess"]
 
-_PIPE_BYTES = 1 << 20
-"""The pipe of blocks holds this much (about 60,000 plain steps) when the system allows it:
-the run goes on while the helper catches up."""
+_PIPE_BYTES = 1 << 18
+"""The pipe of blocks holds this much (some 15,000 plain steps) when the system allows it:
+the run goes on while the helper catches up, and a killed recorder loses little."""
 
 
 @dataclass(frozen=True, slots=True)
