@@ -229,7 +229,7 @@ class StepMessages:
                         block.append((channel, t * STEP_NS, head, tail))  # type: ignore[arg-type]
                         follows = -1
                     else:  # the same, and its event after it
-                        whole = self._blocked_step(outcome, pose, model.version)
+                        whole = self._whole_step(outcome, pose, model.version)
                         block.append((channel, t * STEP_NS, *whole))
                         block += then(outcome)
                         follows = -1
@@ -237,7 +237,7 @@ class StepMessages:
                         block += then(outcome)
                         follows = -1
                 else:
-                    whole = self._blocked_step(outcome, pose, model.version)
+                    whole = self._whole_step(outcome, pose, model.version)
                     block.append((channel, t * STEP_NS, *whole))
                     block += then(outcome)
                     follows = -1
@@ -254,7 +254,7 @@ class StepMessages:
         if block:
             yield block
 
-    def _blocked_step(self, outcome: StepOutcome, pose: Pose, version: int) -> tuple[bytes, bytes]:
+    def _whole_step(self, outcome: StepOutcome, pose: Pose, version: int) -> tuple[bytes, bytes]:
         """The message of a step that was blocked or found no transition: head and tail."""
         t, action, state_before, state_after, blocker, no_transition, _ = outcome
         head, moved, cut = self._poses.get(pose) or self._parts(pose)
