@@ -24,7 +24,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from rsstp_sim import RandomStrategy, load_scenario
+from rsstp_sim import load_scenario
 from rsstp_sim.errors import ChunkProcessFailed, RecordingError
 from rsstp_sim.recording.chunk_process import ChunkProcess
 from rsstp_sim.recording.chunks import OpenChunk
@@ -78,19 +78,41 @@ def test_steps_one_at_a_time_then_a_helped_run(tmp_path: Path) -> None:
     assert files[0] == files[1]
 
 
-def test_a_long_run_is_helped_by_default(tmp_path: Path) -> None:
-    """From HELPER_STEPS steps: a helper process runs while the run does."""
-    recorder = Recorder(tmp_path / "run.mcap", load_scenario("two-joint-30"), RandomStrategy(),
-                        seed=1)  # fmt: skip
-    seen: list[list[int]] = []
-    recorder.run(HELPER_STEPS, progress=lambda done: seen.append(helpers()))
-    assert seen[0] and all(found == seen[0] for found in seen)  # one helper, all along
-    assert not alive(seen[0])
-    short = Recorder(tmp_path / "short.mcap", load_scenario("two-joint-30"), RandomStrategy(),
-                     seed=1)  # fmt: skip
-    seen.clear()
-    short.run(HELPER_STEPS - 1, progress=lambda done: seen.append(helpers()))
-    assert seen and not any(seen)
+def test_left_to_choose_a_run_keeps_its_helper_while_its_steps_are_light(
+    tmp_path: Path,
+) -> None:
+    """From HELPER_STEPS steps, a helper starts with the run; after the first HELPER_STEPS
+    steps it stays for a random walk of three-joint (its poses met again) and ends for the
+    splitter (a whole model message every few steps). The bytes are the run's alone."""
+    seen: dict[str, list[list[int]]] = {}
+    for name, scenario, strategy in [
+        ("walk", "three-joint", "random"),
+        ("splitter", "two-joint-30", "splitter"),
+    ]:
+        path = tmp_path / f"{name}.mcap"
+        recorder = recorded(path, scenario, strategy, chunk_size=1 << 16)
+        found = seen[name] = []
+        recorder.run(HELPER_STEPS + 12_000, progress=lambda done, found=found: found.append(
+            [done, *helpers()]))  # fmt: skip
+        alone = tmp_path / f"{name}-alone.mcap"
+        recorded(alone, scenario, strategy, chunk_size=1 << 16).run(
+            HELPER_STEPS + 12_000, helper=False
+        )
+        assert path.read_bytes() == alone.read_bytes()
+    walk, splitter = seen["walk"], seen["splitter"]
+    assert [len(found) for found in walk] == [2] * len(walk)  # one helper, all along
+    assert len({found[1] for found in walk}) == 1 and not alive([walk[0][1]])
+    before = [found for found in splitter if found[0] < HELPER_STEPS]
+    after = [found for found in splitter if found[0] >= HELPER_STEPS]
+    assert before and all(len(found) == 2 for found in before)
+    assert after and all(len(found) == 1 for found in after)  # ended at the choice
+
+
+def test_a_short_run_has_no_helper(tmp_path: Path) -> None:
+    recorder = recorded(tmp_path / "short.mcap", "three-joint", "random", chunk_size=1 << 16)
+    found: list[list[int]] = []
+    recorder.run(HELPER_STEPS, progress=lambda done: found.append(helpers()))
+    assert found and not any(found)
 
 
 def helpers() -> list[int]:
@@ -145,8 +167,9 @@ def test_a_helper_killed_mid_run_is_one_line_and_the_steps_written_stay(tmp_path
 
 
 def test_a_helper_that_fails_says_why_in_one_line() -> None:
-    helper = ChunkProcess(OpenChunk([], 0, 0), chunk_size=1024, channels=(1, 2))
+    helper = ChunkProcess(chunk_size=1024, channels=(1, 2))
     try:
+        helper.take_over(OpenChunk([], 0, 0))
         # A tail number no block gave: the helper's own code fails.
         helper.send([Steps(1, 0, [b"}"], [0, 0, 0, 5])])
         with pytest.raises(
@@ -160,15 +183,16 @@ def test_a_helper_that_fails_says_why_in_one_line() -> None:
 
 def test_a_helper_gives_back_the_chunk_it_was_given_when_nothing_came() -> None:
     records = [b"a lead record"]
-    helper = ChunkProcess(OpenChunk(records, 1, 13), chunk_size=1024, channels=(1, 2))
+    helper = ChunkProcess(chunk_size=1024, channels=(1, 2))
     try:
+        helper.take_over(OpenChunk(records, 1, 13))
         assert helper.finish() == ([], OpenChunk(records, 1, 13))
     finally:
         helper.close()
 
 
 def test_closing_a_helper_ends_it_at_once() -> None:
-    helper = ChunkProcess(OpenChunk([], 0, 0), chunk_size=1024, channels=(1, 2))
+    helper = ChunkProcess(chunk_size=1024, channels=(1, 2))  # given nothing yet
     (pid,) = helpers()
     started = time.monotonic()
     helper.close()

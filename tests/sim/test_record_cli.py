@@ -442,15 +442,18 @@ def test_a_second_writer_on_the_same_output_is_refused(tmp_path: Path) -> None:
     assert out.read_bytes().endswith(MCAP_MAGIC) and not side(out).exists()
 
 
-@pytest.mark.parametrize("steps", ["50000", "500000"], ids=["alone", "helped"])
-def test_a_file_size_limit_is_one_line_saying_what_is_safe(tmp_path: Path, steps: str) -> None:
+@pytest.mark.parametrize(
+    ("steps", "limit"), [("50000", 200_000), ("500000", 8_000_000)], ids=["alone", "helped"]
+)
+def test_a_file_size_limit_is_one_line_saying_what_is_safe(
+    tmp_path: Path, steps: str, limit: int
+) -> None:
     """EFBIG (RLIMIT_FSIZE in the child): exit 1, one line; the side file holds the steps it
     names, and a reader recovers exactly those. A run of 500,000 steps builds its chunks in
-    a helper process, and the recorder writes them."""
+    a helper process after its first 65,536 (some 5 MB), and the recorder writes them."""
     import resource
 
     out = tmp_path / "run.mcap"
-    limit = 200_000
 
     def small_files() -> None:
         resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
@@ -469,6 +472,8 @@ def test_a_file_size_limit_is_one_line_saying_what_is_safe(tmp_path: Path, steps
 
     with pytest.warns(UserWarning, match="not finished"), open_recording(side(out)) as rec:
         assert rec.n_steps == safe > 0
+    if steps == "500000":
+        assert safe > 65_536  # (the helper's chunks among them)
 
 
 @pytest.mark.parametrize(
@@ -491,6 +496,8 @@ def test_a_full_disk_is_one_line_saying_what_is_safe(tmp_path: Path, steps: str,
         assert "No space left on device; steps 1 to " in done.stderr
         assert len(done.stderr.splitlines()) == 1 and not out.exists()
         assert side(out).exists()
+        safe = int(re.search(r"steps 1 to ([\d,]+) are safe", done.stderr)[1].replace(",", ""))
+        assert safe > (65_536 if steps == "300000" else 0)  # (the helper's chunks among them)
     finally:
         subprocess.run(["umount", str(disk)], check=True)
 

@@ -64,14 +64,15 @@ _ENDED = object()  # the helper's pipe closed
 
 
 class ChunkProcess:
-    """The helper process building a run's chunks from ``chunk`` on (see the module).
+    """The helper process building a run's chunks (see the module).
 
-    :meth:`send` each block in order, and write the chunks it returns in order; then
-    :meth:`finish` gives the last chunks and the chunk left open. :meth:`close` (always)
-    ends the helper.
+    Started ahead (its imports take a moment), it waits for :meth:`take_over` to give it the
+    chunk being built; then :meth:`send` each block in order, and write the chunks it
+    returns in order; :meth:`finish` gives the last chunks and the chunk left open.
+    :meth:`close` (always) ends the helper.
     """
 
-    def __init__(self, chunk: OpenChunk, *, chunk_size: int, channels: tuple[int, int]) -> None:
+    def __init__(self, *, chunk_size: int, channels: tuple[int, int]) -> None:
         """Start the helper; raises ``OSError`` when no process can be started."""
         blocks_in, blocks_out = os.pipe()
         chunks_in, chunks_out = os.pipe()
@@ -100,7 +101,11 @@ class ChunkProcess:
             target=self._receive, name="rsstp-chunk-process", daemon=True
         )
         self._receiver.start()
-        self._send((chunk_size, channels, chunk))
+        self._setup = chunk_size, channels
+
+    def take_over(self, chunk: OpenChunk) -> None:
+        """Give the helper the chunk being built: it goes on from there."""
+        self._send((*self._setup, chunk))
 
     def _receive(self) -> None:
         """What the helper sends back, as it comes (so that it never waits for the run)."""
@@ -160,7 +165,9 @@ class ChunkProcess:
         )
 
     def close(self) -> None:
-        """End the helper (at once, if :meth:`finish` did not) and its pipes."""
+        """End the helper (at once, if :meth:`finish` did not) and its pipes; idempotent."""
+        if self._blocks.closed:
+            return
         self._blocks.close()  # the helper reads the end of its input and ends
         try:
             self._process.wait(timeout=5)

@@ -36,6 +36,7 @@ from collections.abc import Callable, Generator, Iterable, Iterator, Mapping, Se
 from contextlib import closing, contextmanager, suppress
 from dataclasses import dataclass, replace
 from importlib import metadata
+from itertools import islice
 from pathlib import Path
 
 from rsstp_sim.coupling import Event, Runner, StepOutcome
@@ -80,8 +81,20 @@ DEFAULT_CHUNK_SIZE = 1024 * 1024
 """Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
 
 HELPER_STEPS = 65_536
-"""A run of this many steps or more builds its chunks in a helper process by default
+"""A run of this many steps or more may build its chunks in a helper process, left to choose
 (:meth:`Recorder.run`): the helper's start (about 0.2 s of the other core) pays for itself."""
+
+HELPER_BYTES_PER_STEP = 180
+"""The most bytes of new tails and whole messages a step may cost, over the last
+:data:`_WINDOW_STEPS` of the first :data:`HELPER_STEPS`, for the helper to be kept. Measured
+(2026-11-26, seeds 1 and 2): the random walk of ``three-joint`` 93-140 (its poses met again:
+the helper makes its recording 35-40 % faster), the learner on ``thesis-algo`` 140 (3 %
+faster), an arm roaming free of obstacles 225-234 (no faster, no slower), the same among two
+far obstacles 287-298 (5 % slower with the helper: bigger tails, half its steps at a new
+pose), the splitter on ``two-joint-30`` 16,000-26,000 (a whole model message every few
+steps: 28 % slower)."""
+
+_WINDOW_STEPS = 16_384
 
 _BLOCK_STEPS = 64  # the steps whose messages are built before they go into the chunk
 _HELPER_BLOCK_STEPS = 4096  # ... before they go to the helper
@@ -328,8 +341,9 @@ class Recorder:
 
         ``progress`` is called with the number of steps done every 4,096 steps and at the end.
         ``helper``: build the chunks in a helper process beside the run
-        (:mod:`~rsstp_sim.recording.chunk_process`; the same bytes); by default when
-        ``steps`` is at least :data:`HELPER_STEPS`.
+        (:mod:`~rsstp_sim.recording.chunk_process`; the same bytes): ``True`` from the
+        first step, ``False`` never; by default for a run of at least :data:`HELPER_STEPS`
+        steps, from then on, when its steps were light (see :meth:`_write_run`).
         Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`. When
         the strategy ends the run (:attr:`Runner.stopped <rsstp_sim.coupling.Runner.stopped>`),
         the file ends with an event saying so, at that step, of a budget of ``steps``.
@@ -338,13 +352,8 @@ class Recorder:
         self._budget = self.runner.step_index + steps
         # Closed as soon as the writing ends, so that the steps taken are counted then.
         outcomes = self._outcomes(steps, progress)
-        if helper is None:
-            helper = steps >= HELPER_STEPS
         with self._closed_on_failure(), closing(outcomes):
-            if helper:
-                self._write_helped(outcomes)
-            else:
-                self._write(outcomes)
+            self._write_run(outcomes, steps, helper)
         self.close()
         return self.result()
 
@@ -372,21 +381,49 @@ class Recorder:
         with closing(self._step_blocks(outcomes, steps=_BLOCK_STEPS)) as blocks:
             self._writer.add_messages(self._block_messages.of(blocks))
 
-    def _write_helped(self, outcomes: Iterable[StepOutcome]) -> None:
-        """:meth:`_write`, the chunks built in a helper process (in this one when none can
-        be started). A failure of the run keeps the steps before it, as :meth:`_write` does;
-        a failure of the helper or of the disk loses those it held."""
-        writer = self._writer
-        chunk = writer.hand_over()
-        self._messages.restart_tails()  # the helper's BlockMessages starts without any
-        try:
-            helper = ChunkProcess(
-                chunk, chunk_size=writer.chunk_size, channels=self._column_channels
-            )
-        except OSError:
-            writer.take_back(chunk)
+    def _write_run(self, outcomes: Iterator[StepOutcome], steps: int, helper: bool | None) -> None:
+        """Write the run's steps, in this process or helped (see :meth:`run`). Left to choose,
+        a run of :data:`HELPER_STEPS` steps or more starts a helper at once and writes its
+        first :data:`HELPER_STEPS` steps here, then keeps the helper if the last
+        :data:`_WINDOW_STEPS` of them were light (:data:`HELPER_BYTES_PER_STEP`), else ends
+        it: a run that keeps meeting new poses or changing its model sends the helper more
+        bytes than the helper saves it."""
+        if helper is False or (helper is None and steps <= HELPER_STEPS):
             self._write(outcomes)
             return
+        process = self._start_helper()
+        if process is None:  # no process could be started: this one does the work
+            self._write(outcomes)
+            return
+        try:
+            if helper is None:
+                first = self.runner.step_index
+                self._write(islice(outcomes, HELPER_STEPS - _WINDOW_STEPS))
+                before = self._messages.heavy_bytes
+                self._write(islice(outcomes, _WINDOW_STEPS))
+                if self.runner.step_index - first < HELPER_STEPS:  # the run ended there
+                    return
+                if self._messages.heavy_bytes - before > HELPER_BYTES_PER_STEP * _WINDOW_STEPS:
+                    process.close()  # (at once: its core is the run's from here)
+                    self._write(outcomes)
+                    return
+            self._write_helped(outcomes, process)
+        finally:
+            process.close()
+
+    def _start_helper(self) -> ChunkProcess | None:
+        try:
+            return ChunkProcess(chunk_size=self._writer.chunk_size, channels=self._column_channels)
+        except OSError:
+            return None
+
+    def _write_helped(self, outcomes: Iterable[StepOutcome], helper: ChunkProcess) -> None:
+        """:meth:`_write`, the chunks built by ``helper``. A failure of the run keeps the steps
+        before it, as :meth:`_write` does; a failure of the helper or of the disk loses those
+        it held."""
+        writer = self._writer
+        self._messages.restart_tails()  # the helper's BlockMessages starts without any
+        helper.take_over(writer.hand_over())
         try:
             with closing(self._step_blocks(outcomes, steps=_HELPER_BLOCK_STEPS)) as blocks:
                 for block in blocks:
@@ -399,8 +436,6 @@ class Recorder:
             raise
         else:
             self._end_helper(helper)
-        finally:
-            helper.close()
 
     def _end_helper(self, helper: ChunkProcess) -> None:
         """Write the helper's last chunks and go on with the chunk it leaves open."""

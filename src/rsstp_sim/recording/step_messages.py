@@ -40,12 +40,15 @@ if TYPE_CHECKING:
     from rsstp_sim.transition_system import TransitionSystem
     from rsstp_sim.world import Pose, World
 
-__all__ = ["POSE_CACHE_BYTES", "Block", "BlockMessages", "StepMessages", "Steps"]
+__all__ = ["BLOCK_BYTES", "POSE_CACHE_BYTES", "Block", "BlockMessages", "StepMessages", "Steps"]
 
 POSE_CACHE_BYTES = 128 * 1024 * 1024
 """The most bytes of poses' encoded parts and tails kept for the poses met again
 (three-joint's 39,232 poses take 23 MB of parts and as much of tails; a pose among 1,000
 obstacles 60 KB, its 3,000 distances): the poses met after that are encoded at each visit."""
+
+BLOCK_BYTES = 4 * 1024 * 1024
+"""About the most bytes of new tails and whole messages a block of steps holds."""
 
 _STEP = b'{"step":%d,"agent":{"action":%d,"state_before":%d,"internal_state":%d'
 _HEAD = _STEP + b"%b%d"
@@ -134,6 +137,9 @@ class StepMessages:
         self._blocked_ids: dict[tuple[Pose, int], int] = {}  # (pose, action) -> ~number
         self._tails_given = 0  # tails numbered in this epoch
         self._tail_bytes = 0
+        self.heavy_bytes = 0
+        """The bytes of the new tails and whole messages the blocks have held so far: what
+        a block costs beyond its plain steps' integers."""
         self.column_events = 0
         """Blocked events given as a blocked step's tail in :class:`Steps` (not by ``then``)."""
 
@@ -187,8 +193,10 @@ class StepMessages:
         steps: int,
     ) -> Generator[Block, None, None]:
         """The messages of the steps of ``outcomes``, as each is taken, in blocks of
-        ``steps`` steps (the last one shorter): a step's ``rsstp.Step`` message (at the
-        world's pose and the model's version after the step), then, if the step was
+        ``steps`` steps (the last one shorter; a block ends sooner once the tails and whole
+        messages in it pass :data:`BLOCK_BYTES`: a world of many obstacles): a step's
+        ``rsstp.Step`` message (at the world's pose and the model's version after the
+        step), then, if the step was
         blocked, found no transition, or ``waiting`` is not empty, the messages of
         ``then(outcome)`` (built then). A step that moved by a transition, or was blocked
         while nothing waits, goes into a :class:`Steps` while its tails are kept (then
@@ -202,6 +210,7 @@ class StepMessages:
         fresh: list[bytes] = []
         follows = -1  # the step that goes on ``columns``
         taken = 0
+        started = self.heavy_bytes  # when the block began
         try:
             for outcome in outcomes:
                 t, action, state_before, state_after, blocker, no_transition, _ = outcome
@@ -231,20 +240,20 @@ class StepMessages:
                     else:  # the same, and its event after it
                         whole = self._whole_step(outcome, pose, model.version)
                         block.append((channel, t * STEP_NS, *whole))
-                        block += then(outcome)
+                        self._follow(block, then, outcome)
                         follows = -1
                     if waiting:
-                        block += then(outcome)
+                        self._follow(block, then, outcome)
                         follows = -1
                 else:
                     whole = self._whole_step(outcome, pose, model.version)
                     block.append((channel, t * STEP_NS, *whole))
-                    block += then(outcome)
+                    self._follow(block, then, outcome)
                     follows = -1
                 taken += 1
-                if taken == steps:
+                if taken == steps or self.heavy_bytes - started > BLOCK_BYTES:
                     yield block
-                    block, taken, follows = [], 0, -1
+                    block, taken, follows, started = [], 0, -1, self.heavy_bytes
         except GeneratorExit:
             raise
         except BaseException:
@@ -254,8 +263,17 @@ class StepMessages:
         if block:
             yield block
 
+    def _follow(
+        self, block: Block, then: Callable[[StepOutcome], Iterable[Message]], outcome: StepOutcome
+    ) -> None:
+        """Add ``then(outcome)``'s messages to ``block``, counted in :attr:`heavy_bytes`."""
+        for message in then(outcome):
+            block.append(message)
+            self.heavy_bytes += len(message[2]) + len(message[3])
+
     def _whole_step(self, outcome: StepOutcome, pose: Pose, version: int) -> tuple[bytes, bytes]:
-        """The message of a step that was blocked or found no transition: head and tail."""
+        """The message of a step that was blocked or found no transition: head and tail
+        (counted in the block's bytes)."""
         t, action, state_before, state_after, blocker, no_transition, _ = outcome
         head, moved, cut = self._poses.get(pose) or self._parts(pose)
         first = _HEAD % (t, action, state_before, state_after, head, version)
@@ -265,6 +283,7 @@ class StepMessages:
             _UNBLOCKED if blocker is None else self._blocked(blocker),
             moved[cut + len(_UNBLOCKED) : -2],
         )
+        self.heavy_bytes += len(rest)
         return first, rest
 
     def _blocked_tail(
@@ -288,6 +307,7 @@ class StepMessages:
             event = self._event_tail(action, blocker)
             number = self._blocked_ids[key] = ~self._tails_given
             fresh += (step, event)
+            self.heavy_bytes += len(step) + len(event)
             self._tails_given += 2
             self._room -= len(step) + len(event)
             self._tail_bytes += len(step) + len(event)
@@ -296,8 +316,9 @@ class StepMessages:
 
     def _new_tail(self, pose: Pose, version: int, fresh: list[bytes]) -> int | bytes:
         """The tail number of ``pose`` at ``version``, its tail added to ``fresh``; or,
-        past the bound, the tail itself (not kept)."""
+        past the bound, the tail itself (not kept). Either counts in the block's bytes."""
         tail = self._tail(pose, version)
+        self.heavy_bytes += len(tail)
         if self._room <= 0:
             return tail
         number = self._tail_ids[pose] = self._tails_given
