@@ -81,8 +81,9 @@ DEFAULT_CHUNK_SIZE = 1024 * 1024
 """Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
 
 HELPER_STEPS = 65_536
-"""A run of this many steps or more may build its chunks in a helper process, left to choose
-(:meth:`Recorder.run`): the helper's start (about 0.2 s of the other core) pays for itself."""
+"""A run of more steps than this may build its chunks in a helper process, left to choose
+(:meth:`Recorder.run`), after recording this many itself: the helper's start (about 0.2 s of
+the other core) pays for itself."""
 
 HELPER_BYTES_PER_STEP = 180
 """The most bytes of new tails and whole messages a step may cost, over the last
@@ -342,7 +343,7 @@ class Recorder:
         ``progress`` is called with the number of steps done every 4,096 steps and at the end.
         ``helper``: build the chunks in a helper process beside the run
         (:mod:`~rsstp_sim.recording.chunk_process`; the same bytes): ``True`` from the
-        first step, ``False`` never; by default for a run of at least :data:`HELPER_STEPS`
+        first step, ``False`` never; by default for a run of more than :data:`HELPER_STEPS`
         steps, from then on, when its steps were light (see :meth:`_write_run`).
         Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`. When
         the strategy ends the run (:attr:`Runner.stopped <rsstp_sim.coupling.Runner.stopped>`),
@@ -383,7 +384,7 @@ class Recorder:
 
     def _write_run(self, outcomes: Iterator[StepOutcome], steps: int, helper: bool | None) -> None:
         """Write the run's steps, in this process or helped (see :meth:`run`). Left to choose,
-        a run of :data:`HELPER_STEPS` steps or more starts a helper at once and writes its
+        a run of more than :data:`HELPER_STEPS` steps starts a helper at once and writes its
         first :data:`HELPER_STEPS` steps here, then keeps the helper if the last
         :data:`_WINDOW_STEPS` of them were light (:data:`HELPER_BYTES_PER_STEP`), else ends
         it: a run that keeps meeting new poses or changing its model sends the helper more
