@@ -24,12 +24,13 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
-from rsstp_sim import load_scenario
+from rsstp_sim import RandomStrategy, load_scenario
 from rsstp_sim.errors import ChunkProcessFailed, RecordingError
 from rsstp_sim.recording.chunk_process import ChunkProcess
 from rsstp_sim.recording.chunks import OpenChunk
 from rsstp_sim.recording.recorder import HELPER_STEPS, Recorder
 from rsstp_sim.recording.step_messages import Steps
+from rsstp_sim.scenario import parse_scenario
 from rsstp_sim.strategies import make_strategy
 
 RUNS = [
@@ -78,32 +79,45 @@ def test_steps_one_at_a_time_then_a_helped_run(tmp_path: Path) -> None:
     assert files[0] == files[1]
 
 
+FREE_ARM = """
+[arm]
+lengths = [3.0, 2.0, 1.0]
+initial_deg = [330, 3, 357]
+step_deg = 5
+"""
+"""three-joint's arm without its obstacles: its random walk roams, half its steps at a new
+pose."""
+
+
 def test_left_to_choose_a_run_keeps_its_helper_while_its_steps_are_light(
     tmp_path: Path,
 ) -> None:
     """From HELPER_STEPS steps, a helper starts with the run; after the first HELPER_STEPS
-    steps it stays for a random walk of three-joint (its poses met again) and ends for the
-    splitter (a whole model message every few steps). The bytes are the run's alone."""
+    steps it stays for a random walk of three-joint (its poses met again) and ends for an
+    arm that roams free (each new pose's tail would go to the helper). The bytes are the
+    run's alone."""
     seen: dict[str, list[list[int]]] = {}
-    for name, scenario, strategy in [
-        ("walk", "three-joint", "random"),
-        ("splitter", "two-joint-30", "splitter"),
+    for name, scenario in [
+        ("walk", load_scenario("three-joint")),
+        ("roaming", parse_scenario(FREE_ARM, origin="free.toml")),
     ]:
-        path = tmp_path / f"{name}.mcap"
-        recorder = recorded(path, scenario, strategy, chunk_size=1 << 16)
-        found = seen[name] = []
-        recorder.run(HELPER_STEPS + 12_000, progress=lambda done, found=found: found.append(
-            [done, *helpers()]))  # fmt: skip
-        alone = tmp_path / f"{name}-alone.mcap"
-        recorded(alone, scenario, strategy, chunk_size=1 << 16).run(
-            HELPER_STEPS + 12_000, helper=False
-        )
-        assert path.read_bytes() == alone.read_bytes()
-    walk, splitter = seen["walk"], seen["splitter"]
+        files = []
+        for helper in (None, False):
+            path = tmp_path / f"{name}-{helper}.mcap"
+            recorder = Recorder(path, scenario, RandomStrategy(), seed=1, chunk_size=1 << 16)
+            found = seen.setdefault(name, []) if helper is None else []
+            recorder.run(
+                HELPER_STEPS + 12_000,
+                progress=lambda done, found=found: found.append([done, *helpers()]),
+                helper=helper,
+            )
+            files.append(path.read_bytes())
+        assert files[0] == files[1]
+    walk, roaming = seen["walk"], seen["roaming"]
     assert [len(found) for found in walk] == [2] * len(walk)  # one helper, all along
     assert len({found[1] for found in walk}) == 1 and not alive([walk[0][1]])
-    before = [found for found in splitter if found[0] < HELPER_STEPS]
-    after = [found for found in splitter if found[0] >= HELPER_STEPS]
+    before = [found for found in roaming if found[0] < HELPER_STEPS]
+    after = [found for found in roaming if found[0] >= HELPER_STEPS]
     assert before and all(len(found) == 2 for found in before)
     assert after and all(len(found) == 1 for found in after)  # ended at the choice
 
