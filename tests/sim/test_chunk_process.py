@@ -1,11 +1,11 @@
 """A long run's chunks built in a helper process: the same bytes, and failures said in a line.
 
 The recorder builds a long run's chunks in a helper process (``Recorder.run(helper=True)``,
-the default from ``HELPER_STEPS`` steps). Its file must be the one the recorder writes alone
-(which ``test_chunks.py`` and ``test_step_messages.py`` hold to mcap's ``Writer`` and the
-record encoder), whatever the run does: model changes, notes, blocked moves, steps with no
-transition, chunks of every size, steps recorded one at a time before and after. A helper
-that dies or fails is one line, and the recorder keeps the steps it had written; a helper
+by default past ``HELPER_STEPS`` steps, when they are light). Its file must be the one the
+recorder writes alone (which ``test_chunks.py`` and ``test_step_messages.py`` hold to mcap's
+``Writer`` and the record encoder), whatever the run does: model changes, notes, blocked
+moves, steps with no transition, chunks of every size, steps recorded one at a time before.
+A helper that dies or fails is one line, and the recorder keeps the steps it had written; a helper
 that cannot start leaves the recorder to do the work alone. The signals and the disk's
 errors of a helped run are in ``test_record_cli.py``.
 """
@@ -28,7 +28,7 @@ from rsstp_sim import RandomStrategy, load_scenario
 from rsstp_sim.errors import ChunkProcessFailed, RecordingError
 from rsstp_sim.recording.chunk_process import ChunkProcess
 from rsstp_sim.recording.chunks import OpenChunk
-from rsstp_sim.recording.recorder import HELPER_STEPS, Recorder
+from rsstp_sim.recording.recorder import HELPER_STEPS, TRIAL_STEPS, Recorder
 from rsstp_sim.recording.step_messages import Steps
 from rsstp_sim.scenario import parse_scenario
 from rsstp_sim.strategies import make_strategy
@@ -92,7 +92,7 @@ pose."""
 def test_left_to_choose_a_run_keeps_its_helper_while_its_steps_are_light(
     tmp_path: Path,
 ) -> None:
-    """From HELPER_STEPS steps, a helper starts with the run; after the first HELPER_STEPS
+    """Past HELPER_STEPS steps, a helper starts with the run; after the first TRIAL_STEPS
     steps it stays for a random walk of three-joint (its poses met again) and ends for an
     arm that roams free (each new pose's tail would go to the helper). The bytes are the
     run's alone."""
@@ -107,7 +107,7 @@ def test_left_to_choose_a_run_keeps_its_helper_while_its_steps_are_light(
             recorder = Recorder(path, scenario, RandomStrategy(), seed=1, chunk_size=1 << 16)
             found = seen.setdefault(name, []) if helper is None else []
             recorder.run(
-                HELPER_STEPS + 12_000,
+                HELPER_STEPS + 4_096,
                 progress=lambda done, found=found: found.append([done, *helpers()]),
                 helper=helper,
             )
@@ -116,8 +116,8 @@ def test_left_to_choose_a_run_keeps_its_helper_while_its_steps_are_light(
     walk, roaming = seen["walk"], seen["roaming"]
     assert [len(found) for found in walk] == [2] * len(walk)  # one helper, all along
     assert len({found[1] for found in walk}) == 1 and not alive([walk[0][1]])
-    before = [found for found in roaming if found[0] < HELPER_STEPS]
-    after = [found for found in roaming if found[0] >= HELPER_STEPS]
+    before = [found for found in roaming if found[0] < TRIAL_STEPS]
+    after = [found for found in roaming if found[0] >= TRIAL_STEPS]
     assert before and all(len(found) == 2 for found in before)
     assert after and all(len(found) == 1 for found in after)  # ended at the choice
 

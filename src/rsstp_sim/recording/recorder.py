@@ -71,6 +71,7 @@ from rsstp_sim.transition_system import Operation
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
     "HELPER_STEPS",
+    "TRIAL_STEPS",
     "RecordResult",
     "Recorder",
     "environment_versions",
@@ -80,14 +81,19 @@ __all__ = [
 DEFAULT_CHUNK_SIZE = 1024 * 1024
 """Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
 
-HELPER_STEPS = 65_536
+HELPER_STEPS = 131_072
 """A run of more steps than this may build its chunks in a helper process, left to choose
-(:meth:`Recorder.run`), after recording this many itself: the helper's start (about 0.2 s of
-the other core) pays for itself."""
+(:meth:`Recorder.run`), after recording the first :data:`TRIAL_STEPS` itself: the helper
+then has at least as many steps to save time on, and its start (about 0.2 s of the other
+core) is paid for (at 100,000 steps a recording is no faster with it)."""
+
+TRIAL_STEPS = 65_536
+"""The steps a run left to choose records itself before it chooses (see
+:data:`HELPER_BYTES_PER_STEP`)."""
 
 HELPER_BYTES_PER_STEP = 180
 """The most bytes of new tails and whole messages a step may cost, over the last
-:data:`_WINDOW_STEPS` of the first :data:`HELPER_STEPS`, for the helper to be kept. Measured
+:data:`_WINDOW_STEPS` of the first :data:`TRIAL_STEPS`, for the helper to be kept. Measured
 (2026-11-26, seeds 1 and 2): the random walk of ``three-joint`` 93-140 (its poses met again:
 the helper makes its recording 35-40 % faster), the learner on ``thesis-algo`` 140 (3 %
 faster), an arm roaming free of obstacles 225-234 (no faster, no slower), the same among two
@@ -385,7 +391,7 @@ class Recorder:
     def _write_run(self, outcomes: Iterator[StepOutcome], steps: int, helper: bool | None) -> None:
         """Write the run's steps, in this process or helped (see :meth:`run`). Left to choose,
         a run of more than :data:`HELPER_STEPS` steps starts a helper at once and writes its
-        first :data:`HELPER_STEPS` steps here, then keeps the helper if the last
+        first :data:`TRIAL_STEPS` steps here, then keeps the helper if the last
         :data:`_WINDOW_STEPS` of them were light (:data:`HELPER_BYTES_PER_STEP`), else ends
         it: a run that keeps meeting new poses or changing its model sends the helper more
         bytes than the helper saves it."""
@@ -399,10 +405,10 @@ class Recorder:
         try:
             if helper is None:
                 first = self.runner.step_index
-                self._write(islice(outcomes, HELPER_STEPS - _WINDOW_STEPS))
+                self._write(islice(outcomes, TRIAL_STEPS - _WINDOW_STEPS))
                 before = self._messages.heavy_bytes
                 self._write(islice(outcomes, _WINDOW_STEPS))
-                if self.runner.step_index - first < HELPER_STEPS:  # the run ended there
+                if self.runner.step_index - first < TRIAL_STEPS:  # the run ended there
                     return
                 if self._messages.heavy_bytes - before > HELPER_BYTES_PER_STEP * _WINDOW_STEPS:
                     process.close()  # (at once: its core is the run's from here)
