@@ -571,7 +571,7 @@ class RunsOutOfMemory(Recorder):
     outside the strategy, which the runner names instead)."""
 
     def _step_blocks(
-        self, outcomes: Iterable[StepOutcome], *, steps: int
+        self, outcomes: Iterable[StepOutcome], *, steps: int, max_bytes: int
     ) -> Generator[Block, None, None]:
         def until_six() -> Iterator[StepOutcome]:
             for outcome in outcomes:
@@ -579,7 +579,7 @@ class RunsOutOfMemory(Recorder):
                     raise MemoryError
                 yield outcome
 
-        return super()._step_blocks(until_six(), steps=steps)
+        return super()._step_blocks(until_six(), steps=steps, max_bytes=max_bytes)
 
 
 def test_a_memory_error_under_force_leaves_the_old_recording(tmp_path: Path) -> None:

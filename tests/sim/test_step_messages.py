@@ -121,6 +121,7 @@ def test_every_message_is_the_encoders(
         waiting=(),
         then=then,
         steps=block_steps,
+        max_bytes=1 << 20,
     )
     got = [(ch, t, data + tail) for ch, t, data, tail in BlockMessages(STEP, EVENT).of(blocks)]
     # The independent order: each step's message; then, for a step with no transition,
@@ -171,7 +172,14 @@ def test_then_follows_every_step_while_something_waits() -> None:
 
     messages = StepMessages()
     blocks = messages.blocks(
-        steps(), runner.world, runner.model, channel=STEP, waiting=waiting, then=then, steps=64
+        steps(),
+        runner.world,
+        runner.model,
+        channel=STEP,
+        waiting=waiting,
+        then=then,
+        steps=64,
+        max_bytes=1 << 20,
     )
     got = list(BlockMessages(STEP, EVENT).of(blocks))
     assert [m[1] // 1_000_000 for m in got if m[0] == STEP] == [o.step for o in taken]
@@ -199,10 +207,18 @@ def test_past_its_bound_the_pose_cache_keeps_nothing_more_and_the_bytes_stay() -
             waiting=(),
             then=lambda _: iter(()),
             steps=50,
+            max_bytes=2000,  # (a block of a few new tails)
         )
     )
     got = [data + tail for ch, _, data, tail in BlockMessages(STEP, EVENT).of(blocks) if ch == STEP]
     assert got == expected
+    # A block ends at 50 steps, or sooner after 2,000 bytes of new tails: many blocks early.
+    steps_in = [
+        sum(len(i.columns) // 4 if isinstance(i, Steps) else i[0] == STEP for i in block)
+        for block in blocks
+    ]
+    assert sum(steps_in) == 500 and max(steps_in) <= 50 and len(blocks) > 10
+    assert min(steps_in[:3]) < 10  # (every pose new at first: a block of a few steps)
     poses = {record.split(b'"truth":')[1] for record in expected}
     assert len(poses) > 50  # many poses, past the few the bound keeps
     # The poses' parts and the tails given (at the one model version) share the bound.

@@ -103,8 +103,12 @@ steps: 28 % slower)."""
 
 _WINDOW_STEPS = 16_384
 
-_BLOCK_STEPS = 64  # the steps whose messages are built before they go into the chunk
-_HELPER_BLOCK_STEPS = 4096  # ... before they go to the helper
+# The steps whose messages are built before they go into the chunk, or while their tails and
+# whole messages take at most so many bytes (a world of many obstacles: the chunks' zstd on
+# the second thread goes on beside the steps, not after a burst of them)...
+_BLOCK_STEPS, _BLOCK_BYTES = 64, 128 * 1024
+# ... before they go to the helper.
+_HELPER_BLOCK_STEPS, _HELPER_BLOCK_BYTES = 4096, 4 * 1024 * 1024
 
 _VERSION_KEYS = ("package_version", "python", "numpy", "shapely", "mcap")
 
@@ -279,10 +283,10 @@ class Recorder:
         return self._channels[topic], step * STEP_NS, data, tail
 
     def _step_blocks(
-        self, outcomes: Iterable[StepOutcome], *, steps: int
+        self, outcomes: Iterable[StepOutcome], *, steps: int, max_bytes: int
     ) -> Generator[Block, None, None]:
         """The messages of each step of ``outcomes``, in file order, in blocks of ``steps``
-        steps."""
+        steps or ``max_bytes`` (see :meth:`StepMessages.blocks`)."""
         return self._messages.blocks(
             outcomes,
             self.runner.world,
@@ -291,6 +295,7 @@ class Recorder:
             waiting=self._waiting,
             then=self._after_step,
             steps=steps,
+            max_bytes=max_bytes,
         )
 
     def _after_step(self, outcome: StepOutcome) -> Iterator[Message]:
@@ -385,7 +390,9 @@ class Recorder:
 
     def _write(self, outcomes: Iterable[StepOutcome]) -> None:
         """Write the messages of the steps ``outcomes`` takes."""
-        with closing(self._step_blocks(outcomes, steps=_BLOCK_STEPS)) as blocks:
+        with closing(
+            self._step_blocks(outcomes, steps=_BLOCK_STEPS, max_bytes=_BLOCK_BYTES)
+        ) as blocks:
             self._writer.add_messages(self._block_messages.of(blocks))
 
     def _write_run(self, outcomes: Iterator[StepOutcome], steps: int, helper: bool | None) -> None:
@@ -432,7 +439,11 @@ class Recorder:
         self._messages.restart_tails()  # the helper's BlockMessages starts without any
         helper.take_over(writer.hand_over())
         try:
-            with closing(self._step_blocks(outcomes, steps=_HELPER_BLOCK_STEPS)) as blocks:
+            with closing(
+                self._step_blocks(
+                    outcomes, steps=_HELPER_BLOCK_STEPS, max_bytes=_HELPER_BLOCK_BYTES
+                )
+            ) as blocks:
                 for block in blocks:
                     for packed in helper.send(block):
                         writer.add_packed(packed)

@@ -40,15 +40,12 @@ if TYPE_CHECKING:
     from rsstp_sim.transition_system import TransitionSystem
     from rsstp_sim.world import Pose, World
 
-__all__ = ["BLOCK_BYTES", "POSE_CACHE_BYTES", "Block", "BlockMessages", "StepMessages", "Steps"]
+__all__ = ["POSE_CACHE_BYTES", "Block", "BlockMessages", "StepMessages", "Steps"]
 
 POSE_CACHE_BYTES = 128 * 1024 * 1024
 """The most bytes of poses' encoded parts and tails kept for the poses met again
 (three-joint's 39,232 poses take 23 MB of parts and as much of tails; a pose among 1,000
 obstacles 60 KB, its 3,000 distances): the poses met after that are encoded at each visit."""
-
-BLOCK_BYTES = 4 * 1024 * 1024
-"""About the most bytes of new tails and whole messages a block of steps holds."""
 
 _STEP = b'{"step":%d,"agent":{"action":%d,"state_before":%d,"internal_state":%d'
 _HEAD = _STEP + b"%b%d"
@@ -191,10 +188,11 @@ class StepMessages:
         waiting: Sized,
         then: Callable[[StepOutcome], Iterable[Message]],
         steps: int,
+        max_bytes: int,
     ) -> Generator[Block, None, None]:
         """The messages of the steps of ``outcomes``, as each is taken, in blocks of
         ``steps`` steps (the last one shorter; a block ends sooner once the tails and whole
-        messages in it pass :data:`BLOCK_BYTES`: a world of many obstacles): a step's
+        messages in it pass ``max_bytes``: a world of many obstacles): a step's
         ``rsstp.Step`` message (at the world's pose and the model's version after the
         step), then, if the step was
         blocked, found no transition, or ``waiting`` is not empty, the messages of
@@ -251,7 +249,7 @@ class StepMessages:
                     self._follow(block, then, outcome)
                     follows = -1
                 taken += 1
-                if taken == steps or self.heavy_bytes - started > BLOCK_BYTES:
+                if taken == steps or self.heavy_bytes - started > max_bytes:
                     yield block
                     block, taken, follows, started = [], 0, -1, self.heavy_bytes
         except GeneratorExit:
