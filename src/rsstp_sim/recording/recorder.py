@@ -15,10 +15,11 @@ runner's callbacks and writes:
 written, so the same scenario, strategy and seed give the same bytes.
 
 Speed: a step's message comes from per-pose templates
-(:mod:`~rsstp_sim.recording.step_messages`); a run's messages are a generator that the chunk
-writer consumes, with little Python per message (:mod:`~rsstp_sim.recording.chunks`: the
-mcap ``Writer``'s bytes); each chunk's CRC, compression and write run on a second thread
-(:mod:`~rsstp_sim.recording.output`).
+(:mod:`~rsstp_sim.recording.step_messages`), in blocks of steps that the chunk writer
+consumes, with little Python per message (:mod:`~rsstp_sim.recording.chunks`: the mcap
+``Writer``'s bytes); each chunk's CRC, compression and write run on a second thread
+(:mod:`~rsstp_sim.recording.output`). A long run whose steps are light has its chunks built
+by a helper process (:mod:`~rsstp_sim.recording.chunk_process`), and writes them.
 
 Crash safety: the recording goes to a locked side file, renamed onto the output only when
 finished (:mod:`rsstp_sim.recording.output`). :meth:`Recorder.request_stop` (what the CLI's
