@@ -180,6 +180,30 @@ def test_a_helper_killed_mid_run_is_one_line_and_the_steps_written_stay(tmp_path
     assert steps == list(range(len(steps)))
 
 
+def test_a_helper_that_dies_before_it_is_used_leaves_the_run_to_go_on_alone(
+    tmp_path: Path,
+) -> None:
+    """Killed during the steps the run records itself before it chooses: the run goes on
+    alone, whole, to the same bytes."""
+    path = tmp_path / "run.mcap"
+    recorder = recorded(path, "three-joint", "random", chunk_size=1 << 16)
+    killed: list[int] = []
+
+    def kill_the_helper(done: int) -> None:
+        if not killed:
+            (pid,) = helpers()
+            os.kill(pid, signal.SIGKILL)
+            killed.append(pid)
+
+    result = recorder.run(HELPER_STEPS + 4_096, progress=kill_the_helper)
+    assert killed and result.steps == HELPER_STEPS + 4_096
+    alone = tmp_path / "alone.mcap"
+    recorded(alone, "three-joint", "random", chunk_size=1 << 16).run(
+        HELPER_STEPS + 4_096, helper=False
+    )
+    assert path.read_bytes() == alone.read_bytes()
+
+
 def test_a_helper_that_fails_says_why_in_one_line() -> None:
     helper = ChunkProcess(chunk_size=1024, channels=(1, 2))
     try:

@@ -433,12 +433,18 @@ class Recorder:
             return None
 
     def _write_helped(self, outcomes: Iterable[StepOutcome], helper: ChunkProcess) -> None:
-        """:meth:`_write`, the chunks built by ``helper``. A failure of the run keeps the steps
-        before it, as :meth:`_write` does; a failure of the helper or of the disk loses those
-        it held."""
+        """:meth:`_write`, the chunks built by ``helper`` (by this process alone if the helper
+        ended before it was given the chunk). A failure of the run keeps the steps before it,
+        as :meth:`_write` does; a failure of the helper or of the disk loses those it held."""
         writer = self._writer
         self._messages.restart_tails()  # the helper's BlockMessages starts without any
-        helper.take_over(writer.hand_over())
+        chunk = writer.hand_over()
+        try:
+            helper.take_over(chunk)
+        except ChunkProcessFailed:  # it ended before it was used: this process goes on alone
+            writer.take_back(chunk)
+            self._write(outcomes)
+            return
         try:
             with closing(
                 self._step_blocks(
