@@ -120,8 +120,8 @@ class ChunkProcess:
     def _send(self, item: object) -> None:
         try:
             self._blocks.send_bytes(pickle.dumps(item, pickle.HIGHEST_PROTOCOL))
-        except OSError:  # its pipe closed: it ended; say how
-            self._take(until_open=True)
+        except OSError:  # its pipe closed: it ended; what it sent last says how
+            self._take(until_open=True)  # (raises its failure, or its end)
             raise self._ended() from None
 
     def send(self, block: Block) -> list[PackedChunk]:

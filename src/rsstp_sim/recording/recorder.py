@@ -97,11 +97,10 @@ HELPER_BYTES_PER_STEP = 180
 :data:`_WINDOW_STEPS` of the first :data:`TRIAL_STEPS`, for the helper to be kept. Measured
 (2026-11-26, seeds 1 and 2): the random walk of ``three-joint`` 93-140 (its poses met again:
 the helper makes its recording about 20 % faster, 3.5 s against 4.35 s for 1,000,000 steps
-in one process), the learner on ``thesis-algo`` 140 (3 %
-faster), an arm roaming free of obstacles 225-234 (no faster, no slower), the same among two
-far obstacles 287-298 (5 % slower with the helper: bigger tails, half its steps at a new
-pose), the splitter on ``two-joint-30`` 16,000-26,000 (a whole model message every few
-steps: 28 % slower)."""
+in one process), the learner on ``thesis-algo`` 140 (3 % faster), an arm roaming free of
+obstacles 225-234 (no faster, no slower), the same among two far obstacles 287-298 (5 %
+slower with the helper: bigger tails, half its steps at a new pose), the splitter on
+``two-joint-30`` 16,000-26,000 (a whole model message every few steps: 28 % slower)."""
 
 _WINDOW_STEPS = 16_384
 

@@ -273,16 +273,23 @@ class StepMessages:
         """The message of a step that was blocked or found no transition: head and tail
         (counted in the block's bytes)."""
         t, action, state_before, state_after, blocker, no_transition, _ = outcome
+        head, rest = self._agent_and_rest(pose, blocker, no_transition=no_transition)
+        self.heavy_bytes += len(rest)
+        return _HEAD % (t, action, state_before, state_after, head, version), rest
+
+    def _agent_and_rest(
+        self, pose: Pose, blocker: Blocker | None, *, no_transition: bool
+    ) -> tuple[bytes, bytes]:
+        """A step's message at ``pose`` around its model version: the agent's part before it,
+        and everything after it (its ``no_transition`` and its truth, ``blocker`` in it)."""
         head, moved, cut = self._poses.get(pose) or self._parts(pose)
-        first = _HEAD % (t, action, state_before, state_after, head, version)
         rest = _TAIL % (
             b"true" if no_transition else b"false",
             moved[len(_MOVED) : cut],
             _UNBLOCKED if blocker is None else self._blocked(blocker),
             moved[cut + len(_UNBLOCKED) : -2],
         )
-        self.heavy_bytes += len(rest)
-        return first, rest
+        return head, rest
 
     def _blocked_tail(
         self, pose: Pose, action: int, blocker: Blocker, version: int, fresh: list[bytes]
@@ -294,21 +301,11 @@ class StepMessages:
         if number is None:
             if self._room <= 0:
                 return None
-            head, moved, cut = self._poses.get(pose) or self._parts(pose)
-            rest = _TAIL % (
-                b"false",
-                moved[len(_MOVED) : cut],
-                self._blocked(blocker),
-                moved[cut + len(_UNBLOCKED) : -2],
-            )
+            head, rest = self._agent_and_rest(pose, blocker, no_transition=False)
             step = b"%b%d%b" % (head, version, rest)
-            event = self._event_tail(action, blocker)
-            number = self._blocked_ids[key] = ~self._tails_given
-            fresh += (step, event)
-            self.heavy_bytes += len(step) + len(event)
-            self._tails_given += 2
-            self._room -= len(step) + len(event)
-            self._tail_bytes += len(step) + len(event)
+            number = self._blocked_ids[key] = ~self._give(
+                fresh, step, self._event_tail(action, blocker)
+            )
         self.column_events += 1
         return number
 
@@ -316,15 +313,23 @@ class StepMessages:
         """The tail number of ``pose`` at ``version``, its tail added to ``fresh``; or,
         past the bound, the tail itself (not kept). Either counts in the block's bytes."""
         tail = self._tail(pose, version)
-        self.heavy_bytes += len(tail)
         if self._room <= 0:
+            self.heavy_bytes += len(tail)
             return tail
-        number = self._tail_ids[pose] = self._tails_given
-        fresh.append(tail)
-        self._tails_given += 1
-        self._room -= len(tail)
-        self._tail_bytes += len(tail)
+        number = self._tail_ids[pose] = self._give(fresh, tail)
         return number
+
+    def _give(self, fresh: list[bytes], *tails: bytes) -> int:
+        """Number ``tails`` next in this epoch and add them to ``fresh`` (kept, counted in the
+        bound and in the block's bytes); the first one's number."""
+        first = self._tails_given
+        size = sum(map(len, tails))
+        fresh += tails
+        self._tails_given += len(tails)
+        self._room -= size
+        self._tail_bytes += size
+        self.heavy_bytes += size
+        return first
 
     def _blocked(self, blocker: Blocker) -> bytes:
         truth = self._blocked_truth.get(blocker)
