@@ -604,14 +604,18 @@ def _move_blocker(
         px = py = delta = 0.0
         joint = 0
     turn = abs(delta)
+    disks = geo.disks
+    fixed_links = joint if swept else n  # the links a moving one may meet
     # Each moving link's bound (move_blockers' filters): every point stays within its sweep
     # of where it starts, and the link within half its length of its midpoint. A contact
     # farther than that, with 2 eps to spare for rounding, cannot be met.
-    # A moving link's midpoint, its bound and its segment (the pairs below read them often).
-    mids: list[tuple[float, float, float, tuple[float, float, float, float]]] = []
+    # A moving link's midpoint, half its length, its reach against a fixed link's midpoint
+    # (half its length, eps and its sweep), its bound against a fixed link, and its segment.
+    mids: list[tuple[float, float, float, float, float, tuple[float, float, float, float]]] = []
     near = 0.0  # the moving link's start from the pivot (the first one starts there)
+    ax, ay = points[2 * joint], points[2 * joint + 1]
     for j in range(joint, n):
-        ax, ay, bx, by = points[2 * j : 2 * j + 4]
+        bx, by = points[2 * j + 2], points[2 * j + 3]
         mx, my = 0.5 * (ax + bx), 0.5 * (ay + by)
         if turn:
             far = hypot(bx - px, by - py)  # and its end, the next link's start
@@ -619,42 +623,50 @@ def _move_blocker(
             near = far
         else:
             sweep = 4 * eps
-        mids.append((mx, my, sweep, (ax, ay, bx, by)))
         half = halves[j]
-        for o, (cx, cy, radius) in enumerate(geo.disks):
+        seg = (ax, ay, bx, by)
+        if fixed_links:
+            mids.append((mx, my, half, half + eps + sweep, eps + sweep, seg))
+        for o, (cx, cy, radius) in enumerate(disks):
             bound = radius + eps + sweep
             if hypot(cx - mx, cy - my) - half > bound or _gap(cx, cy, ax, ay, bx, by) > bound:
                 continue
             if swept:
-                distance = _arc_gap(px, py, cx, cy, -delta, (ax, ay, bx, by))
+                distance = _arc_gap(px, py, cx, cy, -delta, seg)
             else:
                 distance = _gap(cx, cy, ax, ay, bx, by)
             met = _meets(distance, radius + eps, unsure)
             if met is None or met:
                 return None if met is None else n + j * m + o
-    for i in range(joint if swept else n):
-        fixed = points[2 * i : 2 * i + 4]
-        fx, fy = 0.5 * (fixed[0] + fixed[2]), 0.5 * (fixed[1] + fixed[3])
-        half_i = halves[i]
-        for j in range(max(joint, i + 2), n):
-            mx, my, sweep, seg = mids[j - joint]
-            bound = eps + sweep
-            if hypot(fx - mx, fy - my) - half_i - halves[j] > bound:
-                continue
-            if _segments_gap(fixed, seg) > bound:
-                continue
-            if swept:
-                distance = min(
-                    _arc_gap(px, py, seg[0], seg[1], delta, fixed),
-                    _arc_gap(px, py, seg[2], seg[3], delta, fixed),
-                    _arc_gap(px, py, fixed[0], fixed[1], -delta, seg),
-                    _arc_gap(px, py, fixed[2], fixed[3], -delta, seg),
-                )
-            else:
-                distance = _segments_gap(fixed, seg)
-            met = _meets(distance, eps, unsure)
-            if met is None or met:
-                return None if met is None else n + n * m + i * n + j
+        ax, ay = bx, by
+    ax, ay = points[0], points[1]
+    for i in range(fixed_links):
+        bx, by = points[2 * i + 2], points[2 * i + 3]
+        first = max(joint, i + 2)
+        if first < n:
+            fixed = (ax, ay, bx, by)
+            fx, fy = 0.5 * (ax + bx), 0.5 * (ay + by)
+            half_i = halves[i]
+            for j, (mx, my, half_j, reach, bound, seg) in enumerate(mids[first - joint :], first):
+                if hypot(fx - mx, fy - my) - half_i > reach:
+                    continue
+                if _gap(mx, my, ax, ay, bx, by) - half_j > bound:
+                    continue  # its midpoint, from the fixed link, less half its length
+                if _segments_gap(fixed, seg) > bound:
+                    continue
+                if swept:
+                    distance = min(
+                        _arc_gap(px, py, seg[0], seg[1], delta, fixed),
+                        _arc_gap(px, py, seg[2], seg[3], delta, fixed),
+                        _arc_gap(px, py, ax, ay, -delta, seg),
+                        _arc_gap(px, py, bx, by, -delta, seg),
+                    )
+                else:
+                    distance = _segments_gap(fixed, seg)
+                met = _meets(distance, eps, unsure)
+                if met is None or met:
+                    return None if met is None else n + n * m + i * n + j
+        ax, ay = bx, by
     return 0
 
 
@@ -691,17 +703,19 @@ def pose_feedback(
 ) -> tuple[bool, float]:
     """:func:`feedback` of one pose given as :func:`pose_points`, equal to it bit for bit.
 
-    ``feedback_points`` is the ``(n, 2)`` array of points, ``reach`` :func:`feedback_reach`.
-    The distances go through numpy's ``hypot`` (Python's rounds differently in rare cases);
-    numpy's mean of at most seven values adds them in order, as here.
+    ``feedback_points`` is the ``(n, 2)`` array of points raveled (``x0, y0, x1, y1, ...``,
+    as the pose's points come), ``reach`` :func:`feedback_reach`. The distances go through
+    numpy's ``hypot`` (Python's rounds differently in rare cases); numpy's mean of at most
+    seven values adds them in order, as here (a closeness is at most 1, a gap being at least
+    0, and one clipped to 0 adds nothing).
     """
-    tips = np.array(points[2:]).reshape(-1, 2) - feedback_points
-    gaps: list[float] = np.hypot(tips[:, 0], tips[:, 1]).tolist()
+    tips = np.array(points[2:]) - feedback_points
+    gaps: list[float] = np.hypot(tips[0::2], tips[1::2]).tolist()
     total = 0.0
-    for k, (gap, r) in enumerate(zip(gaps, reach, strict=True)):
+    for gap, r in zip(gaps, reach, strict=True):
         c = 1.0 - gap / r
-        c = 0.0 if c < 0.0 else 1.0 if c > 1.0 else c
-        total = total + c if k else c
+        if c > 0.0:
+            total += c
     return max(gaps) <= tolerance_abs, total / len(gaps)
 
 

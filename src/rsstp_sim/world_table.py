@@ -165,6 +165,7 @@ class WorldTable:
         self._tolerance_abs = scenario.tolerance * scenario.total_length
         # The same in plain Python numbers, for the move-by-move path.
         self._reach = geometry.feedback_reach(self._points, self.geometry.lengths).tolist()
+        self._flat_points = self._points.ravel()
         self._joint_list: list[int] = self._joint.tolist()
         self._delta_list: list[int] = self._delta.tolist()
         self._reverse_list: list[int] = self._reverse.tolist()
@@ -205,6 +206,8 @@ class WorldTable:
         self._lattice_list: list[int] = self._lattice_radix.tolist()
         self._blank_moves = array.array("i", [-1] * len(self.actions))
         self._no_blockers = array.array("i", [0] * len(self.actions))
+        self._last: tuple[int, Sequence[int], Sequence[float]] = (-1, (), ())
+        """The row :meth:`_add_pose` added last, its angles and its points, as plain lists."""
         start = int(self._initial @ self.radix)
         self._add_poses(np.array([start], dtype=np.int64))
 
@@ -267,9 +270,13 @@ class WorldTable:
         if there >= 0 and back >= 0 and self.next_row[there * n_actions + back] >= 0:
             blocker = self.blocker[there * n_actions + back]
         else:
-            angles = self.angles_of(code)
-            width = self.width
-            points = self.positions[row * width : (row + 1) * width]
+            last_row, last_angles, last_points = self._last
+            if row == last_row:  # a walk mostly moves on from the pose it just added
+                angles, points = list(last_angles), last_points
+            else:
+                width = self.width
+                angles = self.angles_of(code)
+                points = self.positions[row * width : (row + 1) * width]
             blocker = geometry.move_blocker(self.geometry, angles, points, joint, delta)
             if not blocker and there < 0:
                 angles[joint] = turned
@@ -306,14 +313,15 @@ class WorldTable:
         row = len(self.codes)
         points = geometry.pose_points(angles, self.geometry.link_lengths, known=known, first=first)
         sensation, closeness = geometry.pose_feedback(
-            points, self._points, self._reach, self._tolerance_abs
+            points, self._flat_points, self._reach, self._tolerance_abs
         )
         if self._dense is None:
             self._row_of[code] = row
         else:
             self._dense[self._cell(angles)] = row
+        self._last = (row, angles, points)
         self.codes.append(code)
-        self.positions.extend(points)
+        self.positions.fromlist(points)
         self.distances.extend(self._unknown_distances)
         self.sensation.append(sensation)
         self.feedback.append(closeness)

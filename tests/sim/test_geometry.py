@@ -330,7 +330,7 @@ def test_pose_feedback_equals_feedback_bit_for_bit(
     reach = geometry.feedback_reach(feedback_points, lengths).tolist()
     for tolerance in (0.5, 3.0, 30.0):
         sensed, closeness = geometry.feedback(tips, feedback_points, lengths, tolerance)
-        got = geometry.pose_feedback(flat, feedback_points, reach, tolerance)
+        got = geometry.pose_feedback(flat, feedback_points.ravel(), reach, tolerance)
         assert got == (bool(sensed), float(closeness))
 
 
