@@ -4,15 +4,17 @@ The reader's second layer, above :mod:`rsstp_replay._container` (which reads eac
 record, decompressed and CRC-checked) and below :mod:`rsstp_replay._contract`. A chunk's
 message records are sliced out of its bytes (:func:`split_messages`, or through the chunk's
 message index, :func:`messages_at`) for a decoder to take many at once; :func:`topic_chunks`
-reads a topic chunk by chunk. This is the hot path of reading a recording: no object per
-record but the slice of its data.
+reads a topic chunk by chunk (:func:`topics_chunks` several topics in one read of each
+chunk). This is the hot path of reading a recording: no object per record but the slice of
+its data.
 """
 
 from __future__ import annotations
 
+import gc
 import struct
-from collections.abc import Generator
-from contextlib import closing
+from collections.abc import Generator, Iterator, Sequence
+from contextlib import closing, contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -25,12 +27,14 @@ from rsstp_sim.recording.schemas import STEP_NS
 
 __all__ = [
     "count_messages",
+    "gc_paused",
     "message_channels",
     "message_times",
     "log_times_at",
     "messages_at",
     "split_messages",
     "topic_chunks",
+    "topics_chunks",
 ]
 
 _Ints = npt.NDArray[np.int64]
@@ -171,13 +175,28 @@ def topic_chunks(
     step: int | None = None,
 ) -> Generator[tuple[ChunkRef, bytes, list[memoryview], _Ints], None, None]:
     """The chunks with messages of ``channel`` (or only those around ``step``'s log time),
-    each with its records, those messages' bytes and their log times. A finished file's
-    messages are found through each chunk's message index, anything else by walking the
-    chunk's records; an unfinished file's messages stop at ``limit_ns``."""
+    each with its records, those messages' bytes and their log times (:func:`topics_chunks`
+    of one channel)."""
+    for ref, data, [(parts, times)] in topics_chunks(container, (channel,), limit_ns, step=step):
+        yield ref, data, parts, times
+
+
+def topics_chunks(
+    container: Container,
+    channels: Sequence[int],
+    limit_ns: int | None,
+    *,
+    step: int | None = None,
+) -> Generator[tuple[ChunkRef, bytes, list[tuple[list[memoryview], _Ints]]], None, None]:
+    """The chunks with messages of any of ``channels`` (or only those around ``step``'s log
+    time), each with its records and, channel by channel, those messages' bytes and their
+    log times: one read of each chunk for several topics. A finished file's messages are
+    found through each chunk's message index, anything else by walking the chunk's records;
+    an unfinished file's messages stop at ``limit_ns``."""
     path = container.path
     refs = []
     for ref in container.chunks:
-        if ref.channels is not None and channel not in ref.channels:
+        if ref.channels is not None and ref.channels.isdisjoint(channels):
             continue
         if step is not None and not ref.start_ns <= step * STEP_NS <= ref.end_ns:
             continue
@@ -187,13 +206,34 @@ def topic_chunks(
     with container.open() as stream, closing(container.chunks_data(refs)) as chunks:
         for ref, data in zip(refs, chunks, strict=True):
             cut = limit_ns if limit_ns is not None and ref.end_ns >= limit_ns else None
-            if cut is None:
+            found: dict[int, tuple[list[memoryview], _Ints]] = {}
+            for channel in channels if cut is None else ():
+                if ref.channels is not None and channel not in ref.channels:
+                    found[channel] = ([], np.empty(0, np.int64))
+                    continue
                 offsets = container.message_offsets(stream, ref, channel)
                 if offsets is not None:
-                    found = messages_at(path, data, offsets, channel, where=ref.offset)
-                    yield ref, data, found, log_times_at(data, offsets)
-                    continue
-            parts: dict[int, list[memoryview]] = {channel: []}
-            times: dict[int, list[int]] = {channel: []}
-            split_messages(path, data, parts, where=ref.offset, limit_ns=cut, times=times)
-            yield ref, data, parts[channel], np.array(times[channel], np.int64)
+                    parts = messages_at(path, data, offsets, channel, where=ref.offset)
+                    found[channel] = (parts, log_times_at(data, offsets))
+            walked = [channel for channel in channels if channel not in found]
+            if walked:
+                wanted: dict[int, list[memoryview]] = {channel: [] for channel in walked}
+                times: dict[int, list[int]] = {channel: [] for channel in walked}
+                split_messages(path, data, wanted, where=ref.offset, limit_ns=cut, times=times)
+                for channel in walked:
+                    found[channel] = (wanted[channel], np.array(times[channel], np.int64))
+            yield ref, data, [found[channel] for channel in channels]
+
+
+@contextmanager
+def gc_paused() -> Iterator[None]:
+    """No garbage collection while a loop over a topic's chunks makes and drops millions of
+    acyclic objects (a slice per message, a struct per decoded step): otherwise the
+    collector walks every object the process holds, again and again, for nothing."""
+    enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if enabled:
+            gc.enable()

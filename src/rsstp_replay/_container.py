@@ -16,6 +16,7 @@ import io
 import os
 import struct
 import zlib
+from collections import deque
 from collections.abc import Callable, Generator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
@@ -44,6 +45,9 @@ RECORD = struct.Struct("<BQ")
 MESSAGE_TIME = struct.Struct("<BQHIQ")
 """A message record's opcode, length, channel id, sequence and log time."""
 _CHUNK = struct.Struct("<QQQII")  # start, end, uncompressed size, crc, compression length
+CHUNK_THREADS = 2
+"""The threads that read, decompress and check the chunks ahead of their reader."""
+_AHEAD = 3  # chunks in flight: a thread each, and one done and waiting
 _PARSE_ERRORS = (
     McapError,
     struct.error,
@@ -96,8 +100,7 @@ class Container:
 
     def chunk_data(self, stream: BinaryIO, ref: ChunkRef) -> bytes:
         """The decompressed records of the chunk ``ref``, CRC-checked."""
-        stream.seek(ref.offset)
-        raw = stream.read(ref.length)
+        raw = os.pread(stream.fileno(), ref.length, ref.offset)  # no shared file position
         if len(raw) != ref.length:
             raise CorruptRecording(
                 f"{self.path}: the chunk at byte {ref.offset} is truncated: expected "
@@ -106,28 +109,32 @@ class Container:
         return chunk_records(self.path, raw, ref.offset)
 
     def chunks_data(self, refs: Sequence[ChunkRef]) -> Generator[bytes, None, None]:
-        """:meth:`chunk_data` of each chunk of ``refs``, in order, the next one read,
-        decompressed and checked on a second thread (file reads, zstd and CRCs release the
-        GIL; the switch interval is short meanwhile: :mod:`rsstp_sim.switching`) while the
-        caller works on this one; an error is raised where its chunk comes."""
+        """:meth:`chunk_data` of each chunk of ``refs``, in order, the next ones read,
+        decompressed and checked on :data:`CHUNK_THREADS` other threads (file reads, zstd and
+        CRCs release the GIL; the switch interval is short meanwhile:
+        :mod:`rsstp_sim.switching`) while the caller works on this one; an error is raised
+        where its chunk comes."""
         if len(refs) < 2:
             with self.open() as stream:
                 yield from (self.chunk_data(stream, ref) for ref in refs)
             return
         with (
             self.open() as stream,
-            ThreadPoolExecutor(max_workers=1, thread_name_prefix="rsstp-chunks") as ahead,
+            ThreadPoolExecutor(CHUNK_THREADS, thread_name_prefix="rsstp-chunks") as ahead,
             sooner_switches(),
         ):
-            coming = ahead.submit(self.chunk_data, stream, refs[0])
+            coming = deque(ahead.submit(self.chunk_data, stream, ref) for ref in refs[:_AHEAD])
+            later = iter(refs[_AHEAD:])
             try:
-                for following in [*refs[1:], None]:
-                    data = coming.result()
+                for _ in refs:
+                    data = coming.popleft().result()
+                    following = next(later, None)
                     if following is not None:
-                        coming = ahead.submit(self.chunk_data, stream, following)
+                        coming.append(ahead.submit(self.chunk_data, stream, following))
                     yield data
             finally:
-                coming.cancel()
+                for future in coming:
+                    future.cancel()
 
     def message_offsets(self, stream: BinaryIO, ref: ChunkRef, channel: int) -> _Offsets | None:
         """Where the messages of ``channel`` start in the chunk's records, in order, from the

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Generator
+from collections.abc import Generator, Sequence
 from contextlib import closing
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,7 +30,7 @@ import msgspec
 import numpy as np
 import numpy.typing as npt
 
-from rsstp_replay._chunks import count_messages, topic_chunks
+from rsstp_replay._chunks import count_messages, topic_chunks, topics_chunks
 from rsstp_replay._container import ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
 from rsstp_sim.errors import ScenarioError
@@ -83,6 +83,14 @@ class CheckedFile:
         """The chunks with messages of ``topic`` (or only those around ``step``'s log time),
         each with its records, those messages' bytes and their log times."""
         return topic_chunks(self.container, self.channels[topic], self.limit_ns, step=step)
+
+    def chunks_of(
+        self, topics: Sequence[str]
+    ) -> Generator[tuple[ChunkRef, bytes, list[tuple[list[memoryview], _Ints]]], None, None]:
+        """The chunks with messages of any of ``topics``, each read once, with its records
+        and, topic by topic, those messages' bytes and their log times."""
+        channels = [self.channels[topic] for topic in topics]
+        return topics_chunks(self.container, channels, self.limit_ns)
 
     def decode_one(self, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
         """The record of one message of ``topic``."""

@@ -16,12 +16,11 @@ file and where. A file whose writer was killed is read up to its last complete c
 from __future__ import annotations
 
 import bisect
-import gc
 import operator
 import os
 import warnings
-from collections.abc import Generator, Iterator
-from contextlib import closing, contextmanager
+from collections.abc import Generator
+from contextlib import closing
 from functools import partial
 from pathlib import Path
 from types import TracebackType
@@ -32,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
-from rsstp_replay._chunks import message_times
+from rsstp_replay._chunks import gc_paused, message_times
 from rsstp_replay._container import ChunkRef, open_container
 from rsstp_replay._contract import CheckedFile, check_file
 from rsstp_replay._decode import StepColumns
@@ -259,8 +258,21 @@ class Recording:
             self._events = self._event_table()
         return self._events.copy()
 
-    def _event_table(self) -> pd.DataFrame:
-        events = self._records("/rsstp/event")
+    def steps_and_events(self, *, geometry: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
+        """:meth:`steps` and :meth:`events` in one read of the chunks (each alone reads
+        every chunk, the events being among the steps): what an audit reads."""
+        self._check_open()
+        if self._events is not None:
+            return self.steps(geometry=geometry), self.events()
+        events: list[Any] = []
+        columns = self._step_columns(truth=True, events=events)
+        self._log_times = columns.log_time
+        self._events = self._event_table(events)
+        return columns.frame(geometry=geometry), self._events.copy()
+
+    def _event_table(self, events: list[Any] | None = None) -> pd.DataFrame:
+        if events is None:
+            events = self._records("/rsstp/event")
         return pd.DataFrame(
             {
                 "step": np.array([e.step for e in events], np.int64),
@@ -397,11 +409,19 @@ class Recording:
         """Every message of ``topic`` as its record, checked against its log time."""
         found: list[Any] = []
         for ref, _, parts, times in self._chunks(topic):
-            records = self._file.decode_many(topic, parts, times, ref)
-            for record, log_time in zip(records, times.tolist(), strict=True):
-                found.append(self._timed(topic, record, log_time, ref))
+            found += self._chunk_records(topic, ref, parts, times)
         self._counted(topic, len(found))
         return found
+
+    def _chunk_records(
+        self, topic: str, ref: ChunkRef, parts: list[memoryview], times: _Ints
+    ) -> list[Any]:
+        """A chunk's messages of ``topic`` as their records, checked against their log times."""
+        records = self._file.decode_many(topic, parts, times, ref)
+        return [
+            self._timed(topic, record, log_time, ref)
+            for record, log_time in zip(records, times.tolist(), strict=True)
+        ]
 
     def _counted(self, topic: str, found: int) -> None:
         """``found`` messages of ``topic`` must be the summary's count."""
@@ -430,8 +450,9 @@ class Recording:
                 f"{exc.text}"
             ) from None
 
-    def _step_columns(self, *, truth: bool) -> StepColumns:
-        """Decode and check every step message."""
+    def _step_columns(self, *, truth: bool, events: list[Any] | None = None) -> StepColumns:
+        """Decode and check every step message; with ``events``, add every event's record
+        to it, read in the same pass over the chunks."""
         record = self.scenario_record
         columns = StepColumns(
             self.n_steps + 1,
@@ -440,9 +461,15 @@ class Recording:
             truth=truth,
             geometry=ArmGeometry.from_scenario(self.scenario) if truth else None,
         )
-        with _gc_paused():
-            for ref, data, parts, times in self._chunks("/rsstp/step"):
-                self._decode_steps(columns, ref, data, parts, times)
+        topics = ("/rsstp/step",) if events is None else ("/rsstp/step", "/rsstp/event")
+        self._check_open()
+        with gc_paused():
+            for ref, data, found in self._file.chunks_of(topics):
+                self._decode_steps(columns, ref, data, *found[0])
+                if events is not None:
+                    events += self._chunk_records("/rsstp/event", ref, *found[1])
+        if events is not None:
+            self._counted("/rsstp/event", len(events))
         try:
             columns.check(actions=record.actions)
         except BadStep as exc:
@@ -497,15 +524,3 @@ def _row(columns: StepColumns, step: int) -> _AgentRow | None:
         int(columns.internal_state[index]),
         int(columns.model_version[index]),
     )
-
-
-@contextmanager
-def _gc_paused() -> Iterator[None]:
-    """No garbage collection while millions of acyclic objects come and go."""
-    enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if enabled:
-            gc.enable()

@@ -117,12 +117,13 @@ class World:
         self._poses: dict[int, Pose] = {}
         self._block = _FIRST_BLOCK
         self._row = 0
-        self._pose = self._pose_at(0)
+        self._pose = self.pose_at(0)
         self.last_blocker: Blocker | None = None
 
     # -- poses ---------------------------------------------------------------
 
-    def _pose_at(self, row: int) -> Pose:
+    def pose_at(self, row: int) -> Pose:
+        """The :class:`Pose` of a row of the world's table (a row :meth:`walk` gives)."""
         pose = self._poses.get(row)
         if pose is None:
             table = self.table
@@ -136,7 +137,7 @@ class World:
         row = self.table.row_of(code)
         if row < 0:
             raise UnknownPose(f"pose code {code} has not been reached")
-        return self._pose_at(row)
+        return self.pose_at(row)
 
     def _expand(self, row: int) -> None:
         """Compute the moves of ``row`` and of a block of poses around it: the block doubles
@@ -160,7 +161,7 @@ class World:
     def reset(self) -> Pose:
         """Put the arm back at the scenario's start pose."""
         self._row = 0
-        self._pose = self._pose_at(0)
+        self._pose = self.pose_at(0)
         self.last_blocker = None
         return self._pose
 
@@ -187,7 +188,7 @@ class World:
         if row != self._row:
             self._row = row
             pose = self._poses.get(row)
-            self._pose = pose if pose is not None else self._pose_at(row)
+            self._pose = pose if pose is not None else self.pose_at(row)
         blocker = self.last_blocker = self._blocker(blocker_code) if blocker_code else None
         return blocker
 
@@ -220,7 +221,7 @@ class World:
             add_code(blocker[at])
             row = reached
         self._row = row
-        self._pose = self._pose_at(row)
+        self._pose = self.pose_at(row)
         self.last_blocker = self.blocker_of(codes[-1]) if codes else None
         return np.array(rows, np.int64), np.array(codes, np.int64)
 
@@ -231,7 +232,7 @@ class World:
     def peek(self, action: int) -> tuple[Pose, Blocker | None]:
         """Where an action would lead from the current pose, without moving."""
         row, blocker_code = self._outcome(action)
-        return self._pose_at(row), self._blocker(blocker_code)
+        return self.pose_at(row), self._blocker(blocker_code)
 
     @property
     def current(self) -> Pose:

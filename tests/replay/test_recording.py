@@ -14,6 +14,7 @@ import signal
 import subprocess
 import sys
 import time
+import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,6 +26,7 @@ import pytest
 from mcap.reader import make_reader
 
 from rsstp_replay import EVENT_KINDS, open_recording
+from rsstp_replay._container import Container
 from rsstp_replay.errors import ReplayError, StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording import records
@@ -259,6 +261,40 @@ def test_events_table_equals_the_event_messages(refined_run: LiveRun) -> None:
         assert (row.step, row.kind, row.text) == (message.step, message.kind, message.text)
         assert json.loads(row.data) == message.data
     assert {"split", "merge", "add", "delete", "note", "blocked"} <= set(events["kind"])
+
+
+@pytest.mark.parametrize("cut", [False, True])
+def test_steps_and_events_read_in_one_pass_equal_them_read_apart(
+    refined_run: LiveRun, tmp_path: Path, cut: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """What an audit reads: both tables from one read of every chunk, the same as each
+    alone (a finished file through its message indexes, a cut one by walking its chunks)."""
+    path = refined_run.path
+    if cut:
+        offsets = _chunk_offsets(path)
+        path = tmp_path / "cut.mcap"
+        path.write_bytes(refined_run.path.read_bytes()[: offsets[len(offsets) // 2] + 200])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UnfinishedRecordingWarning)
+        apart, together = open_recording(path), open_recording(path)
+    reads: list[int] = []
+    chunk_data = Container.chunk_data
+
+    def counted(self: Container, stream: Any, ref: Any) -> bytes:
+        reads.append(ref.offset)
+        return chunk_data(self, stream, ref)
+
+    monkeypatch.setattr(Container, "chunk_data", counted)
+    steps, events = apart.steps(), apart.events()
+    read_apart, reads[:] = set(reads), []
+    both_steps, both_events = together.steps_and_events()
+    assert len(set(reads)) == len(reads)  # each chunk read once,
+    assert set(reads) == read_apart  # every chunk that either table reads
+    pd.testing.assert_frame_equal(both_steps, steps)
+    pd.testing.assert_frame_equal(both_events, events)
+    assert len(events) > 0 and events["step"].max() <= together.n_steps
+    pd.testing.assert_frame_equal(together.events(), events)  # kept: not read again
+    assert len(reads) == len(read_apart)
 
 
 # ------------------------------------------------------------------ memory and the model

@@ -159,14 +159,21 @@ def truth_record(pose: Pose, blocker: Blocker | None) -> TruthRecord:
     """The truth record of a step ending in ``pose`` after a move that ``blocker`` blocked
     (None: it moved). Poses are cached read-only objects, so a random walk revisiting them
     gets the same immutable record."""
-    positions: list[list[float]] = pose.joint_positions.tolist()
-    distances: list[list[float]] = pose.distances.tolist()
+    angles, points, distances = pose.truth_values()
+    m = len(distances) // len(angles)
     return TruthRecord(
-        angles_deg=tuple(int(v) for v in pose.angles_deg),
-        joint_positions=tuple(PointRecord(x=x, y=y) for x, y in positions),
+        angles_deg=tuple(angles),
+        joint_positions=tuple(
+            [PointRecord(x=x, y=y) for x, y in zip(points[0::2], points[1::2], strict=True)]
+        ),
         blocked=blocker is not None,
         blocked_by=blocked_by_record(blocker),
-        distances=tuple(DistancesRecord(obstacles=tuple(row)) for row in distances),
+        distances=tuple(
+            [
+                DistancesRecord(obstacles=tuple(distances[k * m : (k + 1) * m]))
+                for k in range(len(angles))
+            ]
+        ),
     )
 
 
