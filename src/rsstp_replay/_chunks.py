@@ -2,11 +2,11 @@
 
 The reader's second layer, above :mod:`rsstp_replay._container` (which reads each chunk
 record, decompressed and CRC-checked) and below :mod:`rsstp_replay._contract`. A chunk's
-message records are sliced out of its bytes (:func:`split_messages`, or through the chunk's
-message index, :func:`messages_at`) for a decoder to take many at once; :func:`topic_chunks`
-reads a topic chunk by chunk (:func:`topics_chunks` several topics in one read of each
-chunk). This is the hot path of reading a recording: no object per record but the slice of
-its data.
+message records are found in its bytes (:func:`split_bounds`, or through the chunk's
+message index, :func:`message_bounds`) and sliced out for a decoder to take many at once;
+:func:`topic_chunks` reads a topic chunk by chunk (:func:`topics_chunks` several topics in
+one read of each chunk). This is the hot path of reading a recording: no object per record
+but the slice of its data, or only where it starts and ends.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ import struct
 from collections.abc import Generator, Iterator, Sequence
 from contextlib import closing, contextmanager
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import numpy.typing as npt
@@ -30,9 +31,10 @@ __all__ = [
     "gc_paused",
     "message_channels",
     "message_times",
+    "Messages",
     "log_times_at",
-    "messages_at",
-    "split_messages",
+    "message_bounds",
+    "split_bounds",
     "topic_chunks",
     "topics_chunks",
 ]
@@ -44,12 +46,27 @@ _LOG_TIME = 15  # where a message record's log_time starts
 _MESSAGE_OP = int(Opcode.MESSAGE)
 
 
-def messages_at(
+class Messages(NamedTuple):
+    """A chunk's messages of one channel: where each one's data starts and ends in the
+    chunk's records (no object per message), and each one's log time."""
+
+    starts: list[int]
+    ends: list[int]
+    times: _Ints
+
+    def views(self, data: bytes) -> list[memoryview]:
+        """Each message's data, a slice of the chunk's records ``data`` (no copy)."""
+        view = memoryview(data)
+        return [view[a:b] for a, b in zip(self.starts, self.ends, strict=True)]
+
+
+def message_bounds(
     path: Path, data: bytes, offsets: npt.NDArray[np.int64], channel: int, *, where: int
-) -> list[memoryview]:
-    """The data of the message records of ``channel`` that start at ``offsets`` in ``data``
-    (from the chunk's message index: no walk over the other records); each offset is checked
-    to hold a message record of that channel inside the chunk."""
+) -> tuple[list[int], list[int]]:
+    """Where the data of the message records of ``channel`` that start at ``offsets`` in
+    ``data`` starts and ends (from the chunk's message index: no walk over the other
+    records); each offset is checked to hold a message record of that channel inside the
+    chunk."""
     size = len(data)
     if len(offsets) and (int(offsets[0]) < 0 or int(offsets[-1]) + _MESSAGE_HEAD > size):
         raise CorruptRecording(
@@ -70,25 +87,22 @@ def messages_at(
             f"{path}: the message index of the chunk at byte {where} does not point at "
             f"messages of channel {channel}"
         )
-    view = memoryview(data)
-    return [
-        view[a:b] for a, b in zip((offsets + _MESSAGE_HEAD).tolist(), ends.tolist(), strict=True)
-    ]
+    return (offsets + _MESSAGE_HEAD).tolist(), ends.tolist()
 
 
-def split_messages(
+def split_bounds(
     path: Path,
     data: bytes,
-    wanted: dict[int, list[memoryview]],
+    wanted: dict[int, tuple[list[int], list[int]]],
     *,
     where: int,
     limit_ns: int | None = None,
     times: dict[int, list[int]] | None = None,
 ) -> None:
-    """Append the data of each message record in ``data`` to ``wanted[channel_id]`` (channels
-    not in ``wanted`` are skipped; with ``limit_ns``, so are messages logged at or after it),
-    and with ``times``, its ``log_time`` to ``times[channel_id]``."""
-    view = memoryview(data)
+    """Append where the data of each message record in ``data`` starts and ends to
+    ``wanted[channel_id]`` (channels not in ``wanted`` are skipped; with ``limit_ns``, so are
+    messages logged at or after it), and with ``times``, its ``log_time`` to
+    ``times[channel_id]``."""
     size = len(data)
     get = wanted.get
     position = 0
@@ -100,7 +114,8 @@ def split_messages(
                 if opcode == _MESSAGE_OP:
                     found = get(channel)
                     if found is not None:
-                        found.append(view[position + _MESSAGE_HEAD : position + 9 + length])
+                        found[0].append(position + _MESSAGE_HEAD)
+                        found[1].append(position + 9 + length)
                 position += 9 + length
         else:
             limit = limit_ns if limit_ns is not None else 1 << 64
@@ -111,7 +126,8 @@ def split_messages(
                 if opcode == _MESSAGE_OP and log_time < limit:
                     found = get(channel)
                     if found is not None:
-                        found.append(view[position + _MESSAGE_HEAD : position + 9 + length])
+                        found[0].append(position + _MESSAGE_HEAD)
+                        found[1].append(position + 9 + length)
                         if times is not None:
                             found_times[channel].append(log_time)
                 position += 9 + length
@@ -137,7 +153,7 @@ def message_channels(data: bytes) -> list[int]:
 
 def log_times_at(data: bytes, offsets: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
     """The log times of the message records that start at ``offsets`` in ``data`` (offsets
-    that :func:`messages_at` checked)."""
+    that :func:`message_bounds` checked)."""
     raw = np.frombuffer(data, np.uint8)
     at = offsets[:, None] + np.arange(_LOG_TIME, _LOG_TIME + 8)
     times: npt.NDArray[np.int64] = raw[at].copy().view("<u8").ravel().astype(np.int64)
@@ -177,8 +193,8 @@ def topic_chunks(
     """The chunks with messages of ``channel`` (or only those around ``step``'s log time),
     each with its records, those messages' bytes and their log times (:func:`topics_chunks`
     of one channel)."""
-    for ref, data, [(parts, times)] in topics_chunks(container, (channel,), limit_ns, step=step):
-        yield ref, data, parts, times
+    for ref, data, [found] in topics_chunks(container, (channel,), limit_ns, step=step):
+        yield ref, data, found.views(data), found.times
 
 
 def topics_chunks(
@@ -187,10 +203,10 @@ def topics_chunks(
     limit_ns: int | None,
     *,
     step: int | None = None,
-) -> Generator[tuple[ChunkRef, bytes, list[tuple[list[memoryview], _Ints]]], None, None]:
+) -> Generator[tuple[ChunkRef, bytes, list[Messages]], None, None]:
     """The chunks with messages of any of ``channels`` (or only those around ``step``'s log
-    time), each with its records and, channel by channel, those messages' bytes and their
-    log times: one read of each chunk for several topics. A finished file's messages are
+    time), each with its records and, channel by channel, its :class:`Messages`: one read of
+    each chunk for several topics. A finished file's messages are
     found through each chunk's message index, anything else by walking the chunk's records;
     an unfinished file's messages stop at ``limit_ns``."""
     path = container.path
@@ -206,22 +222,23 @@ def topics_chunks(
     with container.open() as stream, closing(container.chunks_data(refs)) as chunks:
         for ref, data in zip(refs, chunks, strict=True):
             cut = limit_ns if limit_ns is not None and ref.end_ns >= limit_ns else None
-            found: dict[int, tuple[list[memoryview], _Ints]] = {}
+            found: dict[int, Messages] = {}
             for channel in channels if cut is None else ():
                 if ref.channels is not None and channel not in ref.channels:
-                    found[channel] = ([], np.empty(0, np.int64))
+                    found[channel] = Messages([], [], np.empty(0, np.int64))
                     continue
                 offsets = container.message_offsets(stream, ref, channel)
                 if offsets is not None:
-                    parts = messages_at(path, data, offsets, channel, where=ref.offset)
-                    found[channel] = (parts, log_times_at(data, offsets))
+                    starts, ends = message_bounds(path, data, offsets, channel, where=ref.offset)
+                    found[channel] = Messages(starts, ends, log_times_at(data, offsets))
             walked = [channel for channel in channels if channel not in found]
             if walked:
-                wanted: dict[int, list[memoryview]] = {channel: [] for channel in walked}
+                wanted: dict[int, tuple[list[int], list[int]]] = {c: ([], []) for c in walked}
                 times: dict[int, list[int]] = {channel: [] for channel in walked}
-                split_messages(path, data, wanted, where=ref.offset, limit_ns=cut, times=times)
+                split_bounds(path, data, wanted, where=ref.offset, limit_ns=cut, times=times)
                 for channel in walked:
-                    found[channel] = (wanted[channel], np.array(times[channel], np.int64))
+                    starts, ends = wanted[channel]
+                    found[channel] = Messages(starts, ends, np.array(times[channel], np.int64))
             yield ref, data, [found[channel] for channel in channels]
 
 

@@ -30,7 +30,7 @@ import msgspec
 import numpy as np
 import numpy.typing as npt
 
-from rsstp_replay._chunks import count_messages, topic_chunks, topics_chunks
+from rsstp_replay._chunks import Messages, count_messages, topic_chunks, topics_chunks
 from rsstp_replay._container import ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
 from rsstp_sim.errors import ScenarioError
@@ -86,9 +86,9 @@ class CheckedFile:
 
     def chunks_of(
         self, topics: Sequence[str]
-    ) -> Generator[tuple[ChunkRef, bytes, list[tuple[list[memoryview], _Ints]]], None, None]:
+    ) -> Generator[tuple[ChunkRef, bytes, list[Messages]], None, None]:
         """The chunks with messages of any of ``topics``, each read once, with its records
-        and, topic by topic, those messages' bytes and their log times."""
+        and, topic by topic, its :class:`~rsstp_replay._chunks.Messages`."""
         channels = [self.channels[topic] for topic in topics]
         return topics_chunks(self.container, channels, self.limit_ns)
 

@@ -19,7 +19,7 @@ import bisect
 import operator
 import os
 import warnings
-from collections.abc import Generator
+from collections.abc import Generator, Sequence
 from contextlib import closing
 from functools import partial
 from pathlib import Path
@@ -31,7 +31,7 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
-from rsstp_replay._chunks import gc_paused, message_times
+from rsstp_replay._chunks import Messages, gc_paused, message_times
 from rsstp_replay._container import ChunkRef, open_container
 from rsstp_replay._contract import CheckedFile, check_file
 from rsstp_replay._decode import StepColumns
@@ -405,6 +405,12 @@ class Recording:
         self._check_open()
         return self._file.chunks(topic, step=step)
 
+    def _chunks_of(
+        self, topics: Sequence[str]
+    ) -> Generator[tuple[ChunkRef, bytes, list[Messages]], None, None]:
+        self._check_open()
+        return self._file.chunks_of(topics)
+
     def _records(self, topic: str) -> list[Any]:
         """Every message of ``topic`` as its record, checked against its log time."""
         found: list[Any] = []
@@ -462,12 +468,12 @@ class Recording:
             geometry=ArmGeometry.from_scenario(self.scenario) if truth else None,
         )
         topics = ("/rsstp/step",) if events is None else ("/rsstp/step", "/rsstp/event")
-        self._check_open()
         with gc_paused():
-            for ref, data, found in self._file.chunks_of(topics):
-                self._decode_steps(columns, ref, data, *found[0])
+            for ref, data, found in self._chunks_of(topics):
+                self._decode_steps(columns, ref, data, found[0].views(data), found[0].times)
                 if events is not None:
-                    events += self._chunk_records("/rsstp/event", ref, *found[1])
+                    event_parts = found[1].views(data)
+                    events += self._chunk_records("/rsstp/event", ref, event_parts, found[1].times)
         if events is not None:
             self._counted("/rsstp/event", len(events))
         try:

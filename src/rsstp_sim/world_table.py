@@ -378,11 +378,19 @@ class WorldTable:
     def rows_of(self, codes: IntArray) -> Int32Array:
         """The row of every pose code, -1 for a pose not in the table."""
         if self._dense is not None:
-            angles = (codes[:, None] // self.radix) % 360
-            cells = (((angles - self._initial) % 360) // self._spacing) @ self._lattice_radix
-            return np.asarray(self._dense[cells], dtype=np.int32)
+            return self.rows_at((codes[:, None] // self.radix) % 360)
         get = self._row_of.get
         return np.fromiter((get(c, -1) for c in codes.tolist()), np.int32, len(codes))
+
+    def rows_at(self, angles: IntArray) -> Int32Array:
+        """The row of every pose given by its joint angles ``(poses, n)`` (integer degrees in
+        ``0 .. 359``), -1 for a pose not in the table; a pose off the scenario's lattice of
+        angles is never in it, but a dense table maps it to a lattice pose's row, so a caller
+        that may hold one compares the row's code."""
+        if self._dense is not None:
+            cells = (((angles - self._initial) % 360) // self._spacing) @ self._lattice_radix
+            return np.asarray(self._dense[cells], dtype=np.int32)
+        return self.rows_of(np.asarray(angles, np.int64) @ self.radix)
 
     def row_of(self, code: int) -> int:
         """The row of one pose code, -1 when the pose is not in the table."""

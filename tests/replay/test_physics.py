@@ -14,12 +14,21 @@ from test_corrupt import rewrite
 
 from rsstp_cli.replay import main
 from rsstp_replay import open_recording
+from rsstp_replay.audits import physics
 from rsstp_replay.audits.physics import check_physics
 from rsstp_sim import load_scenario, make_strategy
 from rsstp_sim.recording import record
 
 ROOT = Path(__file__).resolve().parents[2]
 STEPS = 3_000
+
+
+@pytest.fixture(autouse=True, params=["move by move", "whole table"])
+def world_walk(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every check twice: the world walked move by move, and tabulated whole with the
+    recorded poses followed in numpy (what a replay longer than its world's pose space does)."""
+    if request.param == "whole table":
+        monkeypatch.setattr(physics, "pose_space_size", lambda scenario: 0)
 
 
 @pytest.fixture(scope="module")

@@ -89,7 +89,7 @@ def check_physics(recording: Recording, steps: pd.DataFrame | None = None) -> Ph
         if steps is None:
             steps = recording.steps(geometry=False)
         actions = steps["action"].to_numpy(dtype=np.int64, na_value=-1)
-        world, rows, blockers = _simulate(recording, actions)
+        world, rows, blockers = _simulate(recording, actions, steps)
         _check_agent_view(steps, world, rows)
         _check_truth(recording, world, rows, blockers)
         _check_blocked_events(recording, world, actions, blockers)
@@ -125,12 +125,17 @@ def _plain(value: object) -> str:
     return json.dumps(msgspec.to_builtins(value), separators=(",", ":"))
 
 
-def _simulate(recording: Recording, actions: IntArray) -> tuple[World, IntArray, IntArray]:
+def _simulate(
+    recording: Recording, actions: IntArray, steps: pd.DataFrame
+) -> tuple[World, IntArray, IntArray]:
     """The world after the recorded actions, the table row of every step's pose and the
     blocker code of every move (step 0 is the start pose, not blocked)."""
     world = World(recording.scenario)
     if not world.per_move and recording.n_steps >= pose_space_size(recording.scenario):
         world.table.complete()  # a long walk meets most poses: all at once costs less
+        followed = _followed(world, actions, steps)
+        if followed is not None:
+            return world, *followed
     try:
         rows, blockers = world.walk(actions[1:].tolist())
     except ActionError:
@@ -142,6 +147,38 @@ def _simulate(recording: Recording, actions: IntArray) -> tuple[World, IntArray,
             f"{actions[step]} is not one of the scenario's actions {sorted(known)}",
         ) from None
     return world, np.concatenate([[0], rows]), np.concatenate([[0], blockers])
+
+
+def _followed(
+    world: World, actions: IntArray, steps: pd.DataFrame
+) -> tuple[IntArray, IntArray] | None:
+    """The rows and blockers of :func:`_simulate`, from a whole world table and the recorded
+    poses, when each step's pose is where the world's table moves the one before by the
+    step's action (checked at once in numpy, not move by move); None at the first step where
+    it is not, which the walk then finds."""
+    table = world.table
+    names = [f"angle_deg_{j}" for j in range(len(table.radix))]
+    if not set(names) <= set(steps.columns) or len(steps) != len(actions):
+        return None
+    angles = steps[names].to_numpy(np.int64)
+    rows = table.rows_at(angles).astype(np.int64)
+    codes = angles @ table.radix
+    if rows[0] != 0 or (rows < 0).any():
+        return None
+    if not np.array_equal(np.frombuffer(table.codes, np.int64)[rows], codes):
+        return None
+    index = np.full(max(table.actions) + 1, -1, np.int64)
+    index[list(table.actions)] = np.arange(len(table.actions))
+    moves = actions[1:]
+    if ((moves < 0) | (moves >= len(index))).any():
+        return None
+    k = index[moves]
+    if (k < 0).any():
+        return None
+    if not np.array_equal(table.next_array()[rows[:-1], k], rows[1:]):
+        return None
+    blockers = table.blocker_array()[rows[:-1], k].astype(np.int64)
+    return rows, np.concatenate([[0], blockers])
 
 
 def _check_agent_view(steps: pd.DataFrame, world: World, rows: IntArray) -> None:
@@ -174,17 +211,19 @@ def _check_truth(recording: Recording, world: World, rows: IntArray, blockers: I
     keys = inverse.tolist()
     step = 0
     with gc_paused():
-        for _, _, parts, _ in recording._chunks("/rsstp/step"):
-            chunk_keys = keys[step : step + len(parts)]
-            if len(chunk_keys) != len(parts):  # pragma: no cover - the steps were counted
+        for _, data, [found] in recording._chunks_of(("/rsstp/step",)):
+            starts, ends = found.starts, found.ends
+            chunk_keys = keys[step : step + len(starts)]
+            if len(chunk_keys) != len(starts):  # pragma: no cover - the steps were counted
                 raise PhysicsDifference(step, "truth", "more step messages than steps")
             tails = list(map(expected.__getitem__, chunk_keys))
-            # One C-level pass over the chunk's messages; Python looks closer at a mismatch.
-            if not all(map(bytes.endswith, map(bytes, parts), tails)):
-                for offset, (part, tail) in enumerate(zip(parts, tails, strict=True)):
-                    if not part.tobytes().endswith(tail):
-                        _compare_decoded(step + offset, part.tobytes(), tail[len(_TRUTH_KEY) : -1])
-            step += len(parts)
+            # One C-level pass over the chunk's messages, in place; Python looks closer only
+            # at a mismatch.
+            if not all(map(data.endswith, tails, starts, ends)):
+                for offset, (a, b, tail) in enumerate(zip(starts, ends, tails, strict=True)):
+                    if not data.endswith(tail, a, b):
+                        _compare_decoded(step + offset, data[a:b], tail[len(_TRUTH_KEY) : -1])
+            step += len(starts)
 
 
 def _compare_decoded(step: int, data: bytes, want: bytes) -> None:
