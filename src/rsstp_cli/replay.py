@@ -23,7 +23,12 @@ from typing import TYPE_CHECKING, Any
 from rsstp_cli._commandline import Parser, UsageError, add_no_cache, progress, run_command
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
-from rsstp_replay.table_files import TABLE_FORMATS, sidecar_path, write_table
+from rsstp_replay.table_files import (
+    TABLE_FORMATS,
+    sidecar_path,
+    write_table,
+    write_table_parts,
+)
 from rsstp_replay.tables import TABLES, recording_table
 from rsstp_sim.files import check_output
 from rsstp_sim.words import counted
@@ -143,10 +148,13 @@ def _check_table_output(out: Path, *, force: bool) -> None:
 def _write_table(table: pd.DataFrame, out: Path) -> None:
     """Write ``table`` whole (:func:`rsstp_replay.table_files.write_table`): a failed write leaves
     no partial table and the old one untouched."""
-    written = write_table(table, out)
+    _wrote(len(table), table, out, write_table(table, out))
+
+
+def _wrote(rows: int, table: pd.DataFrame, out: Path, written: list[Path]) -> None:
     index = f" (index {table.index.name})" if table.index.name is not None else ""
     sidecar = f"; dtypes in {written[1]}" if len(written) > 1 else ""
-    print(f"wrote {len(table):,} rows and {len(table.columns)} columns{index} to {out}{sidecar}")
+    print(f"wrote {rows:,} rows and {len(table.columns)} columns{index} to {out}{sidecar}")
 
 
 def _cmd_table(args: argparse.Namespace) -> int:
@@ -155,6 +163,11 @@ def _cmd_table(args: argparse.Namespace) -> int:
         raise UsageError(f"table: --truth adds to the steps table, not to --what {args.what}")
     _check_table_output(out, force=args.force)
     with _open(args.file) as recording:
+        if args.what == "steps" and not args.truth and out.suffix.lower() == ".parquet":
+            # Written a part at a time while the next is decoded.
+            head = write_table_parts(recording.step_parts(), out)
+            _wrote(recording.n_steps + 1, head, out, [out])
+            return 0
         table = recording_table(
             recording, args.what, truth=args.truth, truth_cache=not args.no_cache
         )

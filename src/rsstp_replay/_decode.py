@@ -268,8 +268,16 @@ class StepColumns:
         self._check_numbers(first, flat[:n])
         self.blocked[s] = np.array([t.blocked for t in truths], np.bool_)
         labels = self.blocker_labels
-        for index, truth in enumerate(truths):
-            by = truth.blocked_by
+        bys = [t.blocked_by for t in truths]
+        with_blocker = k - bys.count(None)
+        if not with_blocker:
+            return
+        # The rows with a blocker are the blocked ones, unless one stands where the arm moved
+        # (check() then names it): then every row is looked at.
+        blocked = np.flatnonzero(self.blocked[s]).tolist()
+        among = sum(bys[index] is not None for index in blocked)
+        for index in blocked if among == with_blocker else range(k):
+            by = bys[index]
             if by is not None:
                 code = labels.get(by)
                 if code is None:
@@ -312,40 +320,44 @@ class StepColumns:
             if self.n_rows and self.blocked[0]:
                 raise BadStep("truth.blocked: expected false at step 0 (the reset)", step=0)
 
-    def frame(self, *, geometry: bool = True, copy: bool = False) -> pd.DataFrame:
+    def frame(
+        self, *, geometry: bool = True, copy: bool = False, rows: slice | None = None
+    ) -> pd.DataFrame:
         """The steps table, indexed by ``step`` (see :meth:`rsstp_replay.Recording.steps` for
         the columns; :meth:`check` made the steps ``0 .. n_rows - 1``); ``geometry=False``
         leaves out the joint positions and distances; ``copy=True`` gives a table that shares
-        no array with these columns."""
-        n = self.n_rows
-        action_mask = np.zeros(n, np.bool_)
-        action_mask[self.action_nulls] = True
-        before_mask = np.zeros(n, np.bool_)
-        before_mask[self.state_before_nulls] = True
+        no array with these columns; ``rows``: only those rows (a part of the table, its
+        index the steps' numbers)."""
+        part = slice(0, self.n_rows) if rows is None else rows
+        start, stop = part.start, part.stop
+        action_mask = np.zeros(stop - start, np.bool_)
+        action_mask[[t - start for t in self.action_nulls if start <= t < stop]] = True
+        before_mask = np.zeros(stop - start, np.bool_)
+        before_mask[[t - start for t in self.state_before_nulls if start <= t < stop]] = True
         columns: dict[str, Any] = {
-            "action": pd.arrays.IntegerArray(self.action, action_mask),
-            "state_before": pd.arrays.IntegerArray(self.state_before, before_mask),
-            "internal_state": self.internal_state,
-            "sensation": self.sensation,
-            "feedback": self.feedback,
-            "model_version": self.model_version,
-            "no_transition": self.no_transition,
+            "action": pd.arrays.IntegerArray(self.action[part], action_mask),
+            "state_before": pd.arrays.IntegerArray(self.state_before[part], before_mask),
+            "internal_state": self.internal_state[part],
+            "sensation": self.sensation[part],
+            "feedback": self.feedback[part],
+            "model_version": self.model_version[part],
+            "no_transition": self.no_transition[part],
         }
         if self.truth:
-            columns["blocked"] = self.blocked
-            columns |= self._blocked_columns()
+            columns["blocked"] = self.blocked[part]
+            columns |= self._blocked_columns(part)
             for j in range(self.n_joints):
-                columns[f"angle_deg_{j}"] = self.angles_deg[j]
+                columns[f"angle_deg_{j}"] = self.angles_deg[j, part]
         if self.truth and geometry:
-            columns |= self._geometry_columns()
-        return pd.DataFrame(columns, index=pd.RangeIndex(n, name="step"), copy=copy)
+            columns |= self._geometry_columns(part)
+        return pd.DataFrame(columns, index=pd.RangeIndex(start, stop, name="step"), copy=copy)
 
-    def _geometry_columns(self) -> dict[str, npt.NDArray[np.float64]]:
-        """``joint{k}_x``, ``joint{k}_y`` and ``dist_{k}_{j}``: each distinct pose computed
-        once (a long run revisits its poses; found by hashing its code, ``sum_j angle_j *
-        360**j``), each column taken whole from those."""
+    def _geometry_columns(self, part: slice) -> dict[str, npt.NDArray[np.float64]]:
+        """``joint{k}_x``, ``joint{k}_y`` and ``dist_{k}_{j}`` of the rows ``part``: each
+        distinct pose computed once (a long run revisits its poses; found by hashing its
+        code, ``sum_j angle_j * 360**j``), each column taken whole from those."""
         places = 360 ** np.arange(self.n_joints, dtype=np.int64)
-        index, codes = pd.factorize(places @ self.angles_deg)
+        index, codes = pd.factorize(places @ self.angles_deg[:, part])
         poses = codes[:, None] // places % 360
         positions, distances = pose_numbers(self._geometry(), poses)
         columns = {}
@@ -357,9 +369,10 @@ class StepColumns:
                 columns[f"dist_{k}_{j}"] = distances[:, k, j].take(index)
         return columns
 
-    def _blocked_columns(self) -> dict[str, Any]:
-        """``blocked_kind`` and the index columns of :data:`BLOCKED_COLUMNS`, taken from the
-        per-row blocker codes through one small table per column (no object per row)."""
+    def _blocked_columns(self, part: slice) -> dict[str, Any]:
+        """``blocked_kind`` and the index columns of :data:`BLOCKED_COLUMNS` of the rows
+        ``part``, taken from the per-row blocker codes through one small table per column (no
+        object per row)."""
         n_codes = len(self.blocker_labels)
         # Code -1 (not blocked) takes the last entry: no kind, every index missing.
         kinds = np.full(n_codes + 1, -1, np.int8)
@@ -372,11 +385,12 @@ class StepColumns:
             kinds[code] = BLOCKER_KINDS.index(by.kind)
             for name, index in zip(BLOCKED_COLUMNS[by.kind], by.indices, strict=True):
                 values[name][code] = index
+        blocker = self.blocker[part]
         columns: dict[str, Any] = {
-            "blocked_kind": pd.Categorical.from_codes(kinds[self.blocker], dtype=_KIND_DTYPE)
+            "blocked_kind": pd.Categorical.from_codes(kinds[blocker], dtype=_KIND_DTYPE)
         }
         for name, table in values.items():
-            column = table[self.blocker]
+            column = table[blocker]
             columns[name] = pd.arrays.IntegerArray(column, column < 0)
         return columns
 

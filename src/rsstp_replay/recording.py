@@ -459,14 +459,47 @@ class Recording:
     def _step_columns(self, *, truth: bool, events: list[Any] | None = None) -> StepColumns:
         """Decode and check every step message; with ``events``, add every event's record
         to it, read in the same pass over the chunks."""
+        columns = self._new_step_columns(truth=truth)
+        for _ in self._decoding(columns, events):
+            pass
+        self._check_steps(columns)
+        return columns
+
+    def step_parts(self, rows: int = 262_144) -> Generator[pd.DataFrame, None, None]:
+        """The steps table (:meth:`steps`) in parts of ``rows`` rows, in order (their
+        ``pd.concat`` is :meth:`steps`), each given as soon as its steps are decoded, the
+        last once every step is checked: to write a long table while the rest is decoded
+        (``rsstp-replay table`` does, :func:`~rsstp_replay.table_files.write_table_parts`).
+        An error raised on the way (a corrupt step) voids the parts given before it."""
+        if rows < 1:
+            raise ValueError(f"a part has at least one row, not {rows}")
+        self._check_open()
+        columns = self._new_step_columns(truth=True)
+        done = 0
+        for _ in self._decoding(columns, None):
+            while columns.rows - done >= rows:
+                yield columns.frame(rows=slice(done, done + rows))
+                done += rows
+        self._check_steps(columns)
+        self._log_times = columns.log_time
+        if done < columns.n_rows:
+            yield columns.frame(rows=slice(done, columns.n_rows))
+
+    def _new_step_columns(self, *, truth: bool) -> StepColumns:
         record = self.scenario_record
-        columns = StepColumns(
+        return StepColumns(
             self.n_steps + 1,
             n_joints=record.n_joints,
             n_obstacles=len(record.obstacles),
             truth=truth,
             geometry=ArmGeometry.from_scenario(self.scenario) if truth else None,
         )
+
+    def _decoding(
+        self, columns: StepColumns, events: list[Any] | None
+    ) -> Generator[None, None, None]:
+        """Decode the step messages into ``columns`` chunk by chunk (pausing after each);
+        with ``events``, add every event's record to it from the same chunks."""
         topics = ("/rsstp/step",) if events is None else ("/rsstp/step", "/rsstp/event")
         with gc_paused():
             for ref, data, found in self._chunks_of(topics):
@@ -474,13 +507,15 @@ class Recording:
                 if events is not None:
                     event_parts = found[1].views(data)
                     events += self._chunk_records("/rsstp/event", ref, event_parts, found[1].times)
+                yield
         if events is not None:
             self._counted("/rsstp/event", len(events))
+
+    def _check_steps(self, columns: StepColumns) -> None:
         try:
-            columns.check(actions=record.actions)
+            columns.check(actions=self.scenario_record.actions)
         except BadStep as exc:
             raise CorruptRecording(f"{self.path}: step {exc.step}: {exc.text}") from None
-        return columns
 
     def _agent_columns(self) -> StepColumns:
         self._check_open()

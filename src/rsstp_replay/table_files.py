@@ -28,6 +28,9 @@ from __future__ import annotations
 
 import json
 import os
+from collections.abc import Iterable
+from concurrent.futures import Future, ThreadPoolExecutor, wait
+from contextlib import suppress
 from pathlib import Path
 from typing import Any
 
@@ -37,7 +40,14 @@ from rsstp_replay.errors import TableError
 from rsstp_sim.errors import OutputError
 from rsstp_sim.files import written_whole
 
-__all__ = ["SIDECAR_SUFFIX", "TABLE_FORMATS", "read_table", "sidecar_path", "write_table"]
+__all__ = [
+    "SIDECAR_SUFFIX",
+    "TABLE_FORMATS",
+    "read_table",
+    "sidecar_path",
+    "write_table",
+    "write_table_parts",
+]
 
 TABLE_FORMATS = (".parquet", ".csv")
 """The suffixes of the table files :func:`write_table` writes and :func:`read_table` reads."""
@@ -107,6 +117,46 @@ def write_table(table: pd.DataFrame, path: str | os.PathLike[str]) -> list[Path]
             side.unlink(missing_ok=True)
             raise
     return [out, sidecar]
+
+
+def write_table_parts(parts: Iterable[pd.DataFrame], path: str | os.PathLike[str]) -> pd.DataFrame:
+    """Write the table made of ``parts`` (consecutive row ranges of one table, the same
+    columns and dtypes) to ``path`` as Parquet, a row group per part, each written on a
+    second thread while the next part is made: read back, the same table as
+    :func:`write_table` of their concatenation. Returns the first part's empty head (the
+    columns and the index). An error from ``parts`` or from the write leaves no file, and
+    what was at ``path`` as it was."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    out = Path(path)
+    if _format_of(out) != ".parquet":
+        raise TableError(f"{out}: a table written in parts goes to Parquet")
+    each = iter(parts)
+    first = next(each, None)
+    if first is None:
+        raise TableError(f"{out}: no part to write")
+    keep_index = _index_name(first, out) is not None
+    with written_whole(out) as side, ThreadPoolExecutor(1, "rsstp-parquet") as thread:
+        arrow = pa.Table.from_pandas(first, preserve_index=keep_index)
+        schema = arrow.schema
+        writer = pq.ParquetWriter(side, schema)
+        pending: Future[None] = thread.submit(writer.write_table, arrow)
+        try:
+            for part in each:
+                arrow = pa.Table.from_pandas(part, schema=schema, preserve_index=keep_index)
+                pending.result()
+                pending = thread.submit(writer.write_table, arrow)
+            pending.result()
+        except BaseException:
+            pending.cancel()
+            wait([pending])
+            with suppress(Exception):  # (the error that stopped the write is the one to say)
+                writer.close()
+            side.unlink(missing_ok=True)
+            raise
+        writer.close()
+    return first.iloc[:0]
 
 
 def _index_name(table: pd.DataFrame, out: Path) -> str | None:

@@ -26,6 +26,7 @@ from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
 from rsstp_replay import Recording, errors, open_recording
+from rsstp_replay.table_files import write_table_parts
 from rsstp_sim import AgentView, StrategyBase, load_scenario
 from rsstp_sim.recording.recorder import record
 
@@ -421,6 +422,20 @@ def test_cli_prints_one_line_and_exits_with_2(
     assert lines[0].startswith("rsstp-replay: error: ")
     assert str(damaged[name]) in lines[0]
     assert re.search(CASES[name].match, lines[0]), lines[0]
+
+
+def test_a_table_streamed_from_a_recording_broken_at_its_end_is_not_kept(
+    damaged: dict[str, Path], tmp_path: Path
+) -> None:
+    """The steps are checked as a whole once all are read: the parts written before the
+    check found the gap are dropped, and the old table stays."""
+    out = tmp_path / "steps.parquet"
+    out.write_bytes(b"old")
+    with open_recording(damaged["step-gap"]) as recording:
+        with pytest.raises(errors.CorruptRecording, match=r"step 50: expected step 50"):
+            write_table_parts(recording.step_parts(10), out)
+    assert out.read_bytes() == b"old"
+    assert [p.name for p in tmp_path.iterdir()] == ["steps.parquet"]
 
 
 def test_a_message_index_that_points_elsewhere_is_refused(original: Path, tmp_path: Path) -> None:

@@ -297,6 +297,17 @@ def test_steps_and_events_read_in_one_pass_equal_them_read_apart(
     assert len(reads) == len(read_apart)
 
 
+@pytest.mark.parametrize("rows", [7, STEPS, STEPS + 1, 10 * STEPS])
+def test_step_parts_make_the_steps_table(random_run: tuple[Path, Any], rows: int) -> None:
+    with open_recording(random_run[0]) as recording:
+        parts = list(recording.step_parts(rows))
+        whole = recording.steps()
+    sizes = [rows] * ((STEPS + 1) // rows) + ([(STEPS + 1) % rows] if (STEPS + 1) % rows else [])
+    assert [len(part) for part in parts] == sizes
+    assert [part.index[0] for part in parts] == list(range(0, STEPS + 1, rows))
+    pd.testing.assert_frame_equal(pd.concat(parts), whole)
+
+
 # ------------------------------------------------------------------ memory and the model
 
 

@@ -4,12 +4,16 @@ refused with a hint to write Parquet, and a failed write leaves the old files.""
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import pandas as pd
+import pyarrow.parquet as pq
 import pytest
 
 from rsstp_replay import TableError, read_table, write_table
+from rsstp_replay.errors import CorruptRecording
+from rsstp_replay.table_files import write_table_parts
 from rsstp_sim.errors import OutputError
 
 
@@ -95,3 +99,65 @@ def test_a_failed_sidecar_write_leaves_the_old_csv(tmp_path: Path) -> None:
         write_table(pd.DataFrame({"a": [1]}), out)
     assert out.read_text() == "old\n"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv", "t.csv.dtypes.json"]
+
+
+def _mixed(rows: int) -> pd.DataFrame:
+    """Every kind of column a steps table has, missing values included, indexed by step."""
+    return pd.DataFrame(
+        {
+            "action": pd.array([None, *range(1, rows)], dtype="Int64"),
+            "kind": pd.Categorical(
+                [["fold", None, "links"][k % 3] for k in range(rows)],
+                categories=["fold", "obstacle", "links"],
+            ),
+            "flag": [k % 2 == 0 for k in range(rows)],
+            "x": [k / 7 for k in range(rows)],
+        },
+        index=pd.RangeIndex(rows, name="step"),
+    )
+
+
+@pytest.mark.parametrize("size", [1, 4, 10, 11])
+def test_a_table_written_in_parts_reads_back_whole(tmp_path: Path, size: int) -> None:
+    table = _mixed(10)
+    parts = [table.iloc[a : a + size] for a in range(0, len(table), size)]
+    out = tmp_path / "t.parquet"
+    head = write_table_parts(iter(parts), out)
+    assert list(head.columns) == list(table.columns) and head.index.name == "step"
+    assert read_table(out).equals(table)
+    assert pq.ParquetFile(out).metadata.num_row_groups == len(parts)
+
+
+def test_a_part_that_fails_leaves_the_old_table(tmp_path: Path) -> None:
+    table = _mixed(10)
+    out = tmp_path / "t.parquet"
+    out.write_bytes(b"old")
+
+    def parts() -> Iterator[pd.DataFrame]:
+        yield table.iloc[:4]
+        yield table.iloc[4:8]
+        raise CorruptRecording("run.mcap: step 8: broken")
+
+    with pytest.raises(CorruptRecording, match="step 8: broken"):
+        write_table_parts(parts(), out)
+    assert out.read_bytes() == b"old"
+    assert [p.name for p in tmp_path.iterdir()] == ["t.parquet"]  # no side file left
+
+
+def test_parts_that_do_not_match_the_first_leave_no_table(tmp_path: Path) -> None:
+    table = _mixed(6)
+    other = table.iloc[3:].assign(x=["a", "b", "c"])  # text where the first part had floats
+    out = tmp_path / "t.parquet"
+    with pytest.raises((TypeError, ValueError)):
+        write_table_parts(iter([table.iloc[:3], other]), out)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_parts_go_to_parquet_only(tmp_path: Path) -> None:
+    with pytest.raises(TableError, match=r"t\.csv: a table written in parts goes to Parquet"):
+        write_table_parts(iter([_mixed(2)]), tmp_path / "t.csv")
+    with pytest.raises(TableError, match=r"t\.parquet: no part to write"):
+        write_table_parts(iter([]), tmp_path / "t.parquet")
+    (tmp_path / "d.parquet").mkdir()
+    with pytest.raises(OutputError, match=r"d\.parquet: "):
+        write_table_parts(iter([_mixed(2)]), tmp_path / "d.parquet")
