@@ -41,6 +41,7 @@ from rsstp_replay.errors import (
     CorruptRecording,
     ReplayError,
     StepOutOfRange,
+    TableError,
     UnfinishedRecordingWarning,
 )
 from rsstp_sim.errors import MemoryRangeError
@@ -472,7 +473,7 @@ class Recording:
         (``rsstp-replay table`` does, :func:`~rsstp_replay.table_files.write_table_parts`).
         An error raised on the way (a corrupt step) voids the parts given before it."""
         if rows < 1:
-            raise ValueError(f"a part has at least one row, not {rows}")
+            raise TableError(f"a part of the steps table has at least one row, not {rows}")
         self._check_open()
         columns = self._new_step_columns(truth=True)
         done = 0

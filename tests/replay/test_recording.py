@@ -27,7 +27,12 @@ from mcap.reader import make_reader
 
 from rsstp_replay import EVENT_KINDS, open_recording
 from rsstp_replay._container import Container
-from rsstp_replay.errors import ReplayError, StepOutOfRange, UnfinishedRecordingWarning
+from rsstp_replay.errors import (
+    ReplayError,
+    StepOutOfRange,
+    TableError,
+    UnfinishedRecordingWarning,
+)
 from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording import records
 from rsstp_sim.recording.recorder import record
@@ -306,6 +311,12 @@ def test_step_parts_make_the_steps_table(random_run: tuple[Path, Any], rows: int
     assert [len(part) for part in parts] == sizes
     assert [part.index[0] for part in parts] == list(range(0, STEPS + 1, rows))
     pd.testing.assert_frame_equal(pd.concat(parts), whole)
+
+
+def test_step_parts_of_no_rows_are_refused(random_run: tuple[Path, Any]) -> None:
+    with open_recording(random_run[0]) as recording:
+        with pytest.raises(TableError, match="at least one row, not 0"):
+            next(recording.step_parts(0))
 
 
 # ------------------------------------------------------------------ memory and the model
