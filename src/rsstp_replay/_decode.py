@@ -321,13 +321,19 @@ class StepColumns:
                 raise BadStep("truth.blocked: expected false at step 0 (the reset)", step=0)
 
     def frame(
-        self, *, geometry: bool = True, copy: bool = False, rows: slice | None = None
+        self,
+        *,
+        geometry: bool = True,
+        blockers: bool = True,
+        copy: bool = False,
+        rows: slice | None = None,
     ) -> pd.DataFrame:
         """The steps table, indexed by ``step`` (see :meth:`rsstp_replay.Recording.steps` for
         the columns; :meth:`check` made the steps ``0 .. n_rows - 1``); ``geometry=False``
-        leaves out the joint positions and distances; ``copy=True`` gives a table that shares
-        no array with these columns; ``rows``: only those rows (a part of the table, its
-        index the steps' numbers)."""
+        leaves out the joint positions and distances, ``blockers=False`` what blocked a move
+        (``blocked_kind`` and the indices; ``blocked`` stays); ``copy=True`` gives a table
+        that shares no array with these columns; ``rows``: only those rows (a part of the
+        table, its index the steps' numbers)."""
         part = slice(0, self.n_rows) if rows is None else rows
         start, stop = part.start, part.stop
         action_mask = np.zeros(stop - start, np.bool_)
@@ -345,7 +351,8 @@ class StepColumns:
         }
         if self.truth:
             columns["blocked"] = self.blocked[part]
-            columns |= self._blocked_columns(part)
+            if blockers:
+                columns |= self._blocked_columns(part)
             for j in range(self.n_joints):
                 columns[f"angle_deg_{j}"] = self.angles_deg[j, part]
         if self.truth and geometry:

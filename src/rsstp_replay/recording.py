@@ -259,17 +259,22 @@ class Recording:
             self._events = self._event_table()
         return self._events.copy()
 
-    def steps_and_events(self, *, geometry: bool = True) -> tuple[pd.DataFrame, pd.DataFrame]:
+    def steps_and_events(
+        self, *, geometry: bool = True, blockers: bool = True
+    ) -> tuple[pd.DataFrame, pd.DataFrame]:
         """:meth:`steps` and :meth:`events` in one read of the chunks (each alone reads
-        every chunk, the events being among the steps): what an audit reads."""
+        every chunk, the events being among the steps): what an audit reads.
+        ``blockers=False`` leaves out of the steps table what blocked a move
+        (``blocked_kind`` and its indices; ``blocked`` stays): no audit reads them, and
+        they are a third of the table's memory without the geometry."""
         self._check_open()
-        if self._events is not None:
-            return self.steps(geometry=geometry), self.events()
-        events: list[Any] = []
+        events: list[Any] | None = [] if self._events is None else None
         columns = self._step_columns(truth=True, events=events)
         self._log_times = columns.log_time
-        self._events = self._event_table(events)
-        return columns.frame(geometry=geometry), self._events.copy()
+        if events is not None:
+            self._events = self._event_table(events)
+        steps = columns.frame(geometry=geometry, blockers=blockers)
+        return steps, self.events()
 
     def _event_table(self, events: list[Any] | None = None) -> pd.DataFrame:
         if events is None:

@@ -26,9 +26,11 @@ STEPS = 3_000
 @pytest.fixture(autouse=True, params=["move by move", "whole table"])
 def world_walk(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
     """Every check twice: the world walked move by move, and tabulated whole with the
-    recorded poses followed in numpy (what a replay longer than its world's pose space does)."""
+    recorded poses followed in numpy, block by block (what a replay longer than its world's
+    pose space does)."""
     if request.param == "whole table":
         monkeypatch.setattr(physics, "pose_space_size", lambda scenario: 0)
+        monkeypatch.setattr(physics, "_BLOCK_STEPS", 97)  # many blocks, a step's at each edge
 
 
 @pytest.fixture(scope="module")

@@ -46,7 +46,7 @@ class LoadedRecording:
         both = getattr(source, "steps_and_events", None)
         self._events: pd.DataFrame | None = None
         if both is not None:
-            table, self._events = both(geometry=False)
+            table, self._events = both(geometry=False, blockers=False)
         else:
             table = source.steps(geometry=False)
         table = table.drop(columns=["blocked_kind", *detail], errors="ignore")

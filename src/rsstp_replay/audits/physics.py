@@ -149,36 +149,52 @@ def _simulate(
     return world, np.concatenate([[0], rows]), np.concatenate([[0], blockers])
 
 
+_BLOCK_STEPS = 1 << 20
+"""Steps :func:`_followed` takes at once (its temporary arrays stay a few tens of MB)."""
+
+
 def _followed(
     world: World, actions: IntArray, steps: pd.DataFrame
 ) -> tuple[IntArray, IntArray] | None:
     """The rows and blockers of :func:`_simulate`, from a whole world table and the recorded
     poses, when each step's pose is where the world's table moves the one before by the
-    step's action (checked at once in numpy, not move by move); None at the first step where
-    it is not, which the walk then finds."""
+    step's action (checked in numpy, a block of steps at a time, not move by move); None at
+    the first step where it is not, which the walk then finds."""
     table = world.table
     names = [f"angle_deg_{j}" for j in range(len(table.radix))]
     if not set(names) <= set(steps.columns) or len(steps) != len(actions):
         return None
-    angles = steps[names].to_numpy(np.int64)
-    rows = table.rows_at(angles).astype(np.int64)
-    codes = angles @ table.radix
-    if rows[0] != 0 or (rows < 0).any():
-        return None
-    if not np.array_equal(np.frombuffer(table.codes, np.int64)[rows], codes):
-        return None
     index = np.full(max(table.actions) + 1, -1, np.int64)
     index[list(table.actions)] = np.arange(len(table.actions))
-    moves = actions[1:]
-    if ((moves < 0) | (moves >= len(index))).any():
-        return None
-    k = index[moves]
-    if (k < 0).any():
-        return None
-    if not np.array_equal(table.next_array()[rows[:-1], k], rows[1:]):
-        return None
-    blockers = table.blocker_array()[rows[:-1], k].astype(np.int64)
-    return rows, np.concatenate([[0], blockers])
+    table_codes = np.frombuffer(table.codes, np.int64)
+    next_rows, blocker_codes = table.next_array(), table.blocker_array()
+    columns = [steps[name].to_numpy() for name in names]
+    rows = np.empty(len(steps), np.int64)
+    blockers = np.zeros(len(steps), np.int64)
+    before = 0  # the row of the step before the block (the start pose's: row 0)
+    for first in range(0, len(steps), _BLOCK_STEPS):
+        block = slice(first, first + _BLOCK_STEPS)
+        angles = np.stack([column[block] for column in columns], axis=1).astype(np.int64)
+        found = table.rows_at(angles)
+        if (found < 0).any() or not np.array_equal(table_codes[found], angles @ table.radix):
+            return None
+        moves = actions[block]
+        if first == 0:  # step 0 is the reset, to the start pose
+            if found[0] != 0:
+                return None
+            found, moves = found[1:], moves[1:]
+        if ((moves < 0) | (moves >= len(index))).any() or (index[moves] < 0).any():
+            return None
+        k = index[moves]
+        came_from = np.concatenate([[before], found[:-1]])
+        if not np.array_equal(next_rows[came_from, k], found):
+            return None
+        where = slice(max(first, 1), block.stop)
+        rows[where] = found
+        blockers[where] = blocker_codes[came_from, k]
+        before = int(found[-1]) if len(found) else before
+    rows[0] = 0
+    return rows, blockers
 
 
 def _check_agent_view(steps: pd.DataFrame, world: World, rows: IntArray) -> None:
@@ -202,18 +218,18 @@ def _check_truth(recording: Recording, world: World, rows: IntArray, blockers: I
     """Every step message's truth, against the bytes the recorder writes for its pose and
     blocker (each pair encoded once)."""
     width = int(blockers.max(initial=0)) + 1
-    distinct, inverse = np.unique(rows * width + blockers, return_inverse=True)
+    keys = rows * width + blockers
+    distinct = np.unique(keys)
     expected = []
     for key in distinct.tolist():
         row, code = divmod(key, width)
         truth = builders.truth_record(world.pose_at(row), world.blocker_of(code))
         expected.append(_TRUTH_KEY + records.encode_json(truth) + b"}")
-    keys = inverse.tolist()
     step = 0
     with gc_paused():
         for _, data, [found] in recording._chunks_of(("/rsstp/step",)):
             starts, ends = found.starts, found.ends
-            chunk_keys = keys[step : step + len(starts)]
+            chunk_keys = np.searchsorted(distinct, keys[step : step + len(starts)]).tolist()
             if len(chunk_keys) != len(starts):  # pragma: no cover - the steps were counted
                 raise PhysicsDifference(step, "truth", "more step messages than steps")
             tails = list(map(expected.__getitem__, chunk_keys))
