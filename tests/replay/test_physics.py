@@ -82,6 +82,15 @@ def test_an_unchanged_recording_holds(walk: Path) -> None:
     assert found.holds and found.to_text().endswith(f"every one of the {STEPS + 1:,} steps")
 
 
+@pytest.mark.parametrize("steps", [0, 1])
+def test_the_reset_alone_and_one_step_hold(tmp_path: Path, steps: int) -> None:
+    path = tmp_path / "short.mcap"
+    record(path, load_scenario("three-joint"), make_strategy("random"), steps=steps, seed=1)
+    with open_recording(path) as recording:
+        found = check_physics(recording)
+    assert found.holds and found.steps == steps
+
+
 @pytest.mark.parametrize("name", sorted(p.name for p in (ROOT / "recordings").glob("*.mcap")))
 def test_every_reference_recording_holds(name: str) -> None:
     with open_recording(ROOT / "recordings" / name) as recording:

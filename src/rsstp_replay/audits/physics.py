@@ -183,6 +183,8 @@ def _followed(
             if found[0] != 0:
                 return None
             found, moves = found[1:], moves[1:]
+            if not len(found):  # the reset alone
+                break
         if ((moves < 0) | (moves >= len(index))).any() or (index[moves] < 0).any():
             return None
         k = index[moves]
@@ -192,7 +194,7 @@ def _followed(
         where = slice(max(first, 1), block.stop)
         rows[where] = found
         blockers[where] = blocker_codes[came_from, k]
-        before = int(found[-1]) if len(found) else before
+        before = int(found[-1])
     rows[0] = 0
     return rows, blockers
 
