@@ -476,7 +476,10 @@ class Recording:
         ``pd.concat`` is :meth:`steps`), each given as soon as its steps are decoded, the
         last once every step is checked: to write a long table while the rest is decoded
         (``rsstp-replay table`` does, :func:`~rsstp_replay.table_files.write_table_parts`).
-        An error raised on the way (a corrupt step) voids the parts given before it."""
+        An error raised on the way (a corrupt step) voids the parts given before it. Until
+        the last part is taken, the garbage collector is paused (the decoding makes and
+        drops millions of acyclic objects): what runs between parts frees by reference
+        counting alone."""
         if rows < 1:
             raise TableError(f"a part of the steps table has at least one row, not {rows}")
         self._check_open()
