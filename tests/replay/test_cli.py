@@ -122,6 +122,31 @@ def test_table_writes_parquet(
     assert read_table(out).equals(expected)
 
 
+def test_a_file_size_limit_never_leaves_a_part_of_a_table(run: Path, tmp_path: Path) -> None:
+    """EFBIG on the thread that writes the row groups (RLIMIT_FSIZE in the child): one
+    line, exit 1, the table that was there untouched, no side file."""
+    import resource
+
+    out = tmp_path / "steps.parquet"
+    out.write_bytes(b"keep me")
+
+    def small_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20_000, 20_000))
+
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_cli.replay", "table", str(run), "-o", str(out), "--force"],
+        capture_output=True, text=True, timeout=120, preexec_fn=small_files,
+        env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": "/tmp",
+             "PYTHONDONTWRITEBYTECODE": "1"},  # no .pyc cut short by the limit
+    )  # fmt: skip
+    assert (done.returncode, done.stdout) == (1, "")
+    assert done.stderr.count("\n") == 1, done.stderr
+    assert done.stderr.startswith(f"rsstp-replay: error: {out}: cannot write: ")
+    assert done.stderr.endswith("File too large\n")  # (pyarrow's words before it)
+    assert out.read_bytes() == b"keep me"
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+
+
 def test_table_truth_adds_class_pose_and_aliasing(
     run: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
