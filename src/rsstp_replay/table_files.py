@@ -1,7 +1,9 @@
 """Table files: a table written whole as Parquet or CSV, and read back with its types.
 
 :func:`write_table` writes one whole (a failed write leaves what was there), as Parquet or
-CSV by the suffix. Parquet keeps the index (as a column named after it) and every dtype.
+CSV by the suffix; :func:`write_table_parts` writes one that comes in parts (a long steps
+table while it is decoded) to Parquet, a row group a part, and is the one home of writing
+Parquet. Parquet keeps the index (as a column named after it) and every dtype.
 CSV cannot say what a column's type is, so a CSV table has a *dtype sidecar* beside it,
 ``OUT.csv.dtypes.json``::
 
@@ -99,12 +101,7 @@ def write_table(table: pd.DataFrame, path: str | os.PathLike[str]) -> list[Path]
     fmt = _format_of(out)
     index = _index_name(table, out)
     if fmt == ".parquet":
-        import pyarrow as pa
-        import pyarrow.parquet as pq
-
-        arrow = pa.Table.from_pandas(table, preserve_index=index is not None)
-        with written_whole(out) as side:
-            pq.write_table(arrow, side)
+        write_table_parts([table], out)  # one part: the same file pq.write_table writes
         return [out]
     sidecar = sidecar_path(out)
     dtypes = _sidecar(table, index, out)
