@@ -2,7 +2,9 @@
 
 Bad input is one line on stderr and exit code 2, never a traceback; an output that could
 not be written whole (a full disk, a file-size limit) is one line and exit code 1; a reader
-that goes away (``| head``) ends the program quietly; Ctrl-C is exit code 130.
+that goes away (``| head``) ends the program quietly; Ctrl-C is exit code 130. A warning,
+ours or a library's, is one line in the errors' form (``PROG: warning: ...``), never Python's
+warning format with its source file and line.
 A long command shows a progress bar (tqdm) on stderr when stderr is a terminal,
 and nothing when it is piped or redirected, or with ``--quiet``.
 """
@@ -12,12 +14,21 @@ from __future__ import annotations
 import argparse
 import os
 import sys
+import warnings
 from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
 
 from rsstp_sim.errors import OutputError, RsstpError, UsageError
 
-__all__ = ["Parser", "Progress", "UsageError", "add_no_cache", "progress", "run_command"]
+__all__ = [
+    "Parser",
+    "Progress",
+    "UsageError",
+    "add_no_cache",
+    "progress",
+    "run_command",
+    "warning_line",
+]
 
 
 class Parser(argparse.ArgumentParser):
@@ -71,8 +82,26 @@ def progress(total: int, what: str, *, unit: str = "step", quiet: bool = False) 
     return Progress(total, what, unit, shown=not quiet and sys.stderr.isatty())
 
 
+def warning_line(prog: str, message: Warning | str) -> str:
+    """A warning as the command line prints it: one line, ``PROG: warning: TEXT``."""
+    return f"{prog}: warning: {' '.join(str(message).split())}"
+
+
 def run_command(prog: str, parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> int:
-    """Parse ``argv`` and run the chosen sub-command (``args.func``); return the exit code."""
+    """Parse ``argv`` and run the chosen sub-command (``args.func``); return the exit code.
+
+    While it runs, every warning shown (which ones: the warning filters in force) is one
+    :func:`warning_line` on stderr."""
+
+    def show(message: Warning | str, *_: object, **__: object) -> None:
+        print(warning_line(prog, message), file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        return _run_parsed(prog, parser, argv)
+
+
+def _run_parsed(prog: str, parser: argparse.ArgumentParser, argv: Sequence[str] | None) -> int:
     try:
         args = parser.parse_args(argv)
         func: Callable[[argparse.Namespace], int] = args.func

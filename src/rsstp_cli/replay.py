@@ -20,7 +20,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from rsstp_cli._commandline import Parser, UsageError, add_no_cache, progress, run_command
+from rsstp_cli._commandline import (
+    Parser,
+    UsageError,
+    add_no_cache,
+    progress,
+    run_command,
+    warning_line,
+)
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.recording import Recording, open_recording
 from rsstp_replay.table_files import (
@@ -52,18 +59,10 @@ _TRUTH_GATES = ("not-learned", "aliasing", "redundancy", "not-equivalent")
 
 
 def _open(path: str) -> Recording:
-    """Open a recording; an unfinished file's warning becomes one line on stderr."""
-    with warnings.catch_warnings(record=True) as caught:
+    """Open a recording; an unfinished file's warning is shown, as one line (``run_command``)."""
+    with warnings.catch_warnings():
         warnings.simplefilter("always", UnfinishedRecordingWarning)
-        recording = open_recording(path)
-    for warning in caught:
-        if issubclass(warning.category, UnfinishedRecordingWarning):
-            print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
-        else:  # pragma: no cover - not ours: pass it on
-            warnings.warn_explicit(
-                warning.message, warning.category, warning.filename, warning.lineno
-            )
-    return recording
+        return open_recording(path)
 
 
 def _cmd_info(args: argparse.Namespace) -> int:
@@ -383,8 +382,8 @@ def _cmd_view(args: argparse.Namespace) -> int:
                     grpc_port=args.grpc_port,
                 )
                 bar.to(1)
-            for warning in caught:
-                print(f"{PROG}: warning: {warning.message}", file=sys.stderr)
+            for warning in caught:  # after the progress bar, not through it
+                print(warning_line(PROG, warning.message), file=sys.stderr)
             print(result.to_text())
             if save is not None:
                 print(f"open it with: {shlex.quote(rerun_command())} {shlex.quote(str(save))}")

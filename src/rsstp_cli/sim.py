@@ -16,7 +16,14 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from rsstp_cli._commandline import Parser, UsageError, add_no_cache, progress, run_command
+from rsstp_cli._commandline import (
+    Parser,
+    UsageError,
+    add_no_cache,
+    progress,
+    run_command,
+    warning_line,
+)
 from rsstp_sim import graph
 from rsstp_sim.coupling import Runner, stop_text
 from rsstp_sim.errors import RecordingWriteError
@@ -143,18 +150,15 @@ def _warn_about(scenario: Scenario) -> None:
 
     problem = unsensable(scenario)
     if problem is not None:
-        print(
-            f"{PROG}: warning: no pose can sense the feedback point, every sensation will be "
-            f"false: {problem}",
-            file=sys.stderr,
-        )
+        text = f"no pose can sense the feedback point, every sensation will be false: {problem}"
+        print(warning_line(PROG, text), file=sys.stderr)
     n = len(scenario.obstacles)
     if n > MANY_OBSTACLES:
-        print(
-            f"{PROG}: warning: {n:,} obstacles: every step measures each joint's distance to "
-            f"each of them, so steps run about {1 + n / 60:.0f} times slower than with a few",
-            file=sys.stderr,
+        text = (
+            f"{n:,} obstacles: every step measures each joint's distance to each of them, so "
+            f"steps run about {1 + n / 60:.0f} times slower than with a few"
         )
+        print(warning_line(PROG, text), file=sys.stderr)
 
 
 def _runner(args: argparse.Namespace) -> Runner:
