@@ -13,9 +13,10 @@ directory gets, besides the recordings and ``findings/``:
 
 A worker process that dies (out of memory, a signal, a crash in native code) takes with it
 every run the scheduler had given it, and Dask gives up on a run that was on dying workers
-too often (``KilledWorker``), whether it was the culprit or a bystander. So such a run is run
-once more at the end, alone on the cluster: only a run that kills its worker then too is a
-failed row.
+too often (``KilledWorker``; on the local cluster at the first death), whether it was the
+culprit or a bystander. So such a run is run once more at the end, alone on the cluster: only
+a run that kills its worker then too is a failed row. A run's result leaves the cluster as
+soon as its row is taken, so that a worker that dies later has nothing to recompute.
 """
 
 from __future__ import annotations
@@ -36,6 +37,16 @@ from rsstp_sweep.plan import Run, Sweep
 __all__ = ["RUNS_TABLE", "SweepResult", "run_sweep", "runs_frame"]
 
 RUNS_TABLE = "runs.parquet"
+
+_LOCAL_CLUSTER_CONFIG = {
+    # A run on a worker that dies is suspect at once: it runs again alone at the end, where
+    # one death settles it (Dask's default, 3 retries, would kill 4 workers per such run).
+    "distributed.scheduler.allowed-failures": 0,
+    # A dead worker's nanny starts another, however long that takes on a busy machine. Dask's
+    # default closes the nanny of a worker not back within 15 s: once every nanny was closed,
+    # the runs left waited for a worker forever.
+    "distributed.deploy.lost-worker-timeout": "1 day",
+}
 
 _KILLED = (
     "its worker process died while running it, also when it ran alone (killed: out of "
@@ -70,14 +81,47 @@ def run_sweep(
     """Run every run of ``sweep`` into ``output`` (a folder or fsspec URL); see the module
     docstring. ``on_row`` is called with each row as its run ends. Ctrl-C cancels the runs
     not finished and returns with ``interrupted`` set; the finished runs are kept."""
+    import dask
     import fsspec
-    from distributed import Client, KilledWorker, LocalCluster, as_completed
 
     fs, root = fsspec.core.url_to_fs(output)
     fs.makedirs(root, exist_ok=True)
     _write_metadata(fs, root, sweep)
     rows: dict[str, dict[str, Any]] = {}
-    interrupted = False
+    # The local cluster's settings last as long as the cluster: its event loop reads them.
+    with dask.config.set(_LOCAL_CLUSTER_CONFIG if scheduler is None else {}):
+        interrupted = _run_on_cluster(
+            sweep, output, workers=workers, scheduler=scheduler, rows=rows, on_row=on_row
+        )
+    if interrupted:  # a run may have finished while its result was on the way
+        for run in sweep.runs:
+            if run.name not in rows:
+                row = finished_row(run, output)
+                if row is not None:
+                    rows[run.name] = row
+                    if on_row is not None:
+                        on_row(row)
+    table = runs_frame([rows.get(run.name) or _not_run(run) for run in sweep.runs])
+    buffer = io.BytesIO()
+    table.to_parquet(buffer, index=False)
+    with fs.open(f"{root.rstrip('/')}/{RUNS_TABLE}", "wb") as out:
+        out.write(buffer.getvalue())
+    return SweepResult(table, interrupted)
+
+
+def _run_on_cluster(
+    sweep: Sweep,
+    output: str,
+    *,
+    workers: int | None,
+    scheduler: str | None,
+    rows: dict[str, dict[str, Any]],
+    on_row: Callable[[Mapping[str, Any]], None] | None,
+) -> bool:
+    """Run the sweep's runs on the cluster at ``scheduler`` (None: a local one, closed at the
+    end), putting each run's row in ``rows`` as it comes; whether Ctrl-C stopped it."""
+    from distributed import Client, KilledWorker, LocalCluster, as_completed
+
     cluster = None
     if scheduler is None:
         # The workers are started ignoring SIGINT (a disposition a new process inherits): a
@@ -103,11 +147,18 @@ def run_sweep(
                     execute_run, run, output, key=f"rsstp-{run.name}", pure=False
                 )
                 by_key[future.key] = (run, future)
+
+            def take(future: Any) -> tuple[Run, dict[str, Any] | None]:
+                """The future's run and row (None: killed), its result let go of."""
+                run, _ = by_key.pop(future.key)
+                row = _result(run, future, KilledWorker)
+                future.release()
+                return run, row
+
             suspects: list[Run] = []
             try:
                 for future in as_completed([f for _, f in by_key.values()]):
-                    run, _ = by_key[future.key]
-                    row = _result(run, future, KilledWorker)
+                    run, row = take(future)
                     if row is None:  # it, or a run beside it, killed its workers
                         suspects.append(run)
                         continue
@@ -119,29 +170,16 @@ def run_sweep(
                         execute_run, run, output, key=f"rsstp-{run.name}-alone", pure=False
                     )
                     by_key[future.key] = (run, future)
-                    rows[run.name] = _result(run, future, KilledWorker) or failed_row(run, _KILLED)
+                    rows[run.name] = take(future)[1] or failed_row(run, _KILLED)
                     if on_row is not None:
                         on_row(rows[run.name])
             except KeyboardInterrupt:
-                interrupted = True
                 client.cancel([f for _, f in by_key.values()])
+                return True
     finally:
         if cluster is not None:
             cluster.close()
-    if interrupted:  # a run may have finished while its result was on the way
-        for run in sweep.runs:
-            if run.name not in rows:
-                row = finished_row(run, output)
-                if row is not None:
-                    rows[run.name] = row
-                    if on_row is not None:
-                        on_row(row)
-    table = runs_frame([rows.get(run.name) or _not_run(run) for run in sweep.runs])
-    buffer = io.BytesIO()
-    table.to_parquet(buffer, index=False)
-    with fs.open(f"{root.rstrip('/')}/{RUNS_TABLE}", "wb") as out:
-        out.write(buffer.getvalue())
-    return SweepResult(table, interrupted)
+    return False
 
 
 def _result(run: Run, future: Any, killed: type[Exception]) -> dict[str, Any] | None:
