@@ -11,7 +11,6 @@ import shutil
 import signal
 import subprocess
 import sys
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -24,6 +23,7 @@ from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import make_strategy
 from rsstp_sim.truth_cache import truth_cache_dir, truth_key
 from scenarios import sweep_toml
+from waiting import HANG_S, wait_until
 
 FAULTY = """
 import os
@@ -53,12 +53,12 @@ class Dies(StrategyBase):
 SWEEP = sweep_toml(steps=300, seeds=2, more_strategies=["sweep_faulty:Breaks"])
 
 
-def sweep_cli(*args: str, path: Path, timeout: float = 240) -> subprocess.CompletedProcess[str]:
+def sweep_cli(*args: str, path: Path) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [sys.executable, "-m", "rsstp_cli.sim", "sweep", *args],
         capture_output=True,
         text=True,
-        timeout=timeout,
+        timeout=HANG_S,
         env=_env(path),
     )
 
@@ -68,7 +68,7 @@ def report_cli(*args: str) -> subprocess.CompletedProcess[str]:
         [sys.executable, "-m", "rsstp_cli.replay", "report", *args],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
     )
 
 
@@ -203,9 +203,7 @@ def test_a_sweep_runs_on_a_scheduler_started_apart(folder: Path, tmp_path: Path)
     )  # fmt: skip
     worker = None
     try:
-        deadline = time.monotonic() + 60
-        while not info.exists() and time.monotonic() < deadline:
-            time.sleep(0.2)
+        wait_until(info.exists, "the scheduler's file", process=scheduler)
         address = json.loads(info.read_text())["address"]
         assert address.startswith("tcp://127.0.0.1:")
         worker = subprocess.Popen(
@@ -231,7 +229,7 @@ def test_a_sweep_runs_on_a_scheduler_started_apart(folder: Path, tmp_path: Path)
         for process in (worker, scheduler):
             if process is not None:
                 process.terminate()
-                process.wait(timeout=30)
+                process.wait(timeout=HANG_S)
 
 
 def test_ctrl_c_keeps_every_finished_run(folder: Path, tmp_path: Path) -> None:
@@ -253,12 +251,9 @@ def test_ctrl_c_keeps_every_finished_run(folder: Path, tmp_path: Path) -> None:
         start_new_session=True,
     )
     try:
-        deadline = time.monotonic() + 120
-        while time.monotonic() < deadline and len(_findings(out)) < 2:
-            assert process.poll() is None, process.communicate()
-            time.sleep(0.1)
+        wait_until(lambda: len(_findings(out)) >= 2, "two runs' findings", process=process)
         os.killpg(process.pid, signal.SIGINT)  # as Ctrl-C at a terminal: the whole group
-        stdout, stderr = process.communicate(timeout=90)
+        stdout, stderr = process.communicate(timeout=HANG_S)
     finally:
         if process.poll() is None:
             process.kill()
@@ -292,7 +287,7 @@ def test_a_bad_sweep_is_one_line_before_anything_runs(
 ) -> None:
     file = tmp_path / "bad.toml"
     file.write_text(sweep)
-    done = sweep_cli(str(file), "-o", str(tmp_path / "out"), path=tmp_path, timeout=60)
+    done = sweep_cli(str(file), "-o", str(tmp_path / "out"), path=tmp_path)
     assert done.returncode == 2
     assert done.stderr.count("\n") == 1 and message in done.stderr
     assert not (tmp_path / "out").exists()
@@ -301,7 +296,7 @@ def test_a_bad_sweep_is_one_line_before_anything_runs(
 def test_an_output_that_is_a_file_is_one_line(folder: Path, tmp_path: Path) -> None:
     taken = tmp_path / "taken"
     taken.write_text("mine")
-    done = sweep_cli(str(folder / "sweep.toml"), "-o", str(taken), path=folder, timeout=60)
+    done = sweep_cli(str(folder / "sweep.toml"), "-o", str(taken), path=folder)
     assert done.returncode == 2
     assert f"{taken}: exists and is not a folder" in done.stderr
     assert taken.read_text() == "mine"
