@@ -14,6 +14,7 @@ import pytest
 from rsstp_replay._viewer_serve import WebServer, ctrl_c_remembered
 from rsstp_replay.recording import open_recording
 from rsstp_replay.viewer import view
+from waiting import HANG_S
 
 ROOT = Path(__file__).resolve().parents[2]
 REFERENCE = ROOT / "recordings" / "thesis-roulette-script.mcap"
@@ -24,9 +25,15 @@ class _InterruptedFinaliser:
 
     def __del__(self) -> None:
         os.kill(os.getpid(), signal.SIGINT)
-        deadline = time.monotonic() + 5
-        while time.monotonic() < deadline:  # the handler runs between these bytecodes
-            pass
+        _bytecodes()  # the handler runs here, and its KeyboardInterrupt ends the loop
+
+
+def _bytecodes() -> None:
+    """A loop for a pending signal's Python handler to run in: CPython runs it at the loop's
+    first jump back (between bytecodes), long before the loop could end; it ends the loop when
+    it raises, so that no time is spent when it does."""
+    for _ in range(1_000_000):
+        pass
 
 
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
@@ -40,7 +47,7 @@ def test_a_ctrl_c_lost_in_a_finaliser_is_still_remembered() -> None:
 def test_ctrl_c_without_interrupt_only_sets_the_flag() -> None:
     with ctrl_c_remembered(interrupt=False) as ctrl_c:
         os.kill(os.getpid(), signal.SIGINT)
-        time.sleep(0.05)  # the handler runs here; no KeyboardInterrupt
+        _bytecodes()  # the handler runs here; no KeyboardInterrupt
     assert ctrl_c.pressed
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
 
@@ -60,8 +67,22 @@ def test_a_real_server_stops_on_ctrl_c_during_its_wait(tmp_path: Path) -> None:
         view(recording, save=rrd, spawn=False, serve_web=False, start=None, end=None)
     server = WebServer(rrd, bind="127.0.0.1", web_port=_free_port(), grpc_port=_free_port())
     process = server._process
-    threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT)).start()
-    began = time.monotonic()
+    before = signal.getsignal(signal.SIGINT)
+    returned = threading.Event()
+    stuck: list[bool] = []
+
+    def press_ctrl_c_during_the_wait() -> None:
+        while signal.getsignal(signal.SIGINT) is before:  # until the wait sets its handler
+            time.sleep(0.01)
+        os.kill(os.getpid(), signal.SIGINT)
+        if not returned.wait(HANG_S):  # a hang guard: the server would serve on forever
+            stuck.append(True)
+            process.kill()
+
+    presser = threading.Thread(target=press_ctrl_c_during_the_wait)
+    presser.start()
     server.wait()
-    assert time.monotonic() - began < 10
+    returned.set()
+    presser.join()
+    assert not stuck, "Ctrl-C did not end the wait"
     assert process.poll() is not None  # the rerun server is gone
