@@ -3,27 +3,34 @@
 Positions are in points, y up (Graphviz's frame); :func:`rsstp_replay.viewer.render_graph`
 pins every state there, so a state has one place in the pictures of every step. (The viewer
 draws the model on the world instead: :mod:`._viewer_model`.)
+
+Graphviz lays the union out in this process (:func:`rsstp_sim.graph.run_graphviz`, from
+``pygraphviz``'s wheel) and holds the interpreter until it is done: no timeout can stop it, so
+the layout is bounded by its input and by Graphviz's own work limits, never by a clock. (A clock
+would also make the picture depend on how busy the machine is: the same recording laid out by
+``dot`` on one machine and by ``sfdp`` on another.) Measured on this project's machine: ``dot``
+with its default limits took 4.3 s of CPU on a learner's union of 400 state pairs, and 21-34 s
+on random graphs of 400 pairs over 70 and 150 states, so the pair count alone
+(:data:`DOT_MAX_PAIRS`) does not bound it; within :data:`DOT_LIMITS` the same graphs take 0.2-0.3
+s and at most 2 s. ``sfdp`` is near linear: 3.7 s for the 1,183 states and 8,699 pairs of a
+learner's run of a two-link arm at 10-degree steps (``bench/graphviz_layout.py``).
 """
 
 from __future__ import annotations
 
-import math
-import shutil
-import subprocess
-import warnings
 from collections.abc import Iterable, Sequence
 from itertools import chain
 
 import numpy as np
 
-from rsstp_replay.errors import ViewerWarning
 from rsstp_sim.graph import plain_positions, run_graphviz
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem, snapshot_form
 
 __all__ = [
+    "DOT_LIMITS",
     "DOT_MAX_PAIRS",
-    "DOT_TIMEOUT_S",
+    "SFDP_SETTINGS",
     "graph_positions",
     "union_model",
 ]
@@ -64,63 +71,48 @@ def graph_positions(
     The layout is Graphviz's: ``dot`` with :func:`rsstp_sim.graph.to_dot`'s graph attributes
     (left to right, the same node and rank separations) over one edge per state pair of the
     union, *without* the action labels (``dot`` places labels as nodes: on the union of a
-    learning run, 90 states and 718 state pairs, 3.2 s with them, 0.2 s without). ``dot``'s
-    crossing minimisation can take minutes on dense graphs, so past :data:`DOT_MAX_PAIRS` pairs,
-    or when ``dot`` runs longer than :data:`DOT_TIMEOUT_S`, the force-directed ``sfdp`` lays it
-    out instead (deterministic too). Without Graphviz the states go on a circle, with a
-    :class:`ViewerWarning`.
+    learning run, 90 states and 718 state pairs, 3.2 s with them, 0.2 s without) and without
+    routing the edges (only the nodes' places are kept), within :data:`DOT_LIMITS`. Past
+    :data:`DOT_MAX_PAIRS` pairs the force-directed ``sfdp`` lays it out instead, its overlaps
+    removed as :data:`SFDP_SETTINGS` says (``pygraphviz``'s Graphviz has no triangulation
+    library for ``prism``, and its ``voronoi`` took 58 s on 1,183 states). Both are
+    deterministic: the same versions give the same places, whatever ran before in the process.
+    A Graphviz failure is :class:`~rsstp_sim.errors.GraphvizFailed`.
     """
     union = union_model(versions, extra_states)
     pairs = sorted({(s, t) for s, _, t in union.transitions() if s != t})
-    if shutil.which("dot") is None:
-        warnings.warn(
-            ViewerWarning("Graphviz 'dot' not found: the model's states are drawn on a circle"),
-            stacklevel=2,
-        )
-        return _circle(union.states)
-    source = _layout_source(union.states, pairs)
     if len(pairs) <= DOT_MAX_PAIRS:
-        try:
-            return _run_layout("dot", source, timeout=DOT_TIMEOUT_S)
-        except subprocess.TimeoutExpired:
-            pass
-    return _run_layout("sfdp", source, timeout=None)
+        engine, settings = "dot", DOT_LIMITS
+    else:
+        engine, settings = "sfdp", SFDP_SETTINGS
+    plain = run_graphviz(
+        engine,
+        _layout_source(union.states, pairs, settings),
+        "plain",
+        what="the layout of every model version",
+    )
+    return plain_positions(plain.decode())
 
 
 DOT_MAX_PAIRS = 400
 """Above this many state pairs the union is laid out by ``sfdp`` rather than ``dot``."""
-DOT_TIMEOUT_S = 10.0
-"""How long ``dot`` may take before ``sfdp`` takes over."""
+DOT_LIMITS = 'splines="none", nslimit="2", nslimit1="2", mclimit="0.5"'
+"""Graphviz's own bounds on ``dot``'s work, deterministic unlike a timeout: its network simplex
+passes (ranks and places) at most twice the nodes' count of iterations, its crossing
+minimisation half its default passes, and no edges routed (only the nodes' places are kept)."""
+SFDP_SETTINGS = 'overlap="portho"'
+"""``sfdp``'s overlap removal: pseudo-orthogonal constraints, which need no triangulation
+library and are deterministic (``vpsc``, the most compact, is not: the same union came out in
+two ways in fresh processes)."""
 
 
-def _layout_source(states: Sequence[int], pairs: Sequence[tuple[int, int]]) -> str:
+def _layout_source(states: Sequence[int], pairs: Sequence[tuple[int, int]], settings: str) -> str:
     lines = [
         "digraph union {",
-        '  graph [rankdir="LR", nodesep="0.6", ranksep="0.9", overlap="false", sep="+12"];',
+        f'  graph [rankdir="LR", nodesep="0.6", ranksep="0.9", sep="+12", {settings}];',
         '  node [shape="circle", width="0.5", fixedsize="true"];',
         *(f"  {s};" for s in states),
         *(f"  {s} -> {t};" for s, t in pairs),
         "}",
     ]
     return "\n".join(lines) + "\n"
-
-
-def _run_layout(
-    engine: str, source: str, *, timeout: float | None
-) -> dict[int, tuple[float, float]]:
-    """Node centres in points from Graphviz's ``plain`` output."""
-    plain = run_graphviz(
-        engine, source, ["-Tplain"], what="the layout of every model version", timeout=timeout
-    )
-    return plain_positions(plain.decode())
-
-
-def _circle(states: Sequence[int]) -> dict[int, tuple[float, float]]:
-    radius = max(60.0, 20.0 * len(states))
-    return {
-        s: (
-            round(radius * math.cos(2 * math.pi * i / len(states)), 2),
-            round(radius * math.sin(2 * math.pi * i / len(states)), 2),
-        )
-        for i, s in enumerate(states)
-    }

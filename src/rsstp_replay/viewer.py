@@ -11,9 +11,9 @@ recording streams in about a second. ``docs/viewer.md`` lists every entity path,
 shows and how; :data:`ENTITY_PATHS` is that list for code.
 
 This is the one lenient part of the project (as Rerun's own ``error_utils``): what cannot be
-shown (no Graphviz for the layout, an audit that fails on the data, a viewer that cannot be
-spawned) is reported as a :class:`ViewerWarning` and the rest is still shown. Bad arguments
-(a step outside the recording, an output in a missing folder) still raise.
+shown (an audit that fails on the data, a viewer that cannot be spawned) is reported as a
+:class:`ViewerWarning` and the rest is still shown. Bad arguments (a step outside the
+recording, an output in a missing folder) still raise.
 """
 
 from __future__ import annotations
@@ -484,9 +484,8 @@ def render_graph(recording: ViewSource, step: int, path: Path, *, on_world: bool
     ``on_world``, where the viewer draws it on the world (the mean tip position while it was
     current; 200 points to a length unit). Returns ``path``.
 
-    Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a bad step,
-    :class:`~rsstp_sim.errors.GraphvizMissing` when a picture format needs ``dot`` and
-    :class:`~rsstp_sim.errors.GraphvizFailed` when Graphviz fails or crashes.
+    Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a bad step and
+    :class:`~rsstp_sim.errors.GraphvizFailed` when Graphviz fails.
     """
     model = recording.model_at(step)
     versions = recording.model_versions()

@@ -11,7 +11,6 @@ from rsstp_sim.env import ArmEnv, register_envs
 from rsstp_sim.errors import (
     ActionError,
     GraphvizFailed,
-    GraphvizMissing,
     MemoryRangeError,
     ModelError,
     RecordingError,
@@ -59,7 +58,6 @@ __all__ = [
     "DeterminismReport",
     "Event",
     "GraphvizFailed",
-    "GraphvizMissing",
     "Memory",
     "MemoryEntry",
     "MemoryRangeError",

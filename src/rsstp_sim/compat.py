@@ -322,8 +322,8 @@ class robot_arm:  # noqa: N801 - the thesis-era name, kept on purpose
 
         Nodes are named by matrix index; the current internal state is filled
         when ``tm`` is the arm's own matrix. With ``path`` the picture is also
-        written there (``.svg``, ``.png``, ``.pdf`` need Graphviz's ``dot``;
-        ``.dot``/``.gv`` do not); without it nothing is written.
+        written there (``.svg``, ``.png``, ``.pdf`` drawn by Graphviz, ``.dot``/``.gv`` the
+        source); without it nothing is written.
         """
         matrix = self.get_transition_matrix() if tm is None else tm
         view = TransitionSystem.from_matrix(matrix, actions=self.scenario.actions)

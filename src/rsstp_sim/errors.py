@@ -9,7 +9,6 @@ __all__ = [
     "MemoryRangeError",
     "StrategyError",
     "GraphvizFailed",
-    "GraphvizMissing",
     "OutputError",
     "RecordingError",
     "RecordingWriteError",
@@ -47,12 +46,8 @@ class OutputError(RsstpError):
     """An output file could not be written whole (a full disk, a file-size limit, ...)."""
 
 
-class GraphvizMissing(RsstpError):
-    """The Graphviz ``dot`` program is needed for SVG/PNG output and was not found."""
-
-
 class GraphvizFailed(RsstpError):
-    """Graphviz ran and failed (an error, or a crash such as a segmentation fault)."""
+    """Graphviz failed to lay out or draw a graph (the message has its first error)."""
 
 
 class RecordingError(RsstpError):

@@ -11,37 +11,33 @@ keeps both properties on purpose:
   ``(source, target)`` pair, labelled like the thesis's matrix cell (``0,1``).
 - :func:`to_dot` is deterministic (sorted iteration, nothing taken from
   memory addresses), and :func:`layout` plus ``to_dot(positions=...)`` pins
-  nodes so a sequence of pictures keeps every state in place (rendered with
-  ``neato -n2``, which uses the given positions as they are).
+  nodes so a sequence of pictures keeps every state in place (drawn by
+  ``neato -n2``'s engine, ``nop2``, which uses the given positions as they are).
 
-Writing ``.dot``/``.gv`` needs only the ``graphviz`` Python package; SVG, PNG
-and PDF need the Graphviz programs (:class:`~rsstp_sim.errors.GraphvizMissing`
-otherwise).
+Graphviz runs in this process, from the libraries inside ``pygraphviz``'s wheel (a dependency):
+no Graphviz program is needed. What Graphviz prints is kept off the terminal and a failure is one
+:class:`~rsstp_sim.errors.GraphvizFailed` line (:func:`run_graphviz`). Writing ``.dot``/``.gv``
+runs no Graphviz at all.
 """
 
 from __future__ import annotations
 
-import shutil
-import signal
-import subprocess
-from collections.abc import Mapping, Sequence
+import re
+from collections.abc import Mapping
 from pathlib import Path
 
-import graphviz
-
-from rsstp_sim.errors import GraphvizFailed, GraphvizMissing, ModelError, RsstpError
+from rsstp_sim._graphviz import run_graphviz
+from rsstp_sim.errors import ModelError, RsstpError
 from rsstp_sim.files import write_whole
 from rsstp_sim.transition_system import TransitionSystem
 
-__all__ = ["graphviz_failed", "layout", "plain_positions", "render", "run_graphviz", "to_dot"]
+__all__ = ["layout", "plain_positions", "render", "run_graphviz", "to_dot"]
 
 _IMAGE_FORMATS = ("svg", "png", "pdf")
 _SOURCE_FORMATS = ("dot", "gv")
-_MISSING = (
-    "Graphviz {program!r} not found: install it (Debian: apt-get install graphviz) "
-    "or write .dot instead"
-)
 _POINTS_PER_INCH = 72.0
+_BARE_ID = re.compile(r"[a-zA-Z_][a-zA-Z0-9_]*|-?(\.[0-9]+|[0-9]+(\.[0-9]*)?)")
+_KEYWORDS = frozenset({"node", "edge", "graph", "digraph", "subgraph", "strict"})
 
 
 def to_dot(
@@ -65,21 +61,15 @@ def to_dot(
         if missing:
             raise ModelError(f"to_dot: positions missing for states {missing}")
 
-    dot = graphviz.Digraph(
-        name="transition_system",
-        graph_attr={
-            "rankdir": "LR",
-            "nodesep": "0.6",
-            "ranksep": "0.9",
-            "forcelabels": "true",
-            "splines": "true",
-            "fontname": "Helvetica",
-        },
-        node_attr={"shape": "circle", "fontname": "Helvetica", "width": "0.5"},
-        edge_attr={"fontname": "Helvetica", "fontsize": "11"},
-    )
+    lines = [
+        "digraph transition_system {",
+        "\tgraph [fontname=Helvetica forcelabels=true nodesep=0.6 rankdir=LR ranksep=0.9 "
+        "splines=true]",
+        "\tnode [fontname=Helvetica shape=circle width=0.5]",
+        "\tedge [fontname=Helvetica fontsize=11]",
+    ]
     if title is not None:
-        dot.attr(label=title, labelloc="t")
+        lines.append(f"\tlabel={_quote(title)} labelloc=t")
     for s in model.states:
         attrs: dict[str, str] = {}
         if s == highlighted:
@@ -87,16 +77,31 @@ def to_dot(
         if positions is not None:
             x, y = positions[s]
             attrs["pos"] = f"{float(x):.2f},{float(y):.2f}!"
-        dot.node(str(s), **attrs)
+        lines.append(f"\t{_quote(str(s))}{_attributes(attrs)}")
     for (s, t), actions in _edge_labels(model).items():
-        dot.edge(str(s), str(t), label=",".join(map(str, actions)))
-    source: str = dot.source
-    return source
+        label = {"label": ",".join(map(str, actions))}
+        lines.append(f"\t{_quote(str(s))} -> {_quote(str(t))}{_attributes(label)}")
+    return "\n".join([*lines, "}"]) + "\n"
+
+
+def _attributes(attrs: Mapping[str, str]) -> str:
+    """`` [key=value ...]`` by key (nothing for no attributes), values quoted as DOT needs."""
+    if not attrs:
+        return ""
+    return " [" + " ".join(f"{key}={_quote(attrs[key])}" for key in sorted(attrs)) + "]"
+
+
+def _quote(value: str) -> str:
+    """``value`` as a DOT ID: bare when it is a name or a number (and no keyword), otherwise a
+    quoted string of the same text (a backslash stays a backslash: no DOT escapes)."""
+    if _BARE_ID.fullmatch(value) and value.lower() not in _KEYWORDS:
+        return value
+    return '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
 
 
 def layout(model: TransitionSystem) -> dict[int, tuple[float, float]]:
     """Node centres in points, computed by ``dot``; the same model gives the same positions."""
-    plain = run_graphviz("dot", to_dot(model), ["-Tplain"], what=_describe(model))
+    plain = run_graphviz("dot", to_dot(model), "plain", what=_describe(model))
     return plain_positions(plain.decode())
 
 
@@ -111,34 +116,6 @@ def plain_positions(plain: str) -> dict[int, tuple[float, float]]:
                 round(float(fields[3]) * _POINTS_PER_INCH, 2),
             )
     return positions
-
-
-def run_graphviz(
-    engine: str,
-    source: str,
-    arguments: Sequence[str],
-    *,
-    what: str,
-    timeout: float | None = None,
-) -> bytes:
-    """Run the Graphviz program ``engine`` on ``source`` and return what it wrote.
-
-    A missing program is :class:`GraphvizMissing`; one that fails or crashes (even
-    before reading its input) is one :class:`GraphvizFailed` line naming ``what``.
-    ``timeout`` (seconds) raises :class:`subprocess.TimeoutExpired`.
-    """
-    if shutil.which(engine) is None:
-        raise GraphvizMissing(_MISSING.format(program=engine))
-    done = subprocess.run(
-        [engine, *arguments],
-        input=source.encode(),
-        capture_output=True,
-        timeout=timeout,
-        check=False,
-    )
-    if done.returncode != 0:
-        raise graphviz_failed(engine, done.returncode, done.stderr, what=what)
-    return done.stdout
 
 
 def _describe(model: TransitionSystem) -> str:
@@ -157,7 +134,8 @@ def render(
 
     The format comes from the suffix (``.svg``, ``.png``, ``.pdf``, ``.dot``,
     ``.gv``) unless ``format`` is given. With ``positions`` the nodes stay
-    where they are given (``neato -n2``). Only ``path`` is written.
+    where they are given (``neato -n2``'s engine), otherwise ``dot`` lays the model out. Only
+    ``path`` is written, and only once the picture is whole.
     """
     out = Path(path)
     fmt = (format or out.suffix.removeprefix(".")).lower()
@@ -169,31 +147,8 @@ def render(
     source = to_dot(model, current=current, positions=positions)
     if fmt in _SOURCE_FORMATS:
         return write_whole(out, source.encode("utf-8"))
-    if positions is None:
-        data = run_graphviz("dot", source, [f"-T{fmt}"], what=_describe(model))
-    else:
-        data = run_graphviz("neato", source, ["-n2", f"-T{fmt}"], what=_describe(model))
-    return write_whole(out, data)
-
-
-def graphviz_failed(
-    engine: str, returncode: int, stderr: bytes | str | None, *, what: str
-) -> GraphvizFailed:
-    """The one-line error for a Graphviz program that failed (exit status) or crashed
-    (signal, e.g. SIGSEGV) drawing ``what``."""
-    if returncode < 0:
-        try:
-            how = f"crashed ({signal.Signals(-returncode).name})"
-        except ValueError:
-            how = f"crashed (signal {-returncode})"
-    else:
-        how = f"failed (exit status {returncode})"
-    text = stderr.decode(errors="replace") if isinstance(stderr, bytes) else stderr or ""
-    lines = [line.strip() for line in text.splitlines() if line.strip()]
-    detail = f": {lines[0][:200]}" if lines else ""
-    return GraphvizFailed(
-        f"Graphviz ({engine}) {how} drawing {what}{detail}; write .dot instead to keep the graph"
-    )
+    engine = "dot" if positions is None else "nop2"
+    return write_whole(out, run_graphviz(engine, source, fmt, what=_describe(model)))
 
 
 def _edge_labels(model: TransitionSystem) -> dict[tuple[int, int], list[int]]:

@@ -3,6 +3,8 @@ with Rerun's own reader (``rerun.chunk``), and check paths, rows and values."""
 
 from __future__ import annotations
 
+import ctypes
+import json
 import re
 import shutil
 import subprocess
@@ -671,20 +673,51 @@ def test_a_viewer_that_cannot_be_spawned_is_a_warning(
     assert len(Rrd(tmp_path / "s.rrd").column("world/arm", "LineStrips2D:strips")) == 11
 
 
-def test_without_graphviz_the_states_go_on_a_circle(
-    refined: tuple[Recording, Rrd], monkeypatch: pytest.MonkeyPatch
+ROULETTE = Path(__file__).parents[2] / "recordings" / "thesis-roulette-roulette.mcap"
+_PLACES = """
+import json, sys
+from rsstp_replay import open_recording
+from rsstp_replay.viewer import graph_positions
+with open_recording(sys.argv[1]) as recording:
+    print(json.dumps(graph_positions(recording.model_versions())))
+"""
+
+
+@pytest.mark.parametrize(("path", "engine"), [(ROULETTE, "dot"), (LEARNER, "sfdp")])
+def test_the_union_layout_is_deterministic_and_keeps_states_apart(
+    path: Path, engine: str, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    recording, _ = refined
-    monkeypatch.setattr(_viewer_layout.shutil, "which", lambda _: None)
-    with pytest.warns(ViewerWarning, match="'dot' not found"):
-        positions = graph_positions(recording.model_versions())
-    states = {s for r in recording.model_versions() for s in r.states}
-    assert set(positions) == states
-    radii = {round(float(np.hypot(*p)), 1) for p in positions.values()}
-    assert len(radii) == 1
+    """``dot`` within its work limits up to DOT_MAX_PAIRS state pairs (the roulette's union:
+    152 states, 151 pairs), ``sfdp`` past them (the learner's: 119 states, 763 pairs) with its
+    overlaps removed by a method the wheel's Graphviz has: no two states closer than a state's
+    width (36 points); the same places as in a fresh process, whatever drew from the C
+    library's ``rand()`` before (sfdp draws from it and never seeds it)."""
+    engines: list[str] = []
+    run = _viewer_layout.run_graphviz
+
+    def spy(engine: str, source: str, output_format: str, *, what: str) -> bytes:
+        engines.append(engine)
+        return run(engine, source, output_format, what=what)
+
+    monkeypatch.setattr(_viewer_layout, "run_graphviz", spy)
+    with open_recording(path) as recording:
+        versions = recording.model_versions()
+    for _ in range(7):
+        ctypes.CDLL(None).rand()
+    positions = graph_positions(versions)
+    assert engines == [engine]
+    assert set(positions) == {s for r in versions for s in r.states}
+    fresh = subprocess.run(
+        [sys.executable, "-c", _PLACES, str(path)], capture_output=True, text=True, check=True
+    )
+    assert {int(s): tuple(xy) for s, xy in json.loads(fresh.stdout).items()} == positions
+    assert graph_positions(versions) == positions
+    places = np.array(list(positions.values()))
+    gaps = np.hypot(*(places[:, None, :] - places[None, :, :]).transpose(2, 0, 1))
+    np.fill_diagonal(gaps, np.inf)
+    assert gaps.min() >= 36.0
 
 
-@pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz is not installed")
 def test_render_graph_thesis_layout_and_on_the_world(
     refined: tuple[Recording, Rrd], tmp_path: Path
 ) -> None:

@@ -1,16 +1,24 @@
-"""Tests for the Graphviz drawing of a transition system."""
+"""Tests for the Graphviz drawing of a transition system (Graphviz in process, from
+``pygraphviz``'s wheel: no Graphviz program is ever run)."""
 
 from __future__ import annotations
 
+import json
+import os
 import re
-import shutil
+import struct
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
+from pygraphviz import graphviz as gv
 
-from rsstp_sim.errors import GraphvizFailed, GraphvizMissing, ModelError, RsstpError
-from rsstp_sim.graph import layout, render, to_dot
+from rsstp_sim.errors import GraphvizFailed, ModelError, RsstpError
+from rsstp_sim.graph import layout, render, run_graphviz, to_dot
 from rsstp_sim.transition_system import TransitionSystem
+
+ROOT = Path(__file__).resolve().parents[2]
 
 FIGURE_16 = [
     [[0], [0, 1], [], []],
@@ -18,8 +26,6 @@ FIGURE_16 = [
     [[1], [], [], [0]],
     [[1], [0], [0, 1], []],
 ]
-
-needs_dot = pytest.mark.skipif(shutil.which("dot") is None, reason="Graphviz 'dot' not installed")
 
 
 @pytest.fixture
@@ -71,7 +77,6 @@ def test_to_dot_title_and_positions(model: TransitionSystem) -> None:
         to_dot(model, positions={0: (0, 0), 1: (1, 1), 2: (2, 2)})
 
 
-@needs_dot
 def test_layout_places_every_state_deterministically(model: TransitionSystem) -> None:
     model.split(1)
     positions = layout(model)
@@ -81,7 +86,6 @@ def test_layout_places_every_state_deterministically(model: TransitionSystem) ->
     assert layout(model) == positions
 
 
-@needs_dot
 def test_render_svg_writes_only_the_picture(model: TransitionSystem, tmp_path: Path) -> None:
     out = render(model, tmp_path / "model.svg")
     assert out == tmp_path / "model.svg"
@@ -91,7 +95,6 @@ def test_render_svg_writes_only_the_picture(model: TransitionSystem, tmp_path: P
     assert [p.name for p in tmp_path.iterdir()] == ["model.svg"]
 
 
-@needs_dot
 def test_render_with_positions_keeps_nodes_in_place(
     model: TransitionSystem, tmp_path: Path
 ) -> None:
@@ -111,7 +114,6 @@ def test_render_with_positions_keeps_nodes_in_place(
     assert all(a[s] == b[s] for s in a)
 
 
-@needs_dot
 def test_render_png_and_explicit_format(model: TransitionSystem, tmp_path: Path) -> None:
     png = render(model, tmp_path / "model.png")
     assert png.read_bytes().startswith(b"\x89PNG")
@@ -128,22 +130,6 @@ def test_render_source_needs_no_program(
     assert out.read_text(encoding="utf-8") == to_dot(model, current=1)
 
 
-@pytest.mark.parametrize("suffix", ["svg", "png", "pdf"])
-def test_render_without_graphviz_says_how_to_fix_it(
-    model: TransitionSystem, tmp_path: Path, monkeypatch: pytest.MonkeyPatch, suffix: str
-) -> None:
-    monkeypatch.setenv("PATH", str(tmp_path))
-    with pytest.raises(GraphvizMissing, match=r"apt-get install graphviz\) or write \.dot"):
-        render(model, tmp_path / f"model.{suffix}")
-    assert list(tmp_path.iterdir()) == []
-
-
-def test_layout_without_graphviz(model: TransitionSystem, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(shutil, "which", lambda _name: None)
-    with pytest.raises(GraphvizMissing, match=r"Graphviz 'dot' not found"):
-        layout(model)
-
-
 def test_render_refuses_unknown_formats(model: TransitionSystem, tmp_path: Path) -> None:
     with pytest.raises(RsstpError, match=r"expected one of svg, png, pdf, dot, gv, got 'txt'"):
         render(model, tmp_path / "model.txt")
@@ -151,28 +137,157 @@ def test_render_refuses_unknown_formats(model: TransitionSystem, tmp_path: Path)
         render(model, tmp_path / "model")
 
 
-@pytest.mark.parametrize("positions", [False, True])
-def test_a_program_that_dies_before_reading_is_one_error(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, positions: bool
+def _failing_layout(
+    monkeypatch: pytest.MonkeyPatch, message: bytes
+) -> list[tuple[object, object, bytes]]:
+    """Graphviz's layout call made to fail as it does: its error on file descriptor 2, status
+    -1. Returns the calls it was given."""
+    calls: list[tuple[object, object, bytes]] = []
+
+    def fail(context: object, handle: object, engine: bytes) -> int:
+        calls.append((context, handle, engine))
+        os.write(2, message)
+        return -1
+
+    monkeypatch.setattr(gv, "gvLayout", fail)
+    return calls
+
+
+@pytest.mark.parametrize(("positions", "engine"), [(False, "dot"), (True, "nop2")])
+def test_a_layout_that_fails_inside_graphviz_is_one_error(
+    model: TransitionSystem,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capfd: pytest.CaptureFixture[str],
+    positions: bool,
+    engine: str,
 ) -> None:
-    """A Graphviz program that crashes before reading its input (source larger than a
-    pipe's buffer, so writing it would break the pipe) is GraphvizFailed naming the
-    signal, never a broken pipe; nothing is written."""
-    for program in ("dot", "neato"):
-        fake = tmp_path / program
-        fake.write_text("#!/bin/sh\nkill -SEGV $$\n")
-        fake.chmod(0o755)
-    monkeypatch.setenv("PATH", str(tmp_path))
-    n = 3000
-    big = TransitionSystem.from_matrix(
-        [[[0] if t in (s, (s + 1) % n) else [] for t in range(n)] for s in range(n)]
+    """GraphvizFailed naming the engine, the model and Graphviz's first error (fontconfig's
+    complaint before it is not the error); nothing reaches stderr, nothing is written."""
+    calls = _failing_layout(
+        monkeypatch, b"Fontconfig warning: line 6: unknown element\nError: out of cheese\nmore\n"
     )
-    assert len(to_dot(big)) > 1 << 16
-    places = {s: (float(s), 0.0) for s in big.states} if positions else None
+    places = {s: (40.0 * s, 0.0) for s in model.states} if positions else None
     out = tmp_path / "model.svg"
-    with pytest.raises(GraphvizFailed, match=r"crashed \(SIGSEGV\) drawing a model of 3000 states"):
-        render(big, out, positions=places)
+    with pytest.raises(GraphvizFailed) as raised:
+        render(model, out, positions=places)
+    assert str(raised.value) == (
+        f"Graphviz ({engine}) failed drawing a model of 4 states and 13 transitions: "
+        "Error: out of cheese; write .dot instead to keep the graph"
+    )
+    assert [call[2] for call in calls] == [engine.encode()]
     assert not out.exists()
+    os.write(2, b"after\n")  # file descriptor 2 is the terminal's again
+    assert capfd.readouterr().err == "after\n"
+
+
+def test_a_failure_graphviz_says_nothing_about_is_still_one_error(
+    model: TransitionSystem, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    _failing_layout(monkeypatch, b"")
+    with pytest.raises(
+        GraphvizFailed,
+        match=r"^Graphviz \(dot\) failed drawing a model of 4 states .*: the dot layout failed "
+        r"\(status -1\); write \.dot",
+    ):
+        layout(model)
+
+
+def test_what_graphviz_says_on_a_call_that_succeeds_is_dropped(
+    model: TransitionSystem,
+    tmp_path: Path,
+    monkeypatch: pytest.MonkeyPatch,
+    capfd: pytest.CaptureFixture[str],
+) -> None:
+    """As the wheel's sfdp says ``Error: remove_overlap: Graphviz not built with triangulation
+    library`` on every layout that succeeds, and its fontconfig warns of the system's fonts."""
+    lay_out = gv.gvLayout
+
+    def noisy(context: object, handle: object, engine: bytes) -> int:
+        os.write(2, b"Error: remove_overlap: Graphviz not built with triangulation library\n")
+        status: int = lay_out(context, handle, engine)
+        return status
+
+    monkeypatch.setattr(gv, "gvLayout", noisy)
+    assert render(model, tmp_path / "model.svg").read_text(encoding="utf-8").startswith("<?xml")
+    assert capfd.readouterr().err == ""
+
+
+@pytest.mark.parametrize(
+    ("engine", "source", "output", "error"),
+    [
+        ("twirl", "digraph { a }", "svg", r'Error: Layout type: "twirl" not recognized'),
+        ("dot", "digraph { a -> }", "svg", r"Error: syntax error in line 1"),
+        ("dot", "digraph { a }", "gif9", r'Error: Format: "gif9" not recognized'),
+    ],
+)
+def test_graphviz_own_errors_are_one_line_and_nothing_on_stderr(
+    capfd: pytest.CaptureFixture[str], engine: str, source: str, output: str, error: str
+) -> None:
+    with pytest.raises(GraphvizFailed, match=rf"^Graphviz \({engine}\) failed drawing x: {error}"):
+        run_graphviz(engine, source, output, what="x")
+    assert capfd.readouterr().err == ""
+
+
+_DRAW_EVERYTHING = """
+import json, sys
+from pathlib import Path
+from rsstp_replay import open_recording
+from rsstp_replay.viewer import graph_positions, render_graph
+from rsstp_sim.graph import layout, render
+from rsstp_sim.transition_system import TransitionSystem
+
+out = Path(sys.argv[1])
+model = TransitionSystem.from_matrix(json.loads(sys.argv[2]))
+places = layout(model)
+render(model, out / "laid-out.svg")
+render(model, out / "laid-out.png")
+render(model, out / "pinned.svg", positions=places)
+render(model, out / "pinned.png", positions=places)
+render(model, out / "pinned.pdf", positions=places)
+with open_recording(sys.argv[3]) as recording:  # its union is laid out by sfdp
+    union = graph_positions(recording.model_versions())
+    render_graph(recording, recording.n_steps, out / "learner.svg")
+print(json.dumps({"places": places, "union": len(union)}))
+"""
+
+
+def test_everything_is_drawn_with_no_graphviz_program_and_no_noise(tmp_path: Path) -> None:
+    """In a fresh process whose PATH holds only Graphviz programs that would leave a mark and
+    fail (``dot``, ``neato``, ``sfdp``...): ``dot`` laid out, ``nop2`` pinned, SVG, PNG and PDF,
+    and the learner's union by ``sfdp``; stderr stays empty (fontconfig's warnings and sfdp's
+    ``remove_overlap`` notice are kept off it) and no program ran."""
+    fakes = tmp_path / "bin"
+    fakes.mkdir()
+    marks = tmp_path / "ran"
+    for program in ("dot", "neato", "sfdp", "fdp", "circo", "twopi"):
+        fake = fakes / program
+        fake.write_text(f"#!/bin/sh\necho {program} >> {marks}\nexit 1\n")
+        fake.chmod(0o755)
+    pictures = tmp_path / "pictures"
+    pictures.mkdir()
+    done = subprocess.run(
+        [sys.executable, "-c", _DRAW_EVERYTHING, str(pictures), json.dumps(FIGURE_16),
+         str(ROOT / "recordings" / "two-joint-30-learner.mcap")],
+        capture_output=True, text=True, timeout=300,
+        env={"PATH": str(fakes), "PYTHONPATH": str(ROOT / "src"), "HOME": str(tmp_path)},
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert done.stderr == ""
+    assert not marks.exists()
+    report = json.loads(done.stdout)
+    assert sorted(report["places"]) == ["0", "1", "2", "3"] and report["union"] == 119
+    for name in ("laid-out", "pinned"):
+        svg = (pictures / f"{name}.svg").read_text(encoding="utf-8")
+        assert svg.startswith("<?xml") and svg.rstrip().endswith("</svg>")
+        assert re.findall(r"<title>(\d+)</title>", svg) == ["0", "1", "2", "3"]
+        png = (pictures / f"{name}.png").read_bytes()
+        assert png.startswith(b"\x89PNG\r\n\x1a\n") and png[12:16] == b"IHDR"
+        width, height = struct.unpack(">II", png[16:24])
+        assert width > 100 and height > 50
+    assert (pictures / "pinned.pdf").read_bytes().startswith(b"%PDF")
+    learner = (pictures / "learner.svg").read_text(encoding="utf-8")
+    assert len(set(re.findall(r"<title>(\d+)</title>", learner))) == 119
 
 
 def test_a_picture_that_cannot_be_written_whole_leaves_the_old_one(tmp_path: Path) -> None:
