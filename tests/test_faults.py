@@ -25,6 +25,7 @@ from rsstp_sim import load_scenario, make_strategy
 from rsstp_sim.recording import record
 from rsstp_sim.scenario import MAX_MAGNITUDE
 from rsstp_sim.world_table import WorldTable
+from waiting import HANG_S
 
 sys.path.insert(0, str(Path(__file__).parent / "replay"))
 from test_corrupt import rewrite  # noqa: E402
@@ -217,7 +218,7 @@ def test_a_table_past_a_file_size_limit_is_one_line_and_exit_1(
         + ["--force"],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
         preexec_fn=_limited(2_000),
         env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": "/tmp",
              "PYTHONDONTWRITEBYTECODE": "1"},  # no .pyc cut short by the limit

@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from waiting import HANG_S
+
 ROOT = Path(__file__).resolve().parents[1]
 REFERENCE = ROOT / "recordings" / "two-joint-30-learner.mcap"
 
@@ -35,7 +37,7 @@ def on_a_terminal(*command: str) -> tuple[int, str]:
             break
         written += chunk
     os.close(leader)
-    return process.wait(timeout=120), written.decode(errors="replace")
+    return process.wait(timeout=HANG_S), written.decode(errors="replace")
 
 
 COMMANDS = [
@@ -59,6 +61,6 @@ def test_a_bar_on_a_terminal_and_nothing_when_piped_or_quiet(
     code, quiet = on_a_terminal(sys.executable, "-m", program, *args, "--quiet")
     assert code == 0 and quiet == ""
     piped = subprocess.run(
-        [sys.executable, "-m", program, *args], capture_output=True, text=True, timeout=120
+        [sys.executable, "-m", program, *args], capture_output=True, text=True, timeout=HANG_S
     )
     assert piped.returncode == 0 and piped.stderr == ""

@@ -24,6 +24,7 @@ from rsstp_replay.audits import audit_truth, compare, run_audits
 from rsstp_replay.audits.physics import check_physics
 from rsstp_sim import AgentView, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording.recorder import record
+from waiting import HANG_S
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 STEPS = 1500
@@ -96,7 +97,7 @@ def test_info_on_an_unfinished_file_warns_in_one_line(run: Path, tmp_path: Path)
         env={**os.environ, "PYTHONPATH": str(SRC)},
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
     )
     assert process.returncode == 0, process.stderr
     assert "Traceback" not in process.stderr
@@ -135,7 +136,7 @@ def test_a_file_size_limit_never_leaves_a_part_of_a_table(run: Path, tmp_path: P
 
     done = subprocess.run(
         [sys.executable, "-m", "rsstp_cli.replay", "table", str(run), "-o", str(out), "--force"],
-        capture_output=True, text=True, timeout=120, preexec_fn=small_files,
+        capture_output=True, text=True, timeout=HANG_S, preexec_fn=small_files,
         env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": "/tmp",
              "PYTHONDONTWRITEBYTECODE": "1"},  # no .pyc cut short by the limit
     )  # fmt: skip

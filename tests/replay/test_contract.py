@@ -26,6 +26,7 @@ from rsstp_sim.coupling import Runner
 from rsstp_sim.recording import record
 from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.strategies import Strategy
+from waiting import HANG_S
 
 REFERENCE = Path(__file__).resolve().parents[2] / "recordings"
 
@@ -147,7 +148,7 @@ def test_check_and_audit_gate_on_the_contract(tmp_path: Path) -> None:
             [sys.executable, "-m", "rsstp_cli.replay", *args],
             capture_output=True,
             text=True,
-            timeout=120,
+            timeout=HANG_S,
         )
 
     ok = cli("check", str(good))

@@ -29,6 +29,7 @@ from rsstp_replay import Recording, errors, open_recording
 from rsstp_replay.table_files import write_table_parts
 from rsstp_sim import AgentView, StrategyBase, load_scenario
 from rsstp_sim.recording.recorder import record
+from waiting import HANG_S
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 RECORDINGS = SRC.parent / "recordings"
@@ -405,7 +406,7 @@ def cli_runs(damaged: dict[str, Path]) -> dict[str, subprocess.CompletedProcess[
         )
     runs = {}
     for name, process in processes.items():
-        stdout, stderr = process.communicate(timeout=120)
+        stdout, stderr = process.communicate(timeout=HANG_S)
         runs[name] = subprocess.CompletedProcess(process.args, process.returncode, stdout, stderr)
     return runs
 
@@ -471,7 +472,7 @@ def test_info_never_calls_a_file_with_a_failing_chunk_finished(damaged: dict[str
         [sys.executable, "-m", "rsstp_cli.replay", "info", str(damaged["chunk-flip"])],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
     )
     assert done.returncode == 2
     assert "finished" not in done.stdout

@@ -12,6 +12,7 @@ import pytest
 from rsstp_replay import open_recording
 from rsstp_sim import load_scenario, make_strategy
 from rsstp_sim.recording import record
+from waiting import HANG_S
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -21,7 +22,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
         [sys.executable, "-m", "rsstp_cli.replay", *args],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
     )
 
 

@@ -30,6 +30,7 @@ from rsstp_replay.foxglove_scene import ARM_TOPIC, LOG_TOPIC, STATIC_TOPIC, TRAN
 from rsstp_sim import __version__, palette
 from rsstp_sim.recording import record
 from rsstp_sim.scenario import Scenario, load_scenario
+from waiting import HANG_S
 
 STEPS = 400
 SRC = Path(__file__).resolve().parents[2] / "src"
@@ -342,7 +343,7 @@ def test_a_file_size_limit_never_leaves_a_truncated_scene(
     done = subprocess.run(
         [sys.executable, "-m", "rsstp_cli.replay", "export", "--foxglove", str(recorded.path),
          "-o", str(out), "--force"],
-        capture_output=True, text=True, timeout=120, preexec_fn=small_files,
+        capture_output=True, text=True, timeout=HANG_S, preexec_fn=small_files,
         env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin", "HOME": "/tmp",
              "PYTHONDONTWRITEBYTECODE": "1"},  # no .pyc cut short by the limit
     )  # fmt: skip
@@ -390,7 +391,7 @@ def test_rerun_imports_the_logs_and_the_frames(
         [RERUN, "mcap", "convert", str(scene.path), "-o", str(rrd)],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
         check=False,
         env={**os.environ, "RUST_LOG": "off"},
     )

@@ -13,7 +13,6 @@ import os
 import signal
 import subprocess
 import sys
-import time
 import warnings
 from collections.abc import Iterator
 from dataclasses import dataclass
@@ -37,6 +36,7 @@ from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, ma
 from rsstp_sim.recording import records
 from rsstp_sim.recording.recorder import record
 from rsstp_sim.transition_system import TransitionSystem
+from waiting import wait_until
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 STEPS = 2000
@@ -431,9 +431,11 @@ def test_a_killed_writer_leaves_a_readable_recording(tmp_path: Path) -> None:
     command += ["--steps", "10000000", "--seed", "3", "--chunk-size", "4096", "-o", str(path)]
     process = subprocess.Popen(command, env=env, stderr=subprocess.DEVNULL)
     try:
-        deadline = time.monotonic() + 30
-        while (not side.exists() or side.stat().st_size < 60_000) and time.monotonic() < deadline:
-            time.sleep(0.02)
+        wait_until(
+            lambda: side.exists() and side.stat().st_size >= 60_000,
+            f"{side} growing to 60,000 bytes",
+            process=process,
+        )
     finally:
         process.send_signal(signal.SIGKILL)
         process.wait()

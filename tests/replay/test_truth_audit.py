@@ -23,6 +23,7 @@ from rsstp_sim import (
 from rsstp_sim.recording import record
 from rsstp_sim.strategies import RouletteStrategy
 from rsstp_sim.truth import compute_truth
+from waiting import HANG_S
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 
@@ -135,7 +136,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
         capture_output=True,
         text=True,
         env={"PYTHONPATH": str(SRC), "PATH": "/usr/bin:/bin"},
-        timeout=120,
+        timeout=HANG_S,
     )
 
 

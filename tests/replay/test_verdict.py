@@ -28,6 +28,7 @@ from rsstp_sim.strategies import LearnerStrategy, RandomStrategy, SplitterStrate
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, compute_truth
 from scenarios import arm_toml
+from waiting import HANG_S
 
 OBSTACLE_SPOTS = [((0.0, 2.2), 0.3), ((-1.5, 1.5), 0.4), ((0.0, -2.2), 0.3), ((-2.5, 0.0), 0.3)]
 """Obstacles clear of the straight arm along +x (the start pose)."""
@@ -210,13 +211,13 @@ def test_the_command_line_fails_a_one_way_run_and_says_why(tmp_path: Path) -> No
     record(path, load_scenario("one-way"), make_strategy("learner"), steps=600, seed=0)
     command = [sys.executable, "-m", "rsstp_cli.replay", "audit", "--truth", str(path)]
     gated = subprocess.run(
-        [*command, "--fail-on", "not-learned"], capture_output=True, text=True, timeout=300
+        [*command, "--fail-on", "not-learned"], capture_output=True, text=True, timeout=HANG_S
     )
     assert gated.returncode == 1
     assert "cannot return to where it started" in gated.stderr
     document = json.loads(
         subprocess.run(
-            [*command, "--json"], capture_output=True, text=True, timeout=300, check=True
+            [*command, "--json"], capture_output=True, text=True, timeout=HANG_S, check=True
         ).stdout
     )
     verdict = document["verdict"]

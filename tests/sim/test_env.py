@@ -15,6 +15,7 @@ from rsstp_sim.env import ENV_ID, MAX_EPISODE_STEPS, ArmEnv, register_envs
 from rsstp_sim.errors import ActionError, ScenarioError
 from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
 from scenarios import arm_toml
+from waiting import HANG_S
 
 FLOAT_TWO_LINKS = arm_toml(
     [2.0, 1.0],
@@ -285,7 +286,7 @@ def test_make_with_the_module_prefix_in_a_fresh_interpreter() -> None:
         ],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["1", str(MAX_EPISODE_STEPS)]

@@ -19,6 +19,7 @@ from rsstp_sim.errors import EnvError
 from rsstp_sim.recording import record
 from rsstp_sim.recording.env_wrapper import RecordMcap
 from rsstp_sim.transition_system import TransitionSystem
+from waiting import HANG_S
 
 ENV_ID = "rsstp_sim:rsstp/Arm-v0"
 
@@ -134,7 +135,7 @@ def test_every_replay_command_reads_a_recording_without_a_model(
         [sys.executable, "-m", "rsstp_cli.replay", *words],
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=HANG_S,
     )
     assert done.returncode == 0, done.stderr
     assert "Traceback" not in done.stderr

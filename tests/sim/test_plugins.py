@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from rsstp_replay import open_recording
+from waiting import HANG_S
 
 STRATEGIES = """
 from rsstp_sim import AgentView, StrategyBase
@@ -62,7 +63,7 @@ def cli(program: str, *args: str, path: Path) -> subprocess.CompletedProcess[str
         [sys.executable, "-m", program, *args],
         capture_output=True,
         text=True,
-        timeout=120,
+        timeout=HANG_S,
         env={**os.environ, "PYTHONPATH": f"{path}{os.pathsep}{os.environ.get('PYTHONPATH', '')}"},
     )
 
@@ -170,7 +171,7 @@ def test_the_readme_strategy_records_and_learns_its_world(tmp_path: Path) -> Non
         program = {"rsstp-sim": "rsstp_cli.sim", "rsstp-replay": "rsstp_cli.replay"}[words[0]]
         done = subprocess.run(
             [sys.executable, "-m", program, *words[1:]],
-            capture_output=True, text=True, timeout=120, cwd=tmp_path,
+            capture_output=True, text=True, timeout=HANG_S, cwd=tmp_path,
             env={**os.environ, "PYTHONPATH": str(tmp_path)},
         )  # fmt: skip
         assert done.returncode == 0, done.stderr

@@ -16,7 +16,6 @@ import signal
 import struct
 import subprocess
 import sys
-import time
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -29,9 +28,9 @@ from mcap.stream_reader import StreamReader, breakup_chunk
 from rsstp_sim import RandomStrategy, load_scenario
 from rsstp_sim.recording import records, schemas
 from rsstp_sim.recording.recorder import record
+from waiting import HANG_S, wait_until
 
 SRC = Path(__file__).resolve().parents[2] / "src"
-TIMEOUT_S = 60
 CHUNK_SIZE = 65536
 MCAP_MAGIC = b"\x89MCAP0\r\n"
 
@@ -49,7 +48,7 @@ def rsstp_record(*args: str | Path, **env: str) -> subprocess.CompletedProcess[s
         env=cli_env(**env),
         capture_output=True,
         text=True,
-        timeout=TIMEOUT_S,
+        timeout=HANG_S,
         check=False,
     )
 
@@ -156,7 +155,7 @@ def bad_runs(
     runs = {}
     for case, (directory, proc) in started.items():
         try:
-            stdout, stderr = proc.communicate(timeout=TIMEOUT_S)
+            stdout, stderr = proc.communicate(timeout=HANG_S)
         finally:
             if proc.poll() is None:
                 proc.kill()
@@ -236,11 +235,13 @@ def helpers_of(pid: int) -> list[int]:
 
 
 def wait_until_gone(pids: list[int]) -> None:
-    deadline = time.monotonic() + 10
-    while any(Path(f"/proc/{pid}").exists() for pid in pids):
-        if time.monotonic() > deadline:
-            pytest.fail(f"helper processes {pids} outlived their recorder")
-        time.sleep(0.02)
+    """Until the helpers ``pids`` end (they do as their recorder's pipe closes; a hang guard
+    fails a helper that outlives its recorder)."""
+
+    def gone() -> bool:
+        return not any(Path(f"/proc/{pid}").exists() for pid in pids)
+
+    wait_until(gone, f"helper processes {pids} outlived their recorder")
 
 
 def side(out: Path) -> Path:
@@ -251,14 +252,11 @@ def side(out: Path) -> Path:
 def wait_for_chunks(proc: subprocess.Popen[str], out: Path, *, min_bytes: int) -> None:
     """Poll until the side file of ``out`` is bigger than ``min_bytes`` (several complete
     chunks)."""
-    deadline = time.monotonic() + TIMEOUT_S
-    while time.monotonic() < deadline:
-        if proc.poll() is not None:
-            pytest.fail(f"the recording ended early: {proc.returncode} {proc.communicate()}")
-        if side(out).exists() and side(out).stat().st_size > min_bytes:
-            return
-        time.sleep(0.02)
-    pytest.fail(f"{out} did not grow past {min_bytes} bytes in {TIMEOUT_S} s")
+
+    def grown() -> bool:
+        return side(out).exists() and side(out).stat().st_size > min_bytes
+
+    wait_until(grown, f"{out} growing past {min_bytes} bytes", process=proc)
 
 
 def stop_recording(
@@ -275,7 +273,7 @@ def stop_recording(
             os.killpg(proc.pid, sig)
         else:
             proc.send_signal(sig)
-        stdout, stderr = proc.communicate(timeout=TIMEOUT_S)
+        stdout, stderr = proc.communicate(timeout=HANG_S)
         wait_until_gone(helpers)
     finally:
         if proc.poll() is None:
@@ -366,7 +364,7 @@ def test_sigkill_keeps_every_complete_chunk(tmp_path: Path) -> None:
         _, status = os.waitpid(proc.pid, os.WUNTRACED)
         assert os.WIFSTOPPED(status)
         proc.kill()
-        proc.communicate(timeout=TIMEOUT_S)
+        proc.communicate(timeout=HANG_S)
         wait_until_gone(helpers)  # its pipe closed: the helper ended too
     finally:
         if proc.poll() is None:
@@ -410,7 +408,7 @@ def test_force_keeps_the_old_recording_until_the_new_one_is_whole(tmp_path: Path
     try:
         wait_for_chunks(proc, out, min_bytes=2 * CHUNK_SIZE)
         proc.kill()  # right in the middle of replacing it
-        proc.communicate(timeout=TIMEOUT_S)
+        proc.communicate(timeout=HANG_S)
     finally:
         if proc.poll() is None:
             proc.kill()
@@ -433,7 +431,7 @@ def test_a_second_writer_on_the_same_output_is_refused(tmp_path: Path) -> None:
         second = rsstp_record("thesis-roulette", "--steps", "20", "-o", out, "--force")
         assert_one_line_error(second, r"another recording is being written there")
         first.send_signal(signal.SIGINT)
-        first.communicate(timeout=TIMEOUT_S)
+        first.communicate(timeout=HANG_S)
     finally:
         if first.poll() is None:
             first.kill()
@@ -461,7 +459,7 @@ def test_a_file_size_limit_is_one_line_saying_what_is_safe(
     done = subprocess.run(
         [sys.executable, "-m", "rsstp_cli.sim", "record", "three-joint", "--steps", steps,
          "-o", str(out)],
-        env=cli_env(), capture_output=True, text=True, timeout=TIMEOUT_S, preexec_fn=small_files,
+        env=cli_env(), capture_output=True, text=True, timeout=HANG_S, preexec_fn=small_files,
     )  # fmt: skip
     assert done.returncode == 1, done.stderr
     lines = done.stderr.splitlines()
@@ -524,11 +522,11 @@ def test_a_named_pipe_is_refused_not_waited_on(tmp_path: Path) -> None:
     os.mkfifo(pipe)
     done = subprocess.run(
         [sys.executable, "-m", "rsstp_cli.sim", "run", str(pipe), "--steps", "3"],
-        env=cli_env(), capture_output=True, text=True, timeout=30,
+        env=cli_env(), capture_output=True, text=True, timeout=HANG_S,
     )  # fmt: skip
     assert_one_line_error(done, r"scenario.toml: a named pipe, not a scenario file")
     replay = subprocess.run(
         [sys.executable, "-m", "rsstp_cli.replay", "info", str(pipe)],
-        env=cli_env(), capture_output=True, text=True, timeout=30,
+        env=cli_env(), capture_output=True, text=True, timeout=HANG_S,
     )  # fmt: skip
     assert replay.returncode == 2 and "a named pipe, not a recording" in replay.stderr

@@ -17,6 +17,7 @@ from rsstp_sim import scenario as scenario_module
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.scenario import Obstacle, builtin_scenarios, load_scenario, parse_scenario
 from rsstp_sim.world import World
+from waiting import HANG_S
 
 BUILTINS = tuple(builtin_scenarios())
 THESIS_BUILTINS = (
@@ -543,7 +544,7 @@ def test_many_obstacles_run_with_a_one_line_warning(tmp_path: Path) -> None:
     )
     done = subprocess.run(
         [sys.executable, "-m", "rsstp_cli.sim", "run", str(scenario), "--steps", "10"],
-        capture_output=True, text=True, timeout=60,
+        capture_output=True, text=True, timeout=HANG_S,
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert done.stderr.startswith("rsstp-sim: warning: 150 obstacles: every step measures")

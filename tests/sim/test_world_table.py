@@ -19,6 +19,7 @@ from rsstp_sim.truth import compute_truth
 from rsstp_sim.world import World
 from rsstp_sim.world_table import MAX_TABULATION_CHECKS, tabulation_checks, unsensable
 from scenarios import arm_toml
+from waiting import HANG_S
 
 ARM = arm_toml([2.0, 1.0], [0, 0], 30, [((0.0, 2.5), 0.5)])
 
@@ -54,7 +55,7 @@ def test_run_warns_in_one_line(tmp_path: Path) -> None:
     scenario.write_text(ARM + "[feedback]\ntarget_deg = [90, 0]\n")
     done = subprocess.run(
         [sys.executable, "-m", "rsstp_cli.sim", "run", str(scenario), "--steps", "10"],
-        capture_output=True, text=True, timeout=60,
+        capture_output=True, text=True, timeout=HANG_S,
     )  # fmt: skip
     assert done.returncode == 0
     assert done.stderr.startswith("rsstp-sim: warning: no pose can sense the feedback point")
