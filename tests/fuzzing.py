@@ -17,9 +17,10 @@ must keep to.
 :func:`check_scenario` and :func:`check_recording` return what went wrong with one case
 (``None`` when nothing did): an exception that is not the package's documented error, a
 command line that ends in anything but its exit code and one line, a case over its time
-bound (in the suite a hang guard, :data:`HANG_SECONDS`: a test never depends on how fast the
-machine is; ``bench/fuzz.py`` gives :data:`STALL_SECONDS`, a stall on the machine it measures),
-or (for recordings) a message returned that was never written. The default test run
+bound (in the suite a hang guard, :data:`waiting.HANG_S`, where a case takes some 0.03 s: a
+test never depends on how fast the machine is; ``bench/fuzz.py`` gives
+:data:`STALL_SECONDS`, a stall on the machine it measures), or (for recordings) a message
+returned that was never written. The default test run
 (``tests/test_fuzz.py``) runs a short budget; ``bench/fuzz.py`` runs a long one and counts.
 """
 
@@ -52,12 +53,8 @@ from rsstp_replay import ReplayError, UnfinishedRecordingWarning, open_recording
 from rsstp_sim import RsstpError, load_scenario, make_strategy, parse_scenario
 from rsstp_sim.recording import record
 from scenarios import toml_text
+from waiting import HANG_S
 
-HANG_SECONDS = 300.0
-"""The suite's time bound of one case (a scenario validated, then a few steps run and recorded;
-a recording read whole, then ``rsstp-replay check``): a hang guard, so that a case that never
-ends is a finding named with its case, not a hang of the suite. A case takes some 0.03 s
-(``bench/fuzz.py``: 8,000 scenario files in 255 s on a loaded machine)."""
 STALL_SECONDS = 10.0
 """``bench/fuzz.py``'s time bound of one case: over it, a stall (a finding) on the machine the
 bench runs on, measured there; not a property of the code that any machine could check."""
@@ -299,7 +296,7 @@ def _command(main: Callable[[list[str]], int], argv: list[str], prog: str) -> st
     return None
 
 
-def check_scenario(text: str, folder: Path, *, seconds: float = HANG_SECONDS) -> str | None:
+def check_scenario(text: str, folder: Path, *, seconds: float = HANG_S) -> str | None:
     """Parse the text (only :class:`ScenarioError` may come out); if it is a scenario, record
     five steps of it with ``rsstp-sim record`` (exit 0, or 2 and one line); within
     ``seconds``."""
@@ -415,7 +412,7 @@ def _not_written(path: Path, written: Written) -> str | None:
 
 
 def check_recording(
-    mutations: list[Mutation], written: Written, folder: Path, *, seconds: float = HANG_SECONDS
+    mutations: list[Mutation], written: Written, folder: Path, *, seconds: float = HANG_S
 ) -> str | None:
     """Damage a real recording's bytes, read it through the API and with ``rsstp-replay
     check`` within ``seconds``; what went wrong, if anything."""
@@ -566,7 +563,7 @@ def _rewrite_message(data: bytes, case: Rewrite) -> bytes | None:
 
 
 def check_rewrite(
-    case: Rewrite, source: Path, steps: int, folder: Path, *, seconds: float = HANG_SECONDS
+    case: Rewrite, source: Path, steps: int, folder: Path, *, seconds: float = HANG_S
 ) -> str | None:
     """A recording with one ground-truth value changed must not pass ``check --physics``
     (within ``seconds``)."""

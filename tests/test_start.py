@@ -20,10 +20,11 @@ import struct
 import subprocess
 import sys
 import termios
-import time
 from pathlib import Path
 
 import pytest
+
+from waiting import HANG_S, wait_until
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
@@ -82,11 +83,9 @@ def _interrupted(command: list[str], seen: str, text: str) -> tuple[int, str]:
     os.close(follower)
     written = b""
     try:
-        maps = Path(f"/proc/{process.pid}/maps")
-        while seen == "mapped" and text not in maps.read_text(errors="replace"):
-            if process.poll() is not None:
-                pytest.fail(f"{command[0]} ended before {text} was mapped")
-            time.sleep(0.001)  # a poll: the moment is the mapping, not a delay
+        if seen == "mapped":
+            maps = Path(f"/proc/{process.pid}/maps")
+            wait_until(lambda: text in maps.read_text(errors="replace"), text, process=process)
         while seen == "shown" and text.encode() not in written:
             chunk = _read(leader)
             if not chunk:
@@ -95,7 +94,7 @@ def _interrupted(command: list[str], seen: str, text: str) -> tuple[int, str]:
         process.send_signal(signal.SIGINT)
         while chunk := _read(leader):
             written += chunk
-        return process.wait(timeout=600), written.decode(errors="replace")  # a hang guard
+        return process.wait(timeout=HANG_S), written.decode(errors="replace")
     finally:
         os.close(leader)
         if process.poll() is None:

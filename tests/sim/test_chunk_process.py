@@ -18,7 +18,6 @@ import shutil
 import signal
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import pytest
@@ -32,6 +31,7 @@ from rsstp_sim.recording.recorder import HELPER_STEPS, TRIAL_STEPS, Recorder
 from rsstp_sim.recording.step_messages import Steps
 from rsstp_sim.scenario import parse_scenario
 from rsstp_sim.strategies import make_strategy
+from waiting import wait_until
 
 RUNS = [
     # scenario, strategy, steps, chunk size: what the run has
@@ -235,10 +235,13 @@ def test_closing_a_helper_ends_it_at_once() -> None:
     a machine slow to start it does not reach that resort."""
     helper = ChunkProcess(chunk_size=1024, channels=(1, 2))  # given nothing yet
     (pid,) = helpers()
-    while "pipe_read" not in Path(f"/proc/{pid}/wchan").read_text():  # the kernel's wait
+
+    def waiting_on_its_pipe() -> bool:  # the kernel's wait: its wchan
         state = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0]
         assert state != "Z", "the helper ended before it read its pipe"
-        time.sleep(0.01)
+        return "pipe_read" in Path(f"/proc/{pid}/wchan").read_text()
+
+    wait_until(waiting_on_its_pipe, "the helper waiting on its pipe")
     helper.close()
     assert helper._process.returncode == 1 and not alive([pid])
 
