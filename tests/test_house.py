@@ -91,6 +91,21 @@ def test_no_package_imports_one_above_it() -> None:
     assert upward == []
 
 
+def test_no_package_imports_another_packages_private_module() -> None:
+    """A module whose name starts with ``_`` is its package's own: another package reaches
+    what it needs through a public module, so the private one can change freely."""
+    reaching = []
+    for path, tree in _modules():
+        package = path.relative_to(SRC).parts[0]
+        for name in sorted(_imports(tree)):
+            parts = name.split(".")
+            if parts[0] in PACKAGES and parts[0] != package:
+                private = [part for part in parts[1:] if part.startswith("_")]
+                if private and not all(p.startswith("__") for p in private):
+                    reaching.append(f"{path.relative_to(SRC)} imports {name}")
+    assert reaching == []
+
+
 def test_the_four_packages_are_all_there_is() -> None:
     """No top-level module beside the packages in every user's site-packages, and the
     console scripts start in the command-line package."""

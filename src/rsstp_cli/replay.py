@@ -339,13 +339,15 @@ def _cmd_compare(args: argparse.Namespace) -> int:
 
 
 def _cmd_view(args: argparse.Namespace) -> int:
-    from rsstp_replay._viewer_serve import (
+    from rsstp_replay.viewer import (
+        ViewerWarning,
+        ViewResult,
         check_port,
         ctrl_c_remembered,
         has_display,
         rerun_command,
+        view,
     )
-    from rsstp_replay.viewer import ViewerWarning, ViewResult, view
 
     save = Path(args.save) if args.save is not None else None
     spawn = args.spawn or (save is None and not args.serve_web)

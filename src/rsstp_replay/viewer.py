@@ -39,7 +39,15 @@ from rsstp_replay import _viewer_world as world_part
 from rsstp_replay._viewer_blueprint import default_blueprint, view_reach
 from rsstp_replay._viewer_chunks import TIMELINE
 from rsstp_replay._viewer_layout import graph_positions
-from rsstp_replay._viewer_serve import DEFAULT_BIND, CtrlC, WebServer, check_port
+from rsstp_replay._viewer_serve import (
+    DEFAULT_BIND,
+    CtrlC,
+    WebServer,
+    check_port,
+    ctrl_c_remembered,
+    has_display,
+    rerun_command,
+)
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.audits.truth import step_true_classes
@@ -63,10 +71,14 @@ __all__ = [
     "ViewResult",
     "ViewSource",
     "ViewerWarning",
+    "check_port",
+    "ctrl_c_remembered",
     "default_blueprint",
     "graph_positions",
+    "has_display",
     "log_recording",
     "render_graph",
+    "rerun_command",
     "view",
 ]
 

@@ -24,15 +24,17 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 import numpy as np
+from numpy.typing import NDArray
 
 from rsstp_replay._chunks import gc_paused
 from rsstp_replay.errors import PhysicsDifference
-from rsstp_sim._arrays import IntArray
 from rsstp_sim.errors import ActionError
 from rsstp_sim.recording import builders, records
 from rsstp_sim.strategies import StrategyOrigin
 from rsstp_sim.world import World
 from rsstp_sim.world_table import pose_space_size
+
+IntArray = NDArray[np.int64]  # (rsstp_sim._arrays is the simulator's own)
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -95,12 +95,13 @@ TRIAL_STEPS = 65_536
 HELPER_BYTES_PER_STEP = 180
 """The most bytes of new tails and whole messages a step may cost, over the last
 :data:`_WINDOW_STEPS` of the first :data:`TRIAL_STEPS`, for the helper to be kept. Measured
-with seeds 1 and 2 (``bench/record_vs_run.py``): the random walk of ``three-joint`` 93-140 (its poses met again:
-the helper makes its recording about 20 % faster, 3.5 s against 4.35 s for 1,000,000 steps
-in one process), the learner on ``thesis-algo`` 140 (3 % faster), an arm roaming free of
-obstacles 225-234 (no faster, no slower), the same among two far obstacles 287-298 (5 %
-slower with the helper: bigger tails, half its steps at a new pose), the splitter on
-``two-joint-30`` 16,000-26,000 (a whole model message every few steps: 28 % slower)."""
+with seeds 1 and 2 (``bench/record_vs_run.py``): the random walk of ``three-joint`` 93-140
+(its poses met again: the helper makes its recording about 20 % faster, 3.5 s against
+4.35 s for 1,000,000 steps in one process), the learner on ``thesis-algo`` 140 (3 % faster),
+an arm roaming free of obstacles 225-234 (no faster, no slower), the same among two far
+obstacles 287-298 (5 % slower with the helper: bigger tails, half its steps at a new pose),
+the splitter on ``two-joint-30`` 16,000-26,000 (a whole model message every few steps: 28 %
+slower)."""
 
 _WINDOW_STEPS = 16_384
 
