@@ -8,12 +8,12 @@ Graphviz lays the union out in this process (:func:`rsstp_sim.graph.run_graphviz
 ``pygraphviz``'s wheel) and holds the interpreter until it is done: no timeout can stop it, so
 the layout is bounded by its input and by Graphviz's own work limits, never by a clock. (A clock
 would also make the picture depend on how busy the machine is: the same recording laid out by
-``dot`` on one machine and by ``sfdp`` on another.) Measured on this project's machine: ``dot``
-with its default limits took 4.3 s of CPU on a learner's union of 400 state pairs, and 21-34 s
-on random graphs of 400 pairs over 70 and 150 states, so the pair count alone
-(:data:`DOT_MAX_PAIRS`) does not bound it; within :data:`DOT_LIMITS` the same graphs take 0.2-0.3
-s and at most 2 s. ``sfdp`` is near linear: 3.7 s for the 1,183 states and 8,699 pairs of a
-learner's run of a two-link arm at 10-degree steps (``bench/graphviz_layout.py``).
+``dot`` on one machine and by ``sfdp`` on another.) Measured (``bench/graphviz_layout.py``,
+warm, 2 shared cores): ``dot`` with Graphviz's default limits took 2.0 s on a learner's union of
+400 state pairs and 25 s on 400 random pairs over 150 states (21 s over 70), so the pair count
+alone (:data:`DOT_MAX_PAIRS`) does not bound it; within :data:`DOT_LIMITS` the same graphs take
+0.3 s, 1.1 s and 1.9 s. ``sfdp`` with :data:`SFDP_SETTINGS` takes 0.06 s on the 119 states and
+763 pairs of a learner's union, 3.1 s on the 1,183 states and 8,699 pairs of another.
 """
 
 from __future__ import annotations
