@@ -40,7 +40,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from typing import IO, Any
 
-from rsstp_sim.errors import GraphvizFailed
+from rsstp_sim.errors import GraphvizFailed, OutputError
 
 __all__ = ["run_graphviz"]
 
@@ -54,10 +54,12 @@ def run_graphviz(engine: str, source: str, output_format: str, *, what: str) -> 
 
     A failure (a source Graphviz cannot read, an engine or format it does not know, a layout or
     a rendering that fails) is one :class:`GraphvizFailed` line naming ``what``, with the first
-    error Graphviz wrote; nothing Graphviz writes reaches the terminal.
+    error Graphviz wrote; nothing Graphviz writes reaches the terminal. ``pygraphviz`` hands the
+    source over in a temporary file: one that cannot be written (a full disk, a file-size limit)
+    is :class:`~rsstp_sim.errors.OutputError`.
     """
     with _LOCK, _captured_stderr() as messages:
-        problem, data = _draw(engine, source, output_format)
+        problem, data = _draw(engine, source, output_format, what=what)
     if problem is not None:
         detail = _first_error(messages) or problem
         raise GraphvizFailed(
@@ -67,7 +69,7 @@ def run_graphviz(engine: str, source: str, output_format: str, *, what: str) -> 
     return data
 
 
-def _draw(engine: str, source: str, output_format: str) -> tuple[str | None, bytes]:
+def _draw(engine: str, source: str, output_format: str, *, what: str) -> tuple[str | None, bytes]:
     """``(None, the output)``, or ``(what went wrong, b"")``: pygraphviz's parser, then
     Graphviz's own calls (``gvLayout``, ``gvRenderData``) on the graph it read."""
     import pygraphviz
@@ -75,7 +77,12 @@ def _draw(engine: str, source: str, output_format: str) -> tuple[str | None, byt
 
     try:
         graph = pygraphviz.AGraph(string=source)
-    except (ValueError, TypeError, OSError) as exc:  # pygraphviz.DotError is a ValueError
+    except OSError as exc:
+        raise OutputError(
+            f"cannot hand the DOT source of {what} to Graphviz: a temporary file could not be "
+            f"written ({exc.strerror or exc})"
+        ) from None
+    except (ValueError, TypeError) as exc:  # pygraphviz.DotError is a ValueError
         return f"cannot read the DOT source ({exc})", b""
     context: Any = gv.gvContextWithBuiltins()
     try:

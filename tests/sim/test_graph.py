@@ -290,6 +290,35 @@ def test_everything_is_drawn_with_no_graphviz_program_and_no_noise(tmp_path: Pat
     assert len(set(re.findall(r"<title>(\d+)</title>", learner))) == 119
 
 
+@pytest.mark.parametrize("suffix", ["svg", "png"])
+def test_a_file_size_limit_met_handing_the_source_to_graphviz_is_one_line(
+    tmp_path: Path, suffix: str
+) -> None:
+    """pygraphviz hands the DOT source to Graphviz in a temporary file: past RLIMIT_FSIZE it
+    cannot be written (EFBIG): one line, exit 1 (the disk failed, not the input), the old
+    picture as it was."""
+    import resource
+
+    out = tmp_path / f"model.{suffix}"
+    out.write_text("the old picture")
+
+    def tiny_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20, 20))
+
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_cli.sim", "graph", "--matrix", "[[[0],[1]],[[1],[0]]]",
+         "-o", str(out), "--force"],
+        capture_output=True, text=True, timeout=60, preexec_fn=tiny_files,
+    )  # fmt: skip
+    assert done.returncode == 1
+    assert done.stderr.strip() == (
+        "rsstp-sim: error: cannot hand the DOT source of a model of 2 states and 4 transitions "
+        "to Graphviz: a temporary file could not be written (File too large)"
+    )
+    assert out.read_text() == "the old picture"
+    assert [p.name for p in tmp_path.iterdir()] == [out.name]
+
+
 def test_a_picture_that_cannot_be_written_whole_leaves_the_old_one(tmp_path: Path) -> None:
     """EFBIG (RLIMIT_FSIZE in the child) while writing: one line, exit 1, the old file as it
     was and no side file."""
