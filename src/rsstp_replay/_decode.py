@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import re
 from itertools import chain
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 import msgspec
 import numpy as np
@@ -28,7 +28,14 @@ import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_replay.errors import BadStep, ReplayError
-from rsstp_sim.geometry import ArmGeometry, joint_positions, obstacle_distances
+from rsstp_sim.geometry import (
+    BLOCKER_ARITY,
+    BLOCKER_KINDS,
+    ArmGeometry,
+    BlockerKind,
+    joint_positions,
+    obstacle_distances,
+)
 from rsstp_sim.recording.records import json_array
 
 __all__ = [
@@ -57,7 +64,7 @@ class _Agent(msgspec.Struct, gc=False, kw_only=True):
 
 
 class _BlockedBy(msgspec.Struct, gc=False, frozen=True):
-    kind: Literal["fold", "obstacle", "links"]
+    kind: BlockerKind
     indices: Annotated[tuple[_Count, ...], msgspec.Meta(min_length=1, max_length=2)]
 
 
@@ -110,11 +117,9 @@ _DECODERS: dict[bool, tuple[msgspec.json.Decoder[Any], msgspec.json.Decoder[Any]
     True: (msgspec.json.Decoder(list[_PoseStep]), msgspec.json.Decoder(_Step)),
     False: (msgspec.json.Decoder(list[_AgentStep]), msgspec.json.Decoder(_AgentStep)),
 }
-_ARITY = {"fold": 1, "obstacle": 2, "links": 2}
-
-BLOCKER_KINDS = ("fold", "obstacle", "links")
-"""The categories of the steps table's ``blocked_kind`` column, in this order in every
-recording (so tables of several recordings concatenate with the categorical kept)."""
+# BLOCKER_KINDS (rsstp_sim.geometry) are the categories of the steps table's ``blocked_kind``
+# column, in that order in every recording (so tables of several recordings concatenate with
+# the categorical kept).
 
 BLOCKED_COLUMNS: dict[str, tuple[str, ...]] = {
     "fold": ("blocked_joint",),
@@ -128,13 +133,13 @@ BLOCKED_COLUMNS: dict[str, tuple[str, ...]] = {
 _KIND_DTYPE = pd.CategoricalDtype(list(BLOCKER_KINDS))
 
 
-def blocker_label(kind: str, indices: tuple[int, ...]) -> str:
+def blocker_label(kind: BlockerKind, indices: tuple[int, ...]) -> str:
     """A blocker as text (the viewer's label): ``fold joint 1``, ``obstacle 1 link 2``,
     ``links 0 2``."""
-    if len(indices) != _ARITY[kind]:
-        raise BadStep(
-            f"truth.blocked_by: a {kind} blocker has {_ARITY[kind]} indices, found {list(indices)}"
-        )
+    arity = BLOCKER_ARITY[kind]
+    if len(indices) != arity:
+        found = list(indices)
+        raise BadStep(f"truth.blocked_by: a {kind} blocker has {arity} indices, found {found}")
     if kind == "fold":
         return f"fold joint {indices[0]}"
     if kind == "obstacle":

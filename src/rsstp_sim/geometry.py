@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal, Protocol
+from typing import Literal, Protocol, get_args
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -219,6 +219,15 @@ def arc_segment_distance(
 
 
 BlockerKind = Literal["fold", "obstacle", "links"]
+"""Why a move was blocked (:class:`Blocker`): the one definition of the blocker kinds, which
+the records, the schemas generated from them and the replay side's tables take from here."""
+
+BLOCKER_KINDS: tuple[BlockerKind, ...] = get_args(BlockerKind)
+"""The blocker kinds in their order (the order of a steps table's ``blocked_kind``
+categories)."""
+
+BLOCKER_ARITY: dict[BlockerKind, int] = {"fold": 1, "obstacle": 2, "links": 2}
+"""How many indices a blocker of each kind has (:class:`Blocker`)."""
 
 
 @dataclass(frozen=True, slots=True)
