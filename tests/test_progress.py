@@ -41,16 +41,18 @@ def on_a_terminal(*command: str) -> tuple[int, str]:
 
 
 COMMANDS = [
-    ("rsstp_cli.sim", "run", "thesis-roulette", "--steps", "140000"),
-    ("rsstp_cli.sim", "record", "one-joint-10", "--steps", "9000", "-o", "{tmp}/run.mcap",
-     "--force"),
-    ("rsstp_cli.replay", "audit", str(REFERENCE), "--truth"),
-    ("rsstp_cli.sim", "sweep", str(ROOT / "tests/sweep/tiny-sweep.toml"), "-o", "{tmp}/sweep",
-     "--workers", "1"),
+    pytest.param(("rsstp_cli.sim", "run", "thesis-roulette", "--steps", "140000"), id="run",
+                 marks=pytest.mark.slow),
+    pytest.param(("rsstp_cli.sim", "record", "one-joint-10", "--steps", "9000", "-o",
+                  "{tmp}/run.mcap", "--force"), id="record"),
+    pytest.param(("rsstp_cli.replay", "audit", str(REFERENCE), "--truth"), id="audit",
+                 marks=pytest.mark.slow),
+    pytest.param(("rsstp_cli.sim", "sweep", str(ROOT / "tests/sweep/tiny-sweep.toml"), "-o",
+                  "{tmp}/sweep", "--workers", "1"), id="sweep", marks=pytest.mark.slow),
 ]  # fmt: skip
 
 
-@pytest.mark.parametrize("command", COMMANDS, ids=lambda c: c[1])
+@pytest.mark.parametrize("command", COMMANDS)
 def test_a_bar_on_a_terminal_and_nothing_when_piped_or_quiet(
     command: tuple[str, ...], tmp_path: Path
 ) -> None:

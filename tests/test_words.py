@@ -113,6 +113,7 @@ def _commands(folder: Path) -> list[tuple[Callable[[list[str]], int], list[str]]
     return commands
 
 
+@pytest.mark.slow
 def test_every_command_prints_counts_that_read_right(
     folder: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

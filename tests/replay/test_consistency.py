@@ -113,6 +113,7 @@ def hidden_system_columns(draw: st.DrawFn) -> Columns:
     return np.array([-1, *actions]), where % state_count, where == goal
 
 
+@pytest.mark.slow
 @settings(max_examples=400, deadline=None)
 @given(columns=random_columns())
 def test_random_memories_match_reference(columns: Columns) -> None:

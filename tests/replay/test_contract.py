@@ -123,6 +123,7 @@ def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
     assert "step 30 is in internal state 998" in found.to_text()
 
 
+@pytest.mark.slow
 def test_check_and_audit_gate_on_the_contract(tmp_path: Path) -> None:
     """`rsstp-replay check` exits 0 on a recording that keeps the contract and 1 on one that
     breaks it (a step edited to start in another state), naming the rule and the step; `audit

@@ -4,6 +4,7 @@ tracked successor table (kept through the touched states, equal to one built afr
 
 from __future__ import annotations
 
+import pytest
 from fakes import FakeRecording, RandomRefiner
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -25,6 +26,7 @@ def as_record(model: TransitionSystem) -> TransitionsRecord:
     )
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(st.data())
 def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(

@@ -23,7 +23,9 @@ ROOT = Path(__file__).resolve().parents[2]
 STEPS = 3_000
 
 
-@pytest.fixture(autouse=True, params=["move by move", "whole table"])
+@pytest.fixture(
+    autouse=True, params=["move by move", pytest.param("whole table", marks=pytest.mark.slow)]
+)
 def world_walk(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
     """Every check twice: the world walked move by move, and tabulated whole with the
     recorded poses followed in numpy, block by block (what a replay longer than its world's

@@ -140,6 +140,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
     )
 
 
+@pytest.mark.slow
 def test_cli_truth_audit_and_gates(tmp_path: Path) -> None:
     path = tmp_path / "roulette.mcap"
     record(path, load_scenario("thesis-roulette"), RouletteStrategy(), steps=100, seed=0)

@@ -16,6 +16,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
+import pytest
 from fakes import FakeRecording, RandomRefiner
 from hypothesis import HealthCheck, event, given, settings
 from hypothesis import strategies as st
@@ -142,6 +143,7 @@ STRATEGIES = {
 }
 
 
+@pytest.mark.slow
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     world=worlds(),
@@ -204,6 +206,7 @@ def test_a_one_way_world_is_not_learned_from_where_the_arm_ended() -> None:
     )
 
 
+@pytest.mark.slow
 def test_the_command_line_fails_a_one_way_run_and_says_why(tmp_path: Path) -> None:
     """`audit --truth --fail-on not-learned` exits 1 on the built-in one-way world, whatever
     the model knows of where the arm ended; the JSON names the confinement."""

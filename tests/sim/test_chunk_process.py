@@ -35,7 +35,9 @@ from waiting import wait_until
 
 RUNS = [
     # scenario, strategy, steps, chunk size: what the run has
-    ("three-joint", "random", 20_000, 4096),  # blocked moves, many small chunks
+    pytest.param(  # blocked moves, many small chunks
+        "three-joint", "random", 20_000, 4096, marks=pytest.mark.slow
+    ),
     ("three-joint", "random", 9_000, 1 << 20),  # all in the first chunk: the helper's last
     ("thesis-algo", "learner", 3_000, 2048),  # model changes, notes, phases
     ("two-joint-30", "splitter", 3_000, 8192),  # splits, steps with no transition
@@ -89,6 +91,7 @@ step_deg = 5
 pose."""
 
 
+@pytest.mark.slow
 def test_left_to_choose_a_run_keeps_its_helper_while_its_steps_are_light(
     tmp_path: Path,
 ) -> None:
@@ -122,6 +125,7 @@ def test_left_to_choose_a_run_keeps_its_helper_while_its_steps_are_light(
     assert after and all(len(found) == 1 for found in after)  # ended at the choice
 
 
+@pytest.mark.slow
 def test_a_short_run_has_no_helper(tmp_path: Path) -> None:
     recorder = recorded(tmp_path / "short.mcap", "three-joint", "random", chunk_size=1 << 16)
     found: list[list[int]] = []
@@ -150,6 +154,7 @@ def alive(pids: list[int]) -> bool:
     return any(Path(f"/proc/{pid}").exists() for pid in pids)
 
 
+@pytest.mark.slow
 def test_a_helper_killed_mid_run_is_one_line_and_the_steps_written_stay(tmp_path: Path) -> None:
     path = tmp_path / "run.mcap"
     recorder = recorded(path, "three-joint", "random", chunk_size=4096)
@@ -180,6 +185,7 @@ def test_a_helper_killed_mid_run_is_one_line_and_the_steps_written_stay(tmp_path
     assert steps == list(range(len(steps)))
 
 
+@pytest.mark.slow
 def test_a_helper_that_dies_before_it_is_used_leaves_the_run_to_go_on_alone(
     tmp_path: Path,
 ) -> None:
@@ -246,6 +252,7 @@ def test_closing_a_helper_ends_it_at_once() -> None:
     assert helper._process.returncode == 1 and not alive([pid])
 
 
+@pytest.mark.slow
 def test_no_helper_can_start_and_the_recorder_does_the_work(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
@@ -257,6 +264,7 @@ def test_no_helper_can_start_and_the_recorder_does_the_work(
     assert helped.read_bytes() == alone.read_bytes()
 
 
+@pytest.mark.slow
 def test_the_helper_runs_this_process_code_wherever_it_was_imported_from(
     tmp_path: Path,
 ) -> None:

@@ -42,7 +42,9 @@ def test_the_docstring_example_runs() -> None:
     assert tried > 0 and failures == 0
 
 
-@pytest.mark.parametrize("scenario", ["one-joint-10", "two-joint-30"])
+@pytest.mark.parametrize(
+    "scenario", ["one-joint-10", pytest.param("two-joint-30", marks=pytest.mark.slow)]
+)
 def test_the_episode_terminates_where_the_learner_stops_its_run(scenario: str) -> None:
     env = StrategyPolicy(
         gymnasium.make(ENV_ID, scenario=scenario, max_episode_steps=20_000), LearnerStrategy()

@@ -59,7 +59,9 @@ def one_joint(step: int, initial: int, target: int, actions: list[int]) -> Scena
 # ------------------------------------------------------------------ targets
 
 
-@pytest.mark.parametrize("name", ["thesis-roulette", "one-joint-10", "thesis-algo"])
+@pytest.mark.parametrize(
+    "name", ["thesis-roulette", "one-joint-10", pytest.param("thesis-algo", marks=pytest.mark.slow)]
+)
 def test_learns_the_one_joint_cycles_within_four_n_squared_steps(name: str) -> None:
     scenario = load_scenario(name)
     truth = compute_truth(scenario)
@@ -76,6 +78,7 @@ def test_learns_two_joint_30_within_50000_steps() -> None:
     assert_minimal_and_equivalent(learner, runner.model, truth)
 
 
+@pytest.mark.slow
 def test_learns_a_three_joint_arm_with_blocked_moves() -> None:
     scenario = parse_scenario(
         'name = "three-joint-60"\n[arm]\nlengths = [2.0, 1.0, 0.5]\ninitial_deg = [0, 0, 0]\n'
@@ -280,6 +283,7 @@ def float_twin(scenario: Scenario) -> Scenario:
     return twin
 
 
+@pytest.mark.slow
 def test_with_float_feedback_the_learner_climbs_to_the_sensed_pose() -> None:
     # thesis-algo starts at 95 degrees, sensed at 100, one joint turning by 1 degree either
     # way: climbing the closeness reaches 100 in 5 steps, or 7 if it first tries the wrong
@@ -298,6 +302,7 @@ def test_with_float_feedback_the_learner_climbs_to_the_sensed_pose() -> None:
     assert sum(b.index(True) if True in b else 200 for b in blind) > sum(firsts.values())
 
 
+@pytest.mark.slow
 def test_with_float_feedback_the_learner_needs_at_most_half_the_steps() -> None:
     # The float twin of a two-joint world: what the agent feels tells poses apart, so a
     # candidate felt otherwise is ruled out at once and a test can end where the agent is
@@ -333,6 +338,7 @@ def test_with_float_feedback_a_local_maximum_wider_than_a_run_is_left(seed: int)
     assert_minimal_and_equivalent(learner, runner.model, truth)
 
 
+@pytest.mark.slow
 def test_every_seed_learns_the_two_joint_world() -> None:
     # Seed 8 once went round for ever in a test whose path to the landmark led through the
     # transition being identified (back to the candidate itself, on that hypothesis).

@@ -105,6 +105,7 @@ def test_a_class_by_its_import_path_records_and_audits(mine: Path, provided: boo
     assert cli("rsstp_cli.replay", "audit", str(out), path=mine).returncode == 0
 
 
+@pytest.mark.slow
 def test_an_entry_point_is_listed_and_runs_by_name(mine: Path) -> None:
     listed = cli("rsstp_cli.sim", "strategies", path=mine)
     assert listed.returncode == 0

@@ -291,8 +291,15 @@ def step_numbers(messages: Sequence[tuple[str, bytes]]) -> list[int]:
     return steps
 
 
-@pytest.mark.parametrize("group", [False, True], ids=["process", "group"])
-@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=["SIGINT", "SIGTERM"])
+@pytest.mark.parametrize(
+    ("sig", "group"),
+    [
+        pytest.param(signal.SIGINT, True, id="SIGINT-group"),  # Ctrl-C at a terminal
+        pytest.param(signal.SIGINT, False, id="SIGINT-process", marks=pytest.mark.slow),
+        pytest.param(signal.SIGTERM, False, id="SIGTERM-process", marks=pytest.mark.slow),
+        pytest.param(signal.SIGTERM, True, id="SIGTERM-group", marks=pytest.mark.slow),
+    ],
+)
 def test_sigint_and_sigterm_finish_the_file(
     tmp_path: Path, sig: signal.Signals, group: bool
 ) -> None:
@@ -351,6 +358,7 @@ def read_sequentially(data: bytes) -> tuple[list[tuple[str, bytes]], list[int], 
     return messages, steps_per_chunk, end, footer
 
 
+@pytest.mark.slow
 def test_sigkill_keeps_every_complete_chunk(tmp_path: Path) -> None:
     out = tmp_path / "killed.mcap"
     proc = start_long_recording(out)
@@ -396,6 +404,7 @@ def test_sigkill_keeps_every_complete_chunk(tmp_path: Path) -> None:
 # -- nothing lost, nothing corrupt ----------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_force_keeps_the_old_recording_until_the_new_one_is_whole(tmp_path: Path) -> None:
     out = tmp_path / "run.mcap"
     assert rsstp_record("thesis-roulette", "--steps", "20", "-o", out).returncode == 0
@@ -441,7 +450,11 @@ def test_a_second_writer_on_the_same_output_is_refused(tmp_path: Path) -> None:
 
 
 @pytest.mark.parametrize(
-    ("steps", "limit"), [("50000", 200_000), ("500000", 8_000_000)], ids=["alone", "helped"]
+    ("steps", "limit"),
+    [
+        pytest.param("50000", 200_000, id="alone"),
+        pytest.param("500000", 8_000_000, id="helped", marks=pytest.mark.slow),
+    ],
 )
 def test_a_file_size_limit_is_one_line_saying_what_is_safe(
     tmp_path: Path, steps: str, limit: int
@@ -475,7 +488,11 @@ def test_a_file_size_limit_is_one_line_saying_what_is_safe(
 
 
 @pytest.mark.parametrize(
-    ("steps", "size"), [("30000", "512k"), ("300000", "8m")], ids=["alone", "helped"]
+    ("steps", "size"),
+    [
+        pytest.param("30000", "512k", id="alone"),
+        pytest.param("300000", "8m", id="helped", marks=pytest.mark.slow),
+    ],
 )
 def test_a_full_disk_is_one_line_saying_what_is_safe(tmp_path: Path, steps: str, size: str) -> None:
     """ENOSPC on a real small tmpfs (mounting needs root: CI runs as root); the run of

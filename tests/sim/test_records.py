@@ -654,6 +654,7 @@ def step_records(draw: st.DrawFn) -> records.StepRecord:
     return records.StepRecord(step=step, agent=agent, truth=truth)
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None)
 @given(step_records())
 def test_random_step_records_round_trip(record: records.StepRecord) -> None:

@@ -168,7 +168,9 @@ def test_a_phase_is_one_word() -> None:
         runner.agent.enter("two words")
 
 
-@pytest.mark.parametrize("name", ["one-joint-10", "thesis-algo"])
+@pytest.mark.parametrize(
+    "name", ["one-joint-10", pytest.param("thesis-algo", marks=pytest.mark.slow)]
+)
 def test_the_learners_phases_are_events_and_their_shares_are_its_step_counts(
     tmp_path: Path, name: str
 ) -> None:

@@ -65,6 +65,7 @@ def test_overlapping_helpers_put_it_back_when_the_last_is_done(interval: float) 
     assert sys.getswitchinterval() == pytest.approx(interval)
 
 
+@pytest.mark.slow
 def test_a_recording_and_a_reading_hold_it_short_while_their_thread_works(
     tmp_path: Path, interval: float
 ) -> None:

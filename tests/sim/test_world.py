@@ -177,6 +177,7 @@ def check_walk(data: st.DataObject, collision: str) -> None:
         assert np.array_equal(alone.joint_positions, world.joint_positions)
 
 
+@pytest.mark.slow
 @settings(max_examples=150, deadline=None)
 @given(st.data())
 def test_swept_moves_against_shapely(data: st.DataObject) -> None:
@@ -193,6 +194,7 @@ step_deg = 90
 """Joint 2 turning +90 sweeps link 2's middle across the base, the end of link 0."""
 
 
+@pytest.mark.slow
 @settings(max_examples=100, deadline=None)
 @given(small_scenarios(collision="swept", links=3, obstacles=0))
 @example(parse_scenario(FIXED_END_ON_MOVING_LINK))
@@ -273,6 +275,7 @@ def test_large_step_cannot_jump_over_a_thin_obstacle_unless_endpoint() -> None:
 # -- the cache ----------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @settings(max_examples=50, deadline=None)
 @given(st.data())
 def test_cached_answers_equal_a_fresh_computation(data: st.DataObject) -> None:
@@ -330,6 +333,7 @@ def test_seven_links_keep_exact_poses(scenario_text) -> None:
     assert world.angles_deg == tuple(angles)
 
 
+@pytest.mark.slow
 def test_a_small_pose_space_grows_in_doubling_blocks() -> None:
     world = World(load_scenario("three-joint"))
     assert world.cache_info() == (1, 0)  # the start pose, no moves computed yet

@@ -117,6 +117,7 @@ def test_a_world_too_costly_to_tabulate_grows_only_where_the_arm_goes() -> None:
     assert "obstacle" in kinds  # the arc is met: the moves were tested, not only bounded
 
 
+@pytest.mark.slow
 def test_a_costly_world_runs_and_records_from_the_command_line(tmp_path: Path) -> None:
     from rsstp_cli.sim import main
     from rsstp_replay import open_recording

@@ -139,6 +139,7 @@ def test_each_recording_is_the_one_record_writes(
         assert alone.read_bytes() == (out / row.recording).read_bytes(), row.run
 
 
+@pytest.mark.slow
 def test_a_rerun_keeps_whole_runs_and_redoes_broken_ones(
     swept: tuple[Path, subprocess.CompletedProcess[str]], folder: Path, tmp_path: Path
 ) -> None:
@@ -175,6 +176,7 @@ def test_a_rerun_keeps_whole_runs_and_redoes_broken_ones(
     assert truncated.read_bytes() == whole
 
 
+@pytest.mark.slow
 def test_a_run_that_kills_its_worker_is_a_failed_row(folder: Path, tmp_path: Path) -> None:
     sweep = tmp_path / "kills.toml"
     sweep.write_text(
@@ -190,6 +192,7 @@ def test_a_run_that_kills_its_worker_is_a_failed_row(folder: Path, tmp_path: Pat
     assert list(runs["status"]) == ["done", "done", "failed", "failed"]
 
 
+@pytest.mark.slow
 def test_a_sweep_runs_on_a_scheduler_started_apart(folder: Path, tmp_path: Path) -> None:
     """`dask scheduler` and `dask worker` as their own processes, on 127.0.0.1."""
     dask = shutil.which("dask", path=str(Path(sys.executable).parent))
@@ -232,6 +235,7 @@ def test_a_sweep_runs_on_a_scheduler_started_apart(folder: Path, tmp_path: Path)
                 process.wait(timeout=HANG_S)
 
 
+@pytest.mark.slow
 def test_ctrl_c_keeps_every_finished_run(folder: Path, tmp_path: Path) -> None:
     """Ctrl-C reaches the sweep and its workers; the sweep stops them, writes its table and
     keeps each finished recording; nothing half written remains."""
@@ -322,6 +326,7 @@ def test_report_gives_one_row_per_scenario_and_strategy(report_dir: Path) -> Non
     assert "thesis-roulette" in text and "100%" in text and "4 / 4" in text
 
 
+@pytest.mark.slow
 def test_report_gates_and_plots(report_dir: Path, tmp_path: Path) -> None:
     gate = ["--strategy", "learner", "--fail-if"]
     passing = report_cli(str(report_dir), *gate, "learned_fraction < 0.5", "--quiet-not-an-option")
