@@ -1,8 +1,10 @@
-"""The records of a recording: msgspec structs that mirror ``schemas/*.json`` one to one.
+"""The records of a recording: msgspec structs, the one definition of ``schemas/*.json``.
 
 Each message schema (``rsstp.Scenario``, ``rsstp.Step``, ``rsstp.Model``, ``rsstp.Event``)
-has a record class, and each nested object of a schema has one too. Field names, order and
-types are those of the schema: JSON arrays are tuples, points are :class:`PointRecord`
+has a record class, and each nested object of a schema has one too. The schema files are
+written from these classes (:mod:`~rsstp_sim.recording.schema_text`): field names, order and
+types, and in each field's ``Annotated`` metadata its description and bounds. JSON arrays are
+tuples, points are :class:`PointRecord`
 ``{x, y}``, a model's transitions a :class:`TransitionsRecord` of three parallel arrays. A
 field the schema makes optional is ``None`` in Python and left out of the JSON (schema 2.0
 writes no ``null``: see ``schemas/README.md``); an event's ``data`` is a dict of the fields
@@ -33,7 +35,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from typing import Any, ClassVar, Literal, Self, TypeVar
+from typing import Annotated, Any, ClassVar, Literal, Self, TypeVar
 
 import msgspec
 
@@ -95,14 +97,39 @@ class _Record(msgspec.Struct, frozen=True, omit_defaults=True, kw_only=True):
         """Checks beyond the field types (where the schema has them)."""
 
 
+# ------------------------------------------------------------------ schema keywords
+
+
+def _schema(description: str | None = None, **keywords: Any) -> msgspec.Meta:
+    """A field's JSON Schema beyond its type: its ``description`` and the ``keywords`` that
+    bound its value (``minimum``, ``minItems``, ``pattern``...), in the order the schema file
+    has them. :mod:`~rsstp_sim.recording.schema_text` writes ``schemas/*.json`` from these;
+    msgspec keeps the keywords for its own JSON Schema and does not check them when it
+    decodes: value ranges are the schema's business (:func:`.schemas.validate`)."""
+    return msgspec.Meta(description=description, extra_json_schema=keywords or None)
+
+
+_Id = Annotated[int, _schema(minimum=0)]
+"""An array's id, index or count (state ids, action ids, link indices): integer >= 0."""
+_Angle = Annotated[int, _schema(minimum=0, maximum=359)]
+"""An array's angle: integer degrees in ``[0, 360)``."""
+_ACTION_ID = (
+    "action id (integer, 0..2n-1): joint a // 2 turns by +step_deg (counter-clockwise) for even "
+    "a, by -step_deg for odd a"
+)
+
+
 # ---------------------------------------------------------------- shared shapes
 
 
 class PointRecord(_Record, frozen=True, kw_only=True):
     """A point ``{x, y}`` in the world frame (length units)."""
 
-    x: float
-    y: float
+    x: Annotated[float, _schema("x (length units, world frame)")]
+    y: Annotated[float, _schema("y (length units, world frame)")]
+
+
+_Point = Annotated[PointRecord, _schema("a point {x, y} (length units, world frame)")]
 
 
 # ---------------------------------------------------------------- rsstp.Scenario
@@ -111,8 +138,10 @@ class PointRecord(_Record, frozen=True, kw_only=True):
 class ObstacleRecord(_Record, frozen=True, kw_only=True):
     """A circular obstacle: ``center`` ``{x, y}`` and ``radius``, in length units."""
 
-    center: PointRecord
-    radius: float
+    center: Annotated[
+        PointRecord, _schema("centre {x, y} (length units, world frame, arm base at the origin)")
+    ]
+    radius: Annotated[float, _schema("radius (length units)", exclusiveMinimum=0)]
 
 
 class FeedbackRecord(_Record, frozen=True, kw_only=True):
@@ -123,19 +152,54 @@ class FeedbackRecord(_Record, frozen=True, kw_only=True):
     given.
     """
 
-    mode: FeedbackMode
-    tolerance: float
-    tolerance_abs: float
-    points: tuple[PointRecord, ...]
-    target_deg: tuple[int, ...] | None = None
+    mode: Annotated[
+        FeedbackMode,
+        _schema(
+            'the observation the scenario intends: "bool" (the sensation) or "float" (the '
+            "feedback value); every step records both"
+        ),
+    ]
+    tolerance: Annotated[
+        float,
+        _schema("tolerance relative to the total arm length (dimensionless ratio)", minimum=0),
+    ]
+    tolerance_abs: Annotated[
+        float,
+        _schema(
+            "tolerance * total arm length: how far each tip may be from its feedback point "
+            "(length units)",
+            minimum=0,
+        ),
+    ]
+    points: Annotated[
+        tuple[_Point, ...],
+        _schema(
+            "feedback point of each link's tip, one {x, y} per joint, base first (length units, "
+            "world frame)",
+            minItems=1,
+        ),
+    ]
+    target_deg: (
+        Annotated[
+            tuple[_Angle, ...],
+            _schema(
+                "the pose whose tips define the points (integer degrees in [0, 360), one per "
+                "joint); absent when the scenario gives the points directly"
+            ),
+        ]
+        | None
+    ) = None
 
 
 class ParamRecord(_Record, frozen=True, kw_only=True):
     """One strategy parameter: its ``name`` and its value as JSON text (``"0.1"``,
     ``"[0, 1]"``), so every parameter has the same type whatever its value."""
 
-    name: str
-    value: str
+    name: Annotated[str, _schema("parameter name")]
+    value: Annotated[
+        str,
+        _schema('its value as JSON text ("0.1", "[0, 1]", "\\"north\\""; units per strategy)'),
+    ]
 
 
 class StrategyRecord(_Record, frozen=True, kw_only=True):
@@ -143,11 +207,29 @@ class StrategyRecord(_Record, frozen=True, kw_only=True):
     and the distribution that provides it with that distribution's version (absent for a
     module that no installed distribution provides), and its parameters in name order."""
 
-    name: str
-    import_path: str
-    distribution: str | None = None
-    version: str | None = None
-    params: tuple[ParamRecord, ...]
+    name: Annotated[
+        str,
+        _schema(
+            "the name the run was given the strategy by (built-in, entry point or "
+            "package.module:Class)"
+        ),
+    ]
+    import_path: Annotated[str, _schema("where its class lives: package.module:Class")]
+    distribution: (
+        Annotated[
+            str,
+            _schema(
+                "the installed distribution that provides the class's top-level package (rsstp "
+                "for the built-in strategies); absent for a module no distribution provides"
+            ),
+        ]
+        | None
+    ) = None
+    version: Annotated[str, _schema("that distribution's version; absent with it")] | None = None
+    params: Annotated[
+        tuple[Annotated[ParamRecord, _schema("one parameter")], ...],
+        _schema("the strategy's parameters, in name order"),
+    ]
 
     def param_values(self) -> dict[str, Any]:
         """The parameters as the strategy took them: name -> JSON value."""
@@ -158,21 +240,70 @@ class ScenarioRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Scenario`` on ``/rsstp/scenario``: the run's world, seed and strategy."""
 
     schema_name: ClassVar[str] = "rsstp.Scenario"
+    schema_description: ClassVar[str] = (
+        "The scenario of the run: the arm, its obstacles, its feedback points, the seed and the "
+        "strategy. Topic /rsstp/scenario, one message, first in the file, log_time 0."
+    )
 
-    name: str
-    description: str
-    origin: str
-    sha256: str
-    n_joints: int
-    lengths: tuple[float, ...]
-    initial_deg: tuple[int, ...]
-    step_deg: int
-    actions: tuple[int, ...]
-    obstacles: tuple[ObstacleRecord, ...]
-    feedback: FeedbackRecord
-    collision: CollisionMode
-    seed: int
-    strategy: StrategyRecord
+    name: Annotated[str, _schema("scenario name (no unit)")]
+    description: Annotated[str, _schema("one-line description of the scenario (no unit)")]
+    origin: Annotated[
+        str,
+        _schema(
+            "where the scenario came from: a built-in scenario's name, or the scenario file's "
+            "base name (never a directory: recordings are byte-identical across machines)"
+        ),
+    ]
+    sha256: Annotated[
+        str,
+        _schema(
+            "SHA-256 of the scenario file's text (UTF-8), 64 lowercase hex digits",
+            pattern="^[0-9a-f]{64}$",
+        ),
+    ]
+    n_joints: Annotated[int, _schema("number of joints n, one link per joint (count)", minimum=1)]
+    lengths: Annotated[
+        tuple[Annotated[float, _schema(exclusiveMinimum=0)], ...],
+        _schema("length of each link, base first (length units)", minItems=1),
+    ]
+    initial_deg: Annotated[
+        tuple[_Angle, ...],
+        _schema(
+            "start pose: relative angle of each joint, base first (integer degrees in [0, 360))",
+            minItems=1,
+        ),
+    ]
+    step_deg: Annotated[
+        int,
+        _schema("how far one action turns its joint (integer degrees)", minimum=1, maximum=359),
+    ]
+    actions: Annotated[
+        tuple[_Id, ...],
+        _schema(f"the actions the agent may take, sorted ({_ACTION_ID})", minItems=1),
+    ]
+    obstacles: Annotated[
+        tuple[Annotated[ObstacleRecord, _schema("one circular obstacle")], ...],
+        _schema(
+            "circular obstacles (closed disks: touching one counts as meeting it), in scenario "
+            "order; obstacle j is truth.distances[k].obstacles[j] of a step"
+        ),
+    ]
+    feedback: Annotated[
+        FeedbackRecord,
+        _schema(
+            "where the tips must be for the sensation to be true, and how the feedback value is "
+            "computed"
+        ),
+    ]
+    collision: Annotated[
+        CollisionMode,
+        _schema(
+            'collision model: "swept" (the whole swept motion must be free) or "endpoint" (only '
+            "the end pose is checked, as in the thesis)"
+        ),
+    ]
+    seed: Annotated[int, _schema("seed of the run's random generator (integer >= 0)", minimum=0)]
+    strategy: Annotated[StrategyRecord, _schema("the learning strategy of the run")]
 
 
 # -------------------------------------------------------------------- rsstp.Step
@@ -182,49 +313,141 @@ class AgentRecord(_Record, frozen=True, kw_only=True):
     """What the agent knows after a step (``action`` and ``state_before`` None, absent from
     the JSON, at step 0)."""
 
-    action: int | None = None
-    state_before: int | None = None
-    internal_state: int
-    sensation: bool
-    feedback: float
-    model_version: int
-    no_transition: bool
+    action: (
+        Annotated[
+            int,
+            _schema(f"the action taken at this step, absent at step 0 ({_ACTION_ID})", minimum=0),
+        ]
+        | None
+    ) = None
+    state_before: (
+        Annotated[
+            int,
+            _schema("internal state before the step (state id), absent at step 0", minimum=0),
+        ]
+        | None
+    ) = None
+    internal_state: Annotated[int, _schema("internal state after the step (state id)", minimum=0)]
+    sensation: Annotated[
+        bool,
+        _schema(
+            "the sensation after the step: every tip within tolerance_abs of its feedback point"
+        ),
+    ]
+    feedback: Annotated[
+        float,
+        _schema(
+            "feedback after the step: closeness to the feedback points, the mean over tips k of "
+            "max(0, 1 - |tip_k - point_k| / (|point_k| + L_0 + ... + L_k)) (dimensionless, in "
+            "[0, 1]; 1 exactly on the points), whatever the scenario's feedback mode",
+            minimum=0,
+            maximum=1,
+        ),
+    ]
+    model_version: Annotated[
+        int,
+        _schema(
+            "version of the internal model after the step (operations applied since the start, "
+            "count): the latest /rsstp/model message at or before this step has this version",
+            minimum=0,
+        ),
+    ]
+    no_transition: Annotated[
+        bool,
+        _schema(
+            "the model had no transition from state_before by action, so the internal state stayed"
+        ),
+    ]
 
 
 class BlockedByRecord(_Record, frozen=True, kw_only=True):
     """Why a move was blocked: ``fold`` ``[joint]``, ``obstacle`` ``[link, obstacle]``,
     ``links`` ``[link_i, link_j]``."""
 
-    kind: BlockerKind
-    indices: tuple[int, ...]
+    kind: Annotated[
+        BlockerKind,
+        _schema(
+            '"fold": a joint would fold back onto the previous link; "obstacle": a link would '
+            'meet an obstacle; "links": two links would intersect'
+        ),
+    ]
+    indices: Annotated[
+        tuple[_Id, ...],
+        _schema(
+            "fold: [joint]; obstacle: [link, obstacle]; links: [link_i, link_j] with "
+            "link_i < link_j - 1 (0-based indices)",
+            minItems=1,
+            maxItems=2,
+        ),
+    ]
 
 
 class DistancesRecord(_Record, frozen=True, kw_only=True):
     """The distances from one link tip to each obstacle's surface (length units), in
     scenario order."""
 
-    obstacles: tuple[float, ...]
+    obstacles: Annotated[
+        tuple[float, ...],
+        _schema("one value per obstacle, in scenario order (length units)"),
+    ]
 
 
 class TruthRecord(_Record, frozen=True, kw_only=True):
     """Ground truth after a step: angles (degrees), positions and distances (length units);
     ``blocked_by`` None (absent) when the arm moved."""
 
-    angles_deg: tuple[int, ...]
-    joint_positions: tuple[PointRecord, ...]
-    blocked: bool
-    blocked_by: BlockedByRecord | None = None
-    distances: tuple[DistancesRecord, ...]
+    angles_deg: Annotated[
+        tuple[_Angle, ...],
+        _schema(
+            "relative joint angles, base first (integer degrees in [0, 360))",
+            minItems=1,
+        ),
+    ]
+    joint_positions: Annotated[
+        tuple[_Point, ...],
+        _schema(
+            "n + 1 points {x, y}: the base (origin) then each link's tip (length units, world "
+            "frame)",
+            minItems=2,
+        ),
+    ]
+    blocked: Annotated[
+        bool,
+        _schema("the move was blocked, so the arm did not move (always false at step 0)"),
+    ]
+    blocked_by: (
+        Annotated[BlockedByRecord, _schema("why the move was blocked; absent when it was not")]
+        | None
+    ) = None
+    distances: Annotated[
+        tuple[
+            Annotated[
+                DistancesRecord,
+                _schema("the distances from one link tip to every obstacle's surface"),
+            ],
+            ...,
+        ],
+        _schema(
+            "n entries, one per link tip (base first), each with m values, one per obstacle "
+            "(scenario order): distances[k].obstacles[j] is |tip_k - centre_j| - radius_j "
+            "(length units; 0 = touching)"
+        ),
+    ]
 
 
 class StepRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Step`` on ``/rsstp/step``: one step (0 = the reset), agent view and truth."""
 
     schema_name: ClassVar[str] = "rsstp.Step"
+    schema_description: ClassVar[str] = (
+        "One coupled step. Topic /rsstp/step, one message per step, log_time = step * "
+        "1_000_000 ns. Step 0 is the reset (no action). `agent` is what the agent knows; "
+        "`truth` is the world's ground truth, which the agent never sees."
+    )
 
-    step: int
-    agent: AgentRecord
-    truth: TruthRecord
+    step: Annotated[int, _schema("step index t (steps; 0 = the reset)", minimum=0)]
+    agent: Annotated[AgentRecord, _schema("what the agent knows after this step")]
+    truth: Annotated[TruthRecord, _schema("ground truth after the step (for analysis only)")]
 
 
 # ------------------------------------------------------------------- rsstp.Model
@@ -236,9 +459,9 @@ class TransitionsRecord(_Record, frozen=True, kw_only=True, gc=False):
     ids). Parallel arrays keep a model message as compact as a list of triples, in a shape
     every JSON-Schema viewer can address."""
 
-    source: tuple[int, ...]
-    action: tuple[int, ...]
-    target: tuple[int, ...]
+    source: Annotated[tuple[_Id, ...], _schema("the source state of each transition (state ids)")]
+    action: Annotated[tuple[_Id, ...], _schema("the action of each transition (action ids)")]
+    target: Annotated[tuple[_Id, ...], _schema("the target state of each transition (state ids)")]
 
     def __len__(self) -> int:
         return len(self.source)
@@ -256,14 +479,38 @@ class TransitionsRecord(_Record, frozen=True, kw_only=True, gc=False):
             )
 
 
+_OPERATION_ARGS = _schema(
+    "split: [s]; merge: [s, t]; add and delete: [s, t, a] (state ids, then an action id)",
+    minItems=1,
+    maxItems=3,
+)
+
+
 class OperationRecord(_Record, frozen=True, kw_only=True):
     """One model operation, as :class:`~rsstp_sim.transition_system.Operation` (``result``
     None, absent, for the operations that create nothing)."""
 
-    kind: OperationKind
-    args: tuple[int, ...]
-    result: int | None = None
-    changed: bool
+    kind: Annotated[
+        OperationKind, _schema("split a state, merge two states, add or delete a transition")
+    ]
+    args: Annotated[tuple[_Id, ...], _OPERATION_ARGS]
+    result: (
+        Annotated[
+            int,
+            _schema(
+                "split: the new state's id; merge: the surviving state s; absent for add and "
+                "delete",
+                minimum=0,
+            ),
+        ]
+        | None
+    ) = None
+    changed: Annotated[
+        bool,
+        _schema(
+            "false only for an add of an existing or a delete of a missing transition (a no-op)"
+        ),
+    ]
 
     def to_operation(self) -> Operation:
         """The operation, ready for :meth:`TransitionSystem.apply`."""
@@ -275,17 +522,36 @@ class ModelRecord(_Record, frozen=True, kw_only=True):
     the previous model message."""
 
     schema_name: ClassVar[str] = "rsstp.Model"
+    schema_description: ClassVar[str] = (
+        "The agent's internal model (a transition system) after a change. Topic /rsstp/model, "
+        "once at step 0 and at every step where the model changed, log_time = step * 1_000_000 "
+        "ns. Applying each message's operations to the previous message's model gives this one."
+    )
 
-    version: int
-    step: int
-    states: tuple[int, ...]
-    next_id: int
-    current: int
-    actions: tuple[int, ...]
-    transitions: TransitionsRecord
-    operations: tuple[OperationRecord, ...]
-    deterministic: bool
-    nondeterministic_pairs: int
+    version: Annotated[
+        int, _schema("model version: operations applied since the start (count)", minimum=0)
+    ]
+    step: Annotated[int, _schema("step at which the model has this version (steps)", minimum=0)]
+    states: Annotated[tuple[_Id, ...], _schema("state ids, sorted (never reused)", minItems=1)]
+    next_id: Annotated[int, _schema("the id the next split will create (state id)", minimum=1)]
+    current: Annotated[int, _schema("the current internal state (state id)", minimum=0)]
+    actions: Annotated[tuple[_Id, ...], _schema("the action alphabet, sorted (action ids)")]
+    transitions: Annotated[
+        TransitionsRecord,
+        _schema(
+            "every transition as three parallel arrays, sorted by source, action, target: "
+            "transition i is source[i] -action[i]-> target[i]"
+        ),
+    ]
+    operations: Annotated[
+        tuple[Annotated[OperationRecord, _schema("one operation on the model")], ...],
+        _schema("the operations applied since the previous model message, in order"),
+    ]
+    deterministic: Annotated[bool, _schema("every (state, action) pair has at most one successor")]
+    nondeterministic_pairs: Annotated[
+        int,
+        _schema("number of (state, action) pairs with more than one successor (count)", minimum=0),
+    ]
 
     def triples(self) -> tuple[tuple[int, int, int], ...]:
         """The transitions as ``(source, action, target)`` triples, sorted as written."""
@@ -304,6 +570,139 @@ class ModelRecord(_Record, frozen=True, kw_only=True):
 
 # ------------------------------------------------------------------- rsstp.Event
 
+# An event's ``data`` by kind: one struct a kind (the fields it requires, and those it may
+# have), which reads ``data`` when an event is read and gives the schema's ``allOf`` branch
+# for that kind; and :class:`_EventData`, every field any kind has, all optional, which gives
+# the schema's ``data`` object.
+
+_EVENT_BLOCKED_BY = msgspec.Meta(
+    description="why, as truth.blocked_by of rsstp.Step",
+    extra={
+        "descriptions": {
+            "kind": "fold, obstacle or links",
+            "indices": "as in rsstp.Step truth.blocked_by (0-based indices)",
+        }
+    },
+)
+_EVENT_ARGS = _schema(
+    "as in rsstp.Model operations (state ids, then an action id)", minItems=1, maxItems=3
+)
+_EVENT_RESULT = _schema(
+    "as in rsstp.Model operations (state id; absent for add and delete)", minimum=0
+)
+_EARLIER = _schema("the earlier step in that state (steps)", minimum=0)
+_LATER = _schema("the later step in that state, j > i (steps)", minimum=0)
+_AFTER = _schema(
+    "the k >= 1 actions after both steps; the sensations agree until the last and differ after "
+    "it (action ids)",
+    minItems=1,
+)
+_ONE_LINE = "^[^\\n]*$"
+
+
+class _BlockedData(msgspec.Struct):
+    action: Annotated[int, _schema("the blocked action (action id)", minimum=0)]
+    blocked_by: Annotated[BlockedByRecord, _EVENT_BLOCKED_BY]
+
+
+class _NoTransitionData(msgspec.Struct):
+    state: Annotated[int, _schema("the internal state that stayed (state id)", minimum=0)]
+    action: Annotated[int, _schema("the action with no transition from it (action id)", minimum=0)]
+
+
+class _NoteData(msgspec.Struct):
+    phase: str | None = None
+    stop: str | None = None
+    budget: int | None = None
+
+
+class _OperationData(msgspec.Struct):
+    args: Annotated[tuple[_Id, ...], _EVENT_ARGS]
+    result: Annotated[int, _EVENT_RESULT] | None = None
+
+
+class _ContradictionData(msgspec.Struct):
+    state: Annotated[int, _schema("the contradicted internal state (state id)", minimum=0)]
+    i: Annotated[int, _EARLIER]
+    j: Annotated[int, _LATER]
+    actions: Annotated[tuple[_Id, ...], _AFTER]
+
+
+class _EventData(msgspec.Struct, kw_only=True):
+    action: (
+        Annotated[
+            int,
+            _schema(
+                "blocked: the blocked action; no_transition: the action with no transition from "
+                "the state (action id)",
+                minimum=0,
+            ),
+        ]
+        | None
+    ) = None
+    blocked_by: Annotated[BlockedByRecord, _EVENT_BLOCKED_BY] | None = None
+    state: (
+        Annotated[
+            int,
+            _schema(
+                "no_transition: the internal state that stayed; contradiction: the contradicted "
+                "internal state (state id)",
+                minimum=0,
+            ),
+        ]
+        | None
+    ) = None
+    args: Annotated[tuple[_Id, ...], _EVENT_ARGS] | None = None
+    result: Annotated[int, _EVENT_RESULT] | None = None
+    i: Annotated[int, _EARLIER] | None = None
+    j: Annotated[int, _LATER] | None = None
+    actions: Annotated[tuple[_Id, ...], _AFTER] | None = None
+    phase: (
+        Annotated[
+            str,
+            _schema(
+                "note: the phase the strategy entered at this step, for the steps from this one "
+                "until the next phase note (one word, e.g. explore, identify, home, done); 2.1",
+                pattern="^\\w+$",
+            ),
+        ]
+        | None
+    ) = None
+    stop: (
+        Annotated[
+            str,
+            _schema(
+                "note: why the strategy ended the run at this step (one line); the step is the "
+                "recording's last; 2.1",
+                pattern=_ONE_LINE,
+            ),
+        ]
+        | None
+    ) = None
+    budget: (
+        Annotated[
+            int,
+            _schema(
+                "note with stop: the steps the run was given (its --steps), of which it used "
+                "this event's step (steps); 2.1",
+                minimum=0,
+            ),
+        ]
+        | None
+    ) = None
+
+
+_EVENT_DATA: dict[str, type[Any]] = {
+    "blocked": _BlockedData,
+    "no_transition": _NoTransitionData,
+    "split": _OperationData,
+    "merge": _OperationData,
+    "add": _OperationData,
+    "delete": _OperationData,
+    "note": _NoteData,
+    "contradiction": _ContradictionData,
+}
+
 
 class EventRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Event`` on ``/rsstp/event``: one line of log (``text``), ``data`` by ``kind``:
@@ -318,11 +717,29 @@ class EventRecord(_Record, frozen=True, kw_only=True):
     """
 
     schema_name: ClassVar[str] = "rsstp.Event"
+    schema_description: ClassVar[str] = (
+        "Something worth a line in the log. Topic /rsstp/event, log_time = step * 1_000_000 ns."
+    )
 
-    step: int
-    kind: EventKind
-    text: str
-    data: dict[str, Any]
+    step: Annotated[int, _schema("step at which it happened (steps)", minimum=0)]
+    kind: Annotated[EventKind, _schema("what happened")]
+    text: Annotated[str, _schema("one human-readable line (no newline)", pattern=_ONE_LINE)]
+    data: Annotated[
+        dict[str, Any],
+        msgspec.Meta(
+            description=(
+                "details, by kind (every field is optional here; the kind says which are "
+                "present, see allOf): blocked: {action, blocked_by}; no_transition: {state, "
+                "action}; split, merge, add, delete: {args, result (split and merge only)} as "
+                "in rsstp.Model operations; note: {}, or {phase} (the strategy entered that "
+                "phase at this step; 2.1), or {stop, budget} (the strategy ended the run at this "
+                "step, the last event of the file; 2.1); contradiction: {state, i, j, actions} "
+                "(the internal state, two steps i < j in it, and the actions after both after "
+                "which the sensations differ)"
+            ),
+            extra={"fields": _EventData, "by_kind": _EVENT_DATA},
+        ),
+    ]
 
     def _check(self) -> None:
         try:
@@ -447,43 +864,3 @@ def _convert(data: object, cls: type[_R], label: str) -> _R:
     except msgspec.ValidationError as exc:
         raise RecordFormatError(f"{label}: {_format_error(exc)}") from None
     return record
-
-
-class _BlockedData(msgspec.Struct):
-    action: int
-    blocked_by: BlockedByRecord
-
-
-class _NoTransitionData(msgspec.Struct):
-    state: int
-    action: int
-
-
-class _NoteData(msgspec.Struct):
-    phase: str | None = None
-    stop: str | None = None
-    budget: int | None = None
-
-
-class _OperationData(msgspec.Struct):
-    args: tuple[int, ...]
-    result: int | None = None
-
-
-class _ContradictionData(msgspec.Struct):
-    state: int
-    i: int
-    j: int
-    actions: tuple[int, ...]
-
-
-_EVENT_DATA: dict[str, type[Any]] = {
-    "blocked": _BlockedData,
-    "no_transition": _NoTransitionData,
-    "split": _OperationData,
-    "merge": _OperationData,
-    "add": _OperationData,
-    "delete": _OperationData,
-    "note": _NoteData,
-    "contradiction": _ContradictionData,
-}
