@@ -4,15 +4,19 @@ Each run here is played live, without a recorder; every step's message from
 :class:`StepMessages` is compared with ``records.encode`` of the builders' record for the
 same step, and every blocked move's event likewise. The runs cover obstacles and none,
 blocked moves, steps with no transition, float feedback, a model that changes, and arms of
-one to seven links.
+one to seven links. Random steps (hypothesis) are compared with records built field by field,
+not by the builders: msgspec's encoding of the equivalent record, whatever the numbers.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Iterator
+from types import SimpleNamespace
 from typing import ClassVar
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 from steps import step_record_after
 
 from rsstp_sim import (
@@ -23,6 +27,7 @@ from rsstp_sim import (
     StrategyBase,
     load_scenario,
 )
+from rsstp_sim.geometry import BLOCKER_ARITY, BLOCKER_KINDS, Blocker
 from rsstp_sim.recording import builders, records
 from rsstp_sim.recording.chunks import Message
 from rsstp_sim.recording.step_messages import BlockMessages, StepMessages, Steps
@@ -231,3 +236,179 @@ def test_past_its_bound_the_pose_cache_keeps_nothing_more_and_the_bytes_stay() -
         for t in item.new_tails
     ]
     assert 3000 <= sum(sizes) < 3000 + max(sizes)  # kept while below the bound, then no more
+
+
+# ------------------------------------------------- random steps against the records
+
+
+class FakePose:
+    """A world pose as :class:`StepMessages` reads it (compared by identity): its observation
+    and its ground truth as flat lists (positions ``x0, y0, x1, ...``; distances tip by tip)."""
+
+    def __init__(
+        self,
+        angles: list[int],
+        positions: list[float],
+        distances: list[float],
+        *,
+        feedback: float,
+        sensation: bool,
+    ) -> None:
+        self.angles, self.positions, self.distances = angles, positions, distances
+        self.feedback, self.sensation = feedback, sensation
+
+    def truth_values(self) -> tuple[list[int], list[float], list[float]]:
+        return self.angles, self.positions, self.distances
+
+    def truth_record(self, blocker: Blocker | None) -> records.TruthRecord:
+        """The record of this pose's truth, built field by field (not by the builders)."""
+        xy, n = self.positions, len(self.angles)
+        m = len(self.distances) // n
+        return records.TruthRecord(
+            angles_deg=tuple(self.angles),
+            joint_positions=tuple(
+                records.PointRecord(x=xy[2 * k], y=xy[2 * k + 1]) for k in range(n + 1)
+            ),
+            blocked=blocker is not None,
+            blocked_by=None
+            if blocker is None
+            else records.BlockedByRecord(kind=blocker.kind, indices=blocker.indices),
+            distances=tuple(
+                records.DistancesRecord(obstacles=tuple(self.distances[k * m : (k + 1) * m]))
+                for k in range(n)
+            ),
+        )
+
+
+finite = st.floats(allow_nan=False, allow_infinity=False)
+state_ids = st.integers(min_value=0, max_value=2**40)
+
+
+@st.composite
+def poses(draw: st.DrawFn, n: int, m: int) -> FakePose:
+    return FakePose(
+        draw(st.lists(st.integers(0, 359), min_size=n, max_size=n)),
+        draw(st.lists(finite, min_size=2 * (n + 1), max_size=2 * (n + 1))),
+        draw(st.lists(finite, min_size=n * m, max_size=n * m)),
+        feedback=draw(st.floats(min_value=0.0, max_value=1.0)),
+        sensation=draw(st.booleans()),
+    )
+
+
+@st.composite
+def blockers(draw: st.DrawFn) -> Blocker:
+    kind = draw(st.sampled_from(BLOCKER_KINDS))
+    indices = draw(st.lists(st.integers(0, 50), min_size=1, max_size=1))
+    if BLOCKER_ARITY[kind] == 2:
+        indices.append(draw(st.integers(0, 50)))
+    return Blocker(kind, tuple(indices))
+
+
+@st.composite
+def runs(draw: st.DrawFn) -> tuple[list[FakePose], list[tuple[StepOutcome, int, int]]]:
+    """A few poses of an arm of ``n`` links among ``m`` obstacles, and steps among them from
+    a random first step: each an outcome, its pose's number and the model's version after
+    it (which grows now and then)."""
+    n, m = draw(st.integers(1, 5)), draw(st.integers(0, 4))
+    pose_list = draw(st.lists(poses(n, m), min_size=1, max_size=4))
+    t = draw(st.integers(1, 10**9))
+    version = draw(st.integers(0, 2**40))
+    steps = []
+    for _ in range(draw(st.integers(1, 25))):
+        version += draw(st.sampled_from([0, 0, 0, 1]))
+        outcome = StepOutcome(
+            t,
+            draw(st.integers(0, 2 * n - 1)),
+            draw(state_ids),
+            draw(state_ids),
+            draw(st.none() | blockers()),
+            draw(st.booleans()),
+            0,
+        )
+        steps.append((outcome, draw(st.integers(0, len(pose_list) - 1)), version))
+        t += 1
+    return pose_list, steps
+
+
+@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    run=runs(),
+    cache_bytes=st.sampled_from([0, 600, 1 << 20]),
+    block_steps=st.integers(1, 8),
+    max_bytes=st.sampled_from([100, 1 << 20]),
+    waiting=st.sampled_from([(), ("a model message",)]),
+    reset=st.tuples(state_ids, state_ids),
+)
+def test_random_steps_are_the_encoding_of_their_records(
+    run: tuple[list[FakePose], list[tuple[StepOutcome, int, int]]],
+    cache_bytes: int,
+    block_steps: int,
+    max_bytes: int,
+    waiting: tuple[str, ...],
+    reset: tuple[int, int],
+) -> None:
+    """The templates' bytes of random steps (random floats, ids, blockers, versions; a pose
+    cache from none to roomy; blocks of any size) are msgspec's encoding of the records of
+    the same steps, built field by field; and each blocked step's event is its record's."""
+    pose_list, steps = run
+    messages = StepMessages(cache_bytes=cache_bytes)
+    first = pose_list[steps[0][1]]
+    internal_state, model_version = reset
+    head, tail = messages.first(first, internal_state=internal_state, model_version=model_version)
+    agent = records.AgentRecord(
+        internal_state=internal_state,
+        sensation=first.sensation,
+        feedback=first.feedback,
+        model_version=model_version,
+        no_transition=False,
+    )
+    step_0 = records.StepRecord(step=0, agent=agent, truth=first.truth_record(None))
+    assert head + tail == records.encode(step_0)
+
+    world, model = SimpleNamespace(current=first), SimpleNamespace(version=-1)
+
+    def outcomes() -> Iterator[StepOutcome]:
+        for outcome, pose, version in steps:
+            world.current, model.version = pose_list[pose], version
+            yield outcome
+
+    def then(outcome: StepOutcome) -> Iterator[Message]:
+        if outcome.blocker is not None:  # (as the recorder: the event of a step given whole)
+            event = messages.blocked_event(outcome.step, outcome.action, outcome.blocker)
+            yield EVENT, outcome.step * 1_000_000, event, b""
+
+    blocks = messages.blocks(
+        outcomes(),
+        world,  # type: ignore[arg-type]
+        model,  # type: ignore[arg-type]
+        channel=STEP,
+        waiting=waiting,
+        then=then,
+        steps=block_steps,
+        max_bytes=max_bytes,
+    )
+    got = [(ch, at, data + tail) for ch, at, data, tail in BlockMessages(STEP, EVENT).of(blocks)]
+    want = []
+    for outcome, pose, version in steps:
+        t, action, before, after, blocker, no_transition, _ = outcome
+        agent = records.AgentRecord(
+            action=action,
+            state_before=before,
+            internal_state=after,
+            sensation=pose_list[pose].sensation,
+            feedback=pose_list[pose].feedback,
+            model_version=version,
+            no_transition=no_transition,
+        )
+        record = records.StepRecord(
+            step=t, agent=agent, truth=pose_list[pose].truth_record(blocker)
+        )
+        want.append((STEP, t * 1_000_000, records.encode(record)))
+        if blocker is not None:
+            by = {"kind": blocker.kind, "indices": list(blocker.indices)}
+            text = f"action {action} blocked: {blocker.describe()}"
+            event = records.EventRecord(
+                step=t, kind="blocked", text=text, data={"action": action, "blocked_by": by}
+            )
+            want.append((EVENT, t * 1_000_000, records.encode(event)))
+    assert got == want
