@@ -4,7 +4,9 @@ Recording is a layer around the simulation: these records are built from the run
 outcomes and the world's poses, never from inside them. ``schemas/README.md`` is the
 contract's documentation. :mod:`~rsstp_sim.recording.records` holds the record classes and
 their JSON conversion, :mod:`~rsstp_sim.recording.builders` makes them from live objects,
-:mod:`~rsstp_sim.recording.schemas` holds the schema files, topics and version policy.
+:mod:`~rsstp_sim.recording.schemas` holds the schema files, topics and version policy, and
+:mod:`~rsstp_sim.recording.schema_text` writes the schema files from the record classes
+(``python -m rsstp_sim.recording.schema_text``; not imported here).
 """
 
 from __future__ import annotations

@@ -1,9 +1,10 @@
 """The JSON Schemas of a recording, as shipped in the package (``rsstp_sim/schemas/*.json``).
 
 A recording registers each schema's file byte for byte (:func:`schema_bytes`), so the
-files are part of the contract; ``schemas/README.md`` documents every field, the topics,
-the metadata record, the attachment and the version policy: a reader accepts any ``2.x``
-(ignoring fields it does not know) and refuses another major version
+files are part of the contract (they are written from the record classes by
+:mod:`~rsstp_sim.recording.schema_text`); ``schemas/README.md`` documents every field, the
+topics, the metadata record, the attachment and the version policy: a reader accepts any
+``2.x`` (ignoring fields it does not know) and refuses another major version
 (:func:`check_schema_version`).
 
 >>> TOPICS["/rsstp/step"]
