@@ -24,7 +24,7 @@ from contextlib import closing
 from functools import partial
 from pathlib import Path
 from types import TracebackType
-from typing import Any, NamedTuple, TypeVar
+from typing import Any, NamedTuple, TypeVar, get_args
 
 import msgspec
 import numpy as np
@@ -48,7 +48,7 @@ from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
-from rsstp_sim.recording.records import EventRecord, ModelRecord, json_array
+from rsstp_sim.recording.records import EventKind, EventRecord, ModelRecord, json_array
 from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
@@ -59,17 +59,9 @@ __all__ = ["EVENT_KINDS", "Recording", "open_recording"]
 
 _Stepped = TypeVar("_Stepped", EventRecord, ModelRecord, ModelHead)
 
-EVENT_KINDS = (
-    "blocked",
-    "no_transition",
-    "split",
-    "merge",
-    "add",
-    "delete",
-    "note",
-    "contradiction",
-)
-"""The categories of :meth:`Recording.events`' ``kind`` column (``rsstp.Event`` 1.x)."""
+EVENT_KINDS: tuple[EventKind, ...] = get_args(EventKind)
+"""The categories of :meth:`Recording.events`' ``kind`` column: the event kinds of the record
+(:data:`rsstp_sim.recording.records.EventKind`), in its order."""
 
 _CACHED_CHUNKS = 4
 
