@@ -4,11 +4,10 @@ Each message schema (``rsstp.Scenario``, ``rsstp.Step``, ``rsstp.Model``, ``rsst
 has a record class, and each nested object of a schema has one too. The schema files are
 written from these classes (:mod:`~rsstp_sim.recording.schema_text`): field names, order and
 types, and in each field's ``Annotated`` metadata its description and bounds. JSON arrays are
-tuples, points are :class:`PointRecord`
-``{x, y}``, a model's transitions a :class:`TransitionsRecord` of three parallel arrays. A
-field the schema makes optional is ``None`` in Python and left out of the JSON (schema 2.0
-writes no ``null``: see ``schemas/README.md``); an event's ``data`` is a dict of the fields
-its kind has.
+tuples, points are :class:`PointRecord` ``{x, y}``, a model's transitions a
+:class:`TransitionsRecord` of three parallel arrays. A field the schema makes optional is
+``None`` in Python and left out of the JSON (schema 2.0 writes no ``null``: see
+``schemas/README.md``); an event's ``data`` is a dict of the fields its kind has.
 
 - ``record.to_json()`` gives the JSON-ready dict (keys in schema order, arrays as lists);
 - ``Record.from_json(data)`` reads one back, ignoring keys it does not know (a later 2.x may
@@ -105,7 +104,8 @@ def _schema(description: str | None = None, **keywords: Any) -> msgspec.Meta:
     bound its value (``minimum``, ``minItems``, ``pattern``...), in the order the schema file
     has them. :mod:`~rsstp_sim.recording.schema_text` writes ``schemas/*.json`` from these;
     msgspec keeps the keywords for its own JSON Schema and does not check them when it
-    decodes: value ranges are the schema's business (:func:`.schemas.validate`)."""
+    decodes: value ranges are the schema's business
+    (:func:`~rsstp_sim.recording.schemas.validate`)."""
     return msgspec.Meta(description=description, extra_json_schema=keywords or None)
 
 
