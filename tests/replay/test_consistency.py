@@ -120,6 +120,7 @@ def test_random_memories_match_reference(columns: Columns) -> None:
     check_against_reference(columns)
 
 
+@pytest.mark.slow
 @settings(max_examples=400, deadline=None)
 @given(columns=hidden_system_columns())
 def test_hidden_system_memories_match_reference(columns: Columns) -> None:

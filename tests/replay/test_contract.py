@@ -55,6 +55,7 @@ STRATEGIES = ["random", "roulette", "splitter", "learner", "refiner", "relocator
 SCENARIOS = ["thesis-roulette", "one-joint-10", "two-joint-30", "thesis-obstacles"]
 
 
+@pytest.mark.slow
 @settings(
     max_examples=24,
     deadline=None,

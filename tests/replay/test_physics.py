@@ -262,6 +262,7 @@ def test_the_scenario_message_disagreeing_with_its_file(walk: Path, tmp_path: Pa
     assert _findings(bad) == (None, "/rsstp/scenario step_deg")
 
 
+@pytest.mark.slow
 def test_check_and_audit_say_it_in_one_line_and_exit_1(
     walk: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

@@ -38,7 +38,9 @@ RUNS = [
     pytest.param(  # blocked moves, many small chunks
         "three-joint", "random", 20_000, 4096, marks=pytest.mark.slow
     ),
-    ("three-joint", "random", 9_000, 1 << 20),  # all in the first chunk: the helper's last
+    pytest.param(  # all in the first chunk: the helper's last
+        "three-joint", "random", 9_000, 1 << 20, marks=pytest.mark.slow
+    ),
     ("thesis-algo", "learner", 3_000, 2048),  # model changes, notes, phases
     ("two-joint-30", "splitter", 3_000, 8192),  # splits, steps with no transition
     ("thesis-obstacles", "roulette", 5_000, 3000),

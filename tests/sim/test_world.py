@@ -249,6 +249,7 @@ def test_endpoint_moves_against_shapely(data: st.DataObject) -> None:
     check_walk(data, "endpoint")
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None)
 @given(small_scenarios(collision="swept"))
 def test_swept_blocks_at_least_what_endpoint_blocks(scenario: Scenario) -> None:
