@@ -1,4 +1,5 @@
-"""Every example of the README and of ``docs/`` runs as written, in order, in one fresh folder.
+"""Every example of the README and of ``docs/`` runs as written, in order, in one fresh folder
+(``pytest -m slow``, as CI runs it: the examples take about 2 minutes).
 
 The pages are read in the order the README links them (the README first); a page of ``docs/``
 that the README does not link fails. Within a page, each fenced block is taken as a reader
@@ -205,6 +206,7 @@ def _run_workflow(block: Block, folder: Path) -> str:
     return "".join(out)
 
 
+@pytest.mark.slow  # the chain of examples takes about 2 minutes: CI runs it (-m slow)
 @pytest.mark.parametrize("index", range(len(BLOCKS)), ids=[b.name for b in BLOCKS])
 def test_example(index: int, folder: Path, printed: dict[str, str]) -> None:
     block = BLOCKS[index]
