@@ -4,12 +4,13 @@
 what a batch does not need (the joint positions and distances that follow from the angles)
 and are not tracked by the garbage collector, and decoding a chunk's steps with them takes
 about a third of the time :class:`~rsstp_sim.recording.records.StepRecord` takes (2026-11-28,
-the 10,001 steps of recordings/three-joint-random.mcap: 1.1 us a step against 3.0 us). So they are kept, and checked
-here against the records, which the schemas are generated from: the same fields in the same
-order, the same optional fields, the same types, and the schema's bounds (which the decode
-structs check while decoding, where the records leave them to the schema). Two differences
-are theirs: a count or id is bounded to int64 (it goes into an int64 column), and an array's
-length is checked on the columns (exactly ``n`` angles, ``n + 1`` points), not by the struct.
+the 10,001 steps of ``recordings/three-joint-random.mcap``: 1.1 us a step against 3.0 us).
+So they are kept, and checked here against the records, which the schemas are generated
+from: the same fields in the same order, the same optional fields, the same types, and the
+schema's bounds (which the decode structs check while decoding, where the records leave them
+to the schema). Two differences are theirs: a count or id is bounded to int64 (it goes into
+an int64 column), and an array's length is checked on the columns (exactly ``n`` angles,
+``n + 1`` points), not by the struct.
 """
 
 from __future__ import annotations
