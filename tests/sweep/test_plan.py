@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -89,18 +90,19 @@ def test_a_missing_sweep_file_is_named(tmp_path: Path) -> None:
         load_sweep(tmp_path / "nothere.toml")
 
 
-def test_the_readme_sweep_file_is_valid(tmp_path: Path) -> None:
-    """The README's example sweep checks (with a scenario file of its own beside it)."""
-    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
-    blocks = [block.split("```")[0] for block in readme.split("```toml\n")[1:]]
-    text = next(block for block in blocks if "seeds" in block)
-    scenario = Path("src/rsstp_sim/scenarios/two-joint-30.toml").read_text()
-    (tmp_path / "my-arm.toml").write_text(scenario.replace("two-joint-30", "my-arm"))
-    (tmp_path / "sweep.toml").write_text(text)
-    sweep = load_sweep(tmp_path / "sweep.toml")
-    assert len(sweep.runs) == 3 * (1 + 1 + 3) * 3
+def test_the_documented_sweep_file_is_valid(tmp_path: Path) -> None:
+    """docs/sweeps.md's example sweep checks, with docs/scenarios.md's scenario file beside it:
+    every scenario x strategy (a grid's every value) x seed."""
+    docs = Path(__file__).resolve().parents[2] / "docs"
+    for page, name in (("sweeps.md", "grid-sweep.toml"), ("scenarios.md", "my-arm.toml")):
+        block = re.search(
+            f"```toml file={re.escape(name)}\n(.*?)```", (docs / page).read_text(), re.S
+        )
+        assert block is not None
+        (tmp_path / name).write_text(block[1])
+    sweep = load_sweep(tmp_path / "grid-sweep.toml")
+    assert len(sweep.runs) == 3 * (1 + 1 + 2) * 2
     assert {run.params.get("horizon") for run in sweep.runs if run.strategy == "splitter"} == {
         4,
-        8,
         16,
     }
