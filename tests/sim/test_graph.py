@@ -17,6 +17,7 @@ from pygraphviz import graphviz as gv
 from rsstp_sim.errors import GraphvizFailed, ModelError, RsstpError
 from rsstp_sim.graph import layout, render, run_graphviz, to_dot
 from rsstp_sim.transition_system import TransitionSystem
+from waiting import HANG_S
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -269,7 +270,7 @@ def test_everything_is_drawn_with_no_graphviz_program_and_no_noise(tmp_path: Pat
     done = subprocess.run(
         [sys.executable, "-c", _DRAW_EVERYTHING, str(pictures), json.dumps(FIGURE_16),
          str(ROOT / "recordings" / "two-joint-30-learner.mcap")],
-        capture_output=True, text=True, timeout=300,
+        capture_output=True, text=True, timeout=HANG_S,
         env={"PATH": str(fakes), "PYTHONPATH": str(ROOT / "src"), "HOME": str(tmp_path)},
     )  # fmt: skip
     assert done.returncode == 0, done.stderr
@@ -290,6 +291,23 @@ def test_everything_is_drawn_with_no_graphviz_program_and_no_noise(tmp_path: Pat
     assert len(set(re.findall(r"<title>(\d+)</title>", learner))) == 119
 
 
+def _graph_under_a_20_byte_file_limit(out: Path) -> subprocess.CompletedProcess[str]:
+    """``rsstp-sim graph`` of a 2-state matrix onto ``out`` (an old picture there first) in a
+    process that may write files of at most 20 bytes (RLIMIT_FSIZE)."""
+    import resource
+
+    out.write_text("the old picture")
+
+    def tiny_files() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (20, 20))
+
+    return subprocess.run(
+        [sys.executable, "-m", "rsstp_cli.sim", "graph", "--matrix", "[[[0],[1]],[[1],[0]]]",
+         "-o", str(out), "--force"],
+        capture_output=True, text=True, timeout=HANG_S, preexec_fn=tiny_files,
+    )  # fmt: skip
+
+
 @pytest.mark.parametrize("suffix", ["svg", "png"])
 def test_a_file_size_limit_met_handing_the_source_to_graphviz_is_one_line(
     tmp_path: Path, suffix: str
@@ -297,19 +315,8 @@ def test_a_file_size_limit_met_handing_the_source_to_graphviz_is_one_line(
     """pygraphviz hands the DOT source to Graphviz in a temporary file: past RLIMIT_FSIZE it
     cannot be written (EFBIG): one line, exit 1 (the disk failed, not the input), the old
     picture as it was."""
-    import resource
-
     out = tmp_path / f"model.{suffix}"
-    out.write_text("the old picture")
-
-    def tiny_files() -> None:
-        resource.setrlimit(resource.RLIMIT_FSIZE, (20, 20))
-
-    done = subprocess.run(
-        [sys.executable, "-m", "rsstp_cli.sim", "graph", "--matrix", "[[[0],[1]],[[1],[0]]]",
-         "-o", str(out), "--force"],
-        capture_output=True, text=True, timeout=60, preexec_fn=tiny_files,
-    )  # fmt: skip
+    done = _graph_under_a_20_byte_file_limit(out)
     assert done.returncode == 1
     assert done.stderr.strip() == (
         "rsstp-sim: error: cannot hand the DOT source of a model of 2 states and 4 transitions "
@@ -322,21 +329,8 @@ def test_a_file_size_limit_met_handing_the_source_to_graphviz_is_one_line(
 def test_a_picture_that_cannot_be_written_whole_leaves_the_old_one(tmp_path: Path) -> None:
     """EFBIG (RLIMIT_FSIZE in the child) while writing: one line, exit 1, the old file as it
     was and no side file."""
-    import resource
-    import subprocess
-    import sys
-
     out = tmp_path / "model.dot"
-    out.write_text("the old picture")
-
-    def tiny_files() -> None:
-        resource.setrlimit(resource.RLIMIT_FSIZE, (20, 20))
-
-    done = subprocess.run(
-        [sys.executable, "-m", "rsstp_cli.sim", "graph", "--matrix", "[[[0],[1]],[[1],[0]]]",
-         "-o", str(out), "--force"],
-        capture_output=True, text=True, timeout=60, preexec_fn=tiny_files,
-    )  # fmt: skip
+    done = _graph_under_a_20_byte_file_limit(out)
     assert done.returncode == 1
     assert done.stderr.strip() == f"rsstp-sim: error: {out}: cannot write: File too large"
     assert out.read_text() == "the old picture"
