@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 from rsstp_cli._commandline import Parser, run_command
+from waiting import HANG_S
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
@@ -65,7 +66,7 @@ def test_an_unfinished_recording_is_one_warning_line(tmp_path: Path) -> None:
         text=True,
         env={**os.environ, "PYTHONWARNINGS": "default"},
         check=False,
-        timeout=600,
+        timeout=HANG_S,
     )
     assert done.returncode == 0, done.stderr
     lines = done.stderr.splitlines()

@@ -16,6 +16,8 @@ from typing import Any
 import pytest
 from mcap.writer import Writer
 
+from waiting import HANG_S
+
 BUNDLE = Path(__file__).parent / "vendor" / "check_channels.mjs"
 
 NO_NODE = (
@@ -52,7 +54,7 @@ def check_channels(recording: Path) -> dict[str, Any]:
         [require_node(), str(BUNDLE), str(recording)],
         capture_output=True,
         text=True,
-        timeout=300,
+        timeout=HANG_S,
         check=False,
     )
     if done.returncode != 0:

@@ -15,6 +15,8 @@ from pathlib import Path
 
 import pytest
 
+from waiting import HANG_S
+
 ROOT = Path(__file__).resolve().parents[2]
 REFERENCE = ROOT / "recordings" / "thesis-roulette-script.mcap"
 LEARNER = ROOT / "recordings" / "two-joint-30-learner.mcap"
@@ -26,7 +28,7 @@ def run_cli(*args: str) -> subprocess.CompletedProcess[str]:
         capture_output=True,
         text=True,
         env={"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "HOME": "/tmp"},
-        timeout=120,
+        timeout=HANG_S,
     )
 
 
@@ -42,7 +44,7 @@ def test_view_saves_an_rrd_and_says_how_to_open_it(tmp_path: Path) -> None:
     shown = next(line for line in done.stdout.splitlines() if line.startswith("open it with"))
     verified = subprocess.run(
         [*shlex.split(shown.removeprefix("open it with: "))[:1], "rrd", "verify", str(out)],
-        capture_output=True, text=True, timeout=120, env={"PATH": "/usr/bin:/bin"},
+        capture_output=True, text=True, timeout=HANG_S, env={"PATH": "/usr/bin:/bin"},
     )  # fmt: skip
     assert verified.returncode == 0, verified.stderr
     again = run_cli("view", str(REFERENCE), "--save", str(out))
@@ -111,7 +113,7 @@ def test_a_graphviz_failure_is_one_line(
     done = subprocess.run(
         [sys.executable, "-c", _FAILING_GRAPHVIZ, "graph", str(LEARNER), "--step", "8000",
          "-o", str(out), *extra],
-        capture_output=True, text=True, timeout=120,
+        capture_output=True, text=True, timeout=HANG_S,
         env={**os.environ, "PYTHONPATH": str(ROOT / "src")},
     )  # fmt: skip
     assert done.returncode == 2, done.stderr
@@ -198,7 +200,7 @@ def test_ctrl_c_as_the_server_starts_leaves_no_server(tmp_path: Path) -> None:
         time.sleep(0.01)
     server.send_signal(signal.SIGINT)
     try:
-        _, err = server.communicate(timeout=60)
+        _, err = server.communicate(timeout=HANG_S)
     except subprocess.TimeoutExpired:
         server.kill()
         _, err = server.communicate()
@@ -232,13 +234,13 @@ def test_serve_web_listens_on_loopback_and_stops_on_ctrl_c(
         assert b"until Ctrl-C" in said, said  # the server is up
         assert _listening(web) == {"0100007F"}  # 127.0.0.1 only
         assert _listening(grpc) == {"0100007F"}
-        page = urllib.request.urlopen(f"http://127.0.0.1:{web}/", timeout=10).read()
+        page = urllib.request.urlopen(f"http://127.0.0.1:{web}/", timeout=HANG_S).read()
         assert b"<html" in page.lower()
         assert list(tmp_path.glob("rsstp-view-*/view.rrd"))
     finally:
         server.send_signal(stop)
         try:
-            out, err = server.communicate(timeout=60)
+            out, err = server.communicate(timeout=HANG_S)
         except subprocess.TimeoutExpired:  # fail this test alone: leave nothing running
             server.kill()
             out, err = server.communicate()
@@ -268,7 +270,7 @@ def test_a_file_size_limit_never_leaves_a_truncated_rrd(tmp_path: Path) -> None:
     done = subprocess.run(
         [sys.executable, "-m", "rsstp_cli.replay", "view", str(LEARNER), "--save", str(out),
          "--force", "--quiet"],
-        capture_output=True, text=True, timeout=120, preexec_fn=small_files,
+        capture_output=True, text=True, timeout=HANG_S, preexec_fn=small_files,
         env={"PYTHONPATH": str(ROOT / "src"), "PATH": "/usr/bin:/bin", "HOME": "/tmp"},
     )  # fmt: skip
     assert done.returncode == 1

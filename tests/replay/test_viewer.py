@@ -38,6 +38,7 @@ from rsstp_sim import palette
 from rsstp_sim.recording import record
 from rsstp_sim.scenario import load_scenario
 from rsstp_sim.truth import compute_truth
+from waiting import HANG_S
 
 REFERENCE = Path(__file__).parents[2] / "recordings" / "three-joint-random.mcap"
 LEARNER = Path(__file__).parents[2] / "recordings" / "two-joint-30-learner.mcap"
@@ -646,7 +647,7 @@ def test_rerun_verifies_the_files(
             [RERUN, "rrd", "verify", str(rrd.path)],
             capture_output=True,
             text=True,
-            timeout=120,
+            timeout=HANG_S,
             check=False,
         )
         assert done.returncode == 0, done.stderr
