@@ -28,6 +28,7 @@ from pathlib import Path
 import pytest
 
 import rsstp_sim
+from waiting import HANG_S
 
 ROOT = Path(__file__).resolve().parents[1]
 SRC = ROOT / "src"
@@ -80,7 +81,7 @@ def build_wheel(out: Path, scratch: Path) -> Path:
         [sys.executable, "-m", "build", "--wheel", "--outdir", str(out), str(source)],
         capture_output=True,
         text=True,
-        timeout=600,
+        timeout=HANG_S,
     )
     assert done.returncode == 0, f"the wheel does not build:\n{done.stdout}\n{done.stderr}"
     (wheel,) = out.glob("*.whl")
@@ -178,7 +179,7 @@ def test_each_command_is_the_one_it_is_named_after(wheel: Wheel, command: str) -
         f"sys.exit(getattr(importlib.import_module({module!r}), {function!r})())"
     )
     done = subprocess.run(
-        [sys.executable, "-c", script, "--version"], capture_output=True, text=True, timeout=60
+        [sys.executable, "-c", script, "--version"], capture_output=True, text=True, timeout=HANG_S
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == f"{command} {wheel.metadata['Version']}"
@@ -189,7 +190,7 @@ def test_each_command_is_the_one_it_is_named_after(wheel: Wheel, command: str) -
 )
 def test_both_commands_print_the_installed_version(program: str, name: str) -> None:
     done = subprocess.run(
-        [sys.executable, "-m", program, "--version"], capture_output=True, text=True, timeout=60
+        [sys.executable, "-m", program, "--version"], capture_output=True, text=True, timeout=HANG_S
     )
     assert done.returncode == 0
     assert done.stdout.strip() == f"{name} {metadata.version('rsstp')}"
