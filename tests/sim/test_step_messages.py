@@ -308,24 +308,29 @@ def blockers(draw: st.DrawFn) -> Blocker:
 def runs(draw: st.DrawFn) -> tuple[list[FakePose], list[tuple[StepOutcome, int, int]]]:
     """A few poses of an arm of ``n`` links among ``m`` obstacles, and steps among them from
     a random first step: each an outcome, its pose's number and the model's version after
-    it (which grows now and then)."""
+    it (which grows now and then). The world is deterministic, as every world is: the same
+    action from the same pose meets the same blocker (or none) every time."""
     n, m = draw(st.integers(1, 5)), draw(st.integers(0, 4))
     pose_list = draw(st.lists(poses(n, m), min_size=1, max_size=4))
     t = draw(st.integers(1, 10**9))
     version = draw(st.integers(0, 2**40))
+    physics: dict[tuple[int, int], Blocker | None] = {}
     steps = []
     for _ in range(draw(st.integers(1, 25))):
         version += draw(st.sampled_from([0, 0, 0, 1]))
+        action, pose = draw(st.integers(0, 2 * n - 1)), draw(st.integers(0, len(pose_list) - 1))
+        if (pose, action) not in physics:
+            physics[pose, action] = draw(st.none() | blockers())
         outcome = StepOutcome(
             t,
-            draw(st.integers(0, 2 * n - 1)),
+            action,
             draw(state_ids),
             draw(state_ids),
-            draw(st.none() | blockers()),
+            physics[pose, action],
             draw(st.booleans()),
             0,
         )
-        steps.append((outcome, draw(st.integers(0, len(pose_list) - 1)), version))
+        steps.append((outcome, pose, version))
         t += 1
     return pose_list, steps
 
