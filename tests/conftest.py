@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import os
+import signal
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 
@@ -80,6 +81,20 @@ def _isolated_truth_cache(truth_cache_home: Path) -> Iterator[None]:
         del os.environ["XDG_CACHE_HOME"]
     else:
         os.environ["XDG_CACHE_HOME"] = before
+
+
+@pytest.fixture(scope="session", autouse=True)
+def _ctrl_c_at_its_default() -> Iterator[None]:
+    """Every command a test starts gets SIGINT at its default, as from a terminal's
+    foreground, also when the suite itself was started with SIGINT ignored (which a shell
+    does to a job it puts in the background without job control, and a child inherits): the
+    Ctrl-C tests test the commands, not how the suite was started."""
+    before = signal.getsignal(signal.SIGINT)
+    if before is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    if before is signal.SIG_IGN:
+        signal.signal(signal.SIGINT, before)
 
 
 @pytest.fixture
