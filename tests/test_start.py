@@ -161,3 +161,25 @@ def test_a_command_runs_numpy_with_the_advice(tmp_path: Path, theirs: str | None
     ).stdout.strip()
     advised = theirs == "1" or chosen not in ("madvise", "defer+madvise")
     assert found == str(advised)
+
+
+def test_a_ctrl_c_inside_a_held_block_comes_when_the_block_has_ended() -> None:
+    """What the command lines hold Ctrl-C over (the packages' imports, a progress bar's
+    construction) finishes whole; the interrupt comes right after, and the handler before it
+    is back."""
+    import threading
+
+    from rsstp_cli.start import ctrl_c_held
+
+    before = signal.getsignal(signal.SIGINT)
+    finished = []
+    with pytest.raises(KeyboardInterrupt):
+        with ctrl_c_held():
+            os.kill(os.getpid(), signal.SIGINT)
+            threading.Event().wait(0.01)  # the handler runs (between bytecodes) in here
+            finished.append("the rest of the block")
+    assert finished == ["the rest of the block"]
+    assert signal.getsignal(signal.SIGINT) is before
+    with ctrl_c_held():  # no Ctrl-C: nothing raised
+        finished.append("again")
+    assert finished[-1] == "again"

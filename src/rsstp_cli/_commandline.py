@@ -18,6 +18,7 @@ import warnings
 from collections.abc import Callable, Sequence
 from typing import Any, NoReturn
 
+from rsstp_cli.start import ctrl_c_held
 from rsstp_sim.errors import OutputError, RsstpError, UsageError
 
 __all__ = [
@@ -47,9 +48,15 @@ class Progress:
         if shown:
             from tqdm import tqdm
 
-            self._bar = tqdm(
-                total=total, desc=what, unit=unit, unit_scale=True, file=sys.stderr, leave=False
-            )
+            try:
+                with ctrl_c_held():  # a bar interrupted half-built fails in its finaliser
+                    self._bar = tqdm(
+                        total=total, desc=what, unit=unit, unit_scale=True, file=sys.stderr,
+                        leave=False,
+                    )  # fmt: skip
+            except KeyboardInterrupt:  # cleared now, before the command's last line
+                self.__exit__()
+                raise
 
     def to(self, done: int) -> None:
         if self._bar is not None:

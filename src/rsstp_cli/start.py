@@ -12,9 +12,12 @@ import importlib
 import os
 import signal
 import sys
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["rsstp_replay", "rsstp_sim"]
+__all__ = ["ctrl_c_held", "rsstp_replay", "rsstp_sim"]
 
 THP_DEFRAG = Path("/sys/kernel/mm/transparent_hugepage/defrag")
 """The kernel's setting of when a page fault may compact memory for a transparent huge page."""
@@ -49,22 +52,37 @@ def _start(prog: str, module: str) -> int:
     advice = huge_page_advice(_read_defrag(), dict(os.environ))
     if advice is not None and "numpy" not in sys.modules:  # read when numpy is imported
         os.environ["NUMPY_MADVISE_HUGEPAGE"] = advice
-    # While the packages load, Ctrl-C is only noted: a KeyboardInterrupt raised inside an
-    # extension's import comes out as that import's ImportError (numpy's does), a traceback.
-    pressed: list[int] = []
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: pressed.append(signum))
     try:
-        main = importlib.import_module(module).main
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    try:
-        if pressed:
-            raise KeyboardInterrupt
+        # A KeyboardInterrupt raised inside an extension's import comes out as that import's
+        # ImportError (numpy's does), a traceback: while the packages load, Ctrl-C waits.
+        with ctrl_c_held():
+            main = importlib.import_module(module).main
         code: int = main()
     except KeyboardInterrupt:
         print(f"{prog}: interrupted", file=sys.stderr)
         return 130
     return code
+
+
+@contextmanager
+def ctrl_c_held() -> Iterator[None]:
+    """Ctrl-C inside the block is held until the block ends, then raised as
+    :class:`KeyboardInterrupt`: for work that an interrupt would leave half done (an
+    extension's import; a progress bar's construction, whose half-built object fails again
+    in its finaliser). Outside the main thread, or where SIGINT is ignored, nothing changes."""
+    if threading.current_thread() is not threading.main_thread() or (
+        signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+    ):
+        yield
+        return
+    pressed: list[int] = []
+    previous = signal.signal(signal.SIGINT, lambda signum, frame: pressed.append(signum))
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+    if pressed:
+        raise KeyboardInterrupt
 
 
 def rsstp_sim() -> int:
