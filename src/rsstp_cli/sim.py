@@ -25,11 +25,12 @@ from rsstp_cli._commandline import (
     warning_line,
 )
 from rsstp_sim import graph
+from rsstp_sim.bodies import body_of
 from rsstp_sim.coupling import Runner, stop_text
 from rsstp_sim.errors import RecordingWriteError
 from rsstp_sim.files import check_output
 from rsstp_sim.nesting import too_deep
-from rsstp_sim.scenario import MANY_OBSTACLES, Scenario, builtin_scenarios, load_scenario
+from rsstp_sim.scenario import AnyScenario, builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.words import counted
@@ -143,21 +144,9 @@ def _size(n_bytes: int) -> str:
     return f"{n_bytes / 1024**power:,.1f} {('KiB', 'MiB', 'GiB', 'TiB')[power - 1]}"
 
 
-def _warn_about(scenario: Scenario) -> None:
-    """Warnings a scenario earns before it runs: a feedback point no pose can sense, and so
-    many obstacles that steps slow down."""
-    from rsstp_sim.world_table import unsensable
-
-    problem = unsensable(scenario)
-    if problem is not None:
-        text = f"no pose can sense the feedback point, every sensation will be false: {problem}"
-        print(warning_line(PROG, text), file=sys.stderr)
-    n = len(scenario.obstacles)
-    if n > MANY_OBSTACLES:
-        text = (
-            f"{n:,} obstacles: every step measures each joint's distance to each of them, so "
-            f"steps run about {1 + n / 60:.0f} times slower than with a few"
-        )
+def _warn_about(scenario: AnyScenario) -> None:
+    """Warnings a scenario earns before it runs (its body's, :meth:`Body.warnings`)."""
+    for text in body_of(scenario).warnings(scenario):
         print(warning_line(PROG, text), file=sys.stderr)
 
 

@@ -321,6 +321,11 @@ def rebuild_scenario(
         scenario = parse_scenario(text, origin=record.origin)
     except ScenarioError as exc:
         raise CorruptRecording(f"{path}: the {ATTACHMENT_NAME} attachment: {exc}") from None
+    if not isinstance(scenario, Scenario):
+        raise CorruptRecording(
+            f"{path}: the {ATTACHMENT_NAME} attachment describes a {scenario.body}, the "
+            "/rsstp/scenario message an arm"
+        )
     if scenario.n_joints != record.n_joints or len(scenario.obstacles) != len(record.obstacles):
         raise CorruptRecording(
             f"{path}: the /rsstp/scenario message has {record.n_joints} joints and "

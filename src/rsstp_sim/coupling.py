@@ -23,14 +23,14 @@ from typing import Any, Literal, NamedTuple
 
 import numpy as np
 
+from rsstp_sim.bodies import make_world
 from rsstp_sim.errors import ActionError, StrategyError
 from rsstp_sim.geometry import Blocker
 from rsstp_sim.memory import Memory
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.strategies import AgentView, Strategy, StrategyBase
 from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.words import counted
-from rsstp_sim.world import World
 
 __all__ = ["Event", "RunSummary", "Runner", "StepOutcome", "stop_text"]
 
@@ -117,7 +117,7 @@ class Runner:
 
     def __init__(
         self,
-        scenario: Scenario,
+        scenario: AnyScenario,
         strategy: Strategy,
         *,
         seed: int,
@@ -129,7 +129,7 @@ class Runner:
         self.scenario = scenario
         self.strategy = strategy
         self.seed = seed
-        self.world = World(scenario)
+        self.world = make_world(scenario)
         self._on_event = on_event
         self._on_model_change = on_model_change
         self.reset()

@@ -155,7 +155,13 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
             raise EnvError(f"step_cost must be a number, got {step_cost!r}")
         self._reward = reward
         self._step_cost = float(step_cost)
-        self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+        loaded = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+        if not isinstance(loaded, Scenario):
+            raise EnvError(
+                f"{loaded.name}: a {loaded.body} has no Gymnasium env yet (its observation and "
+                "drawing are the arm's); the Runner runs it"
+            )
+        self.scenario = loaded
         self.render_mode = render_mode
         self.world = World(self.scenario)
         self._actions = self.scenario.actions

@@ -15,9 +15,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rsstp_sim._arrays import IntArray
+from rsstp_sim._arrays import BoolArray, IntArray
 
-__all__ = ["moore_classes"]
+__all__ = ["moore_classes", "reached"]
 
 
 def moore_classes(next_state: IntArray, output: ArrayLike) -> IntArray:
@@ -64,3 +64,22 @@ def _packed(columns: list[IntArray], *, bits: int) -> list[IntArray]:
             word = (word << bits) | column
         words.append(word)
     return words
+
+
+def reached(tail: IntArray, head: IntArray, start: int, n: int) -> BoolArray:
+    """The nodes ``0 .. n-1`` reached from ``start`` along the edges ``tail[i] -> head[i]``,
+    breadth first, a whole frontier per numpy call."""
+    order = np.argsort(tail, kind="stable")
+    heads = head[order]
+    bounds = np.searchsorted(tail[order], np.arange(n + 1, dtype=np.int64))
+    seen = np.zeros(n, np.bool_)
+    seen[start] = True
+    frontier = np.array([start], np.int64)
+    while len(frontier):
+        lo, hi = bounds[frontier], bounds[frontier + 1]
+        sizes = hi - lo
+        offsets = np.repeat(lo - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))
+        following = np.unique(heads[offsets])
+        frontier = following[~seen[following]]
+        seen[frontier] = True
+    return seen

@@ -31,14 +31,19 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, ClassVar, Literal, TypeAlias
 
 from rsstp_sim import geometry
+from rsstp_sim.bodies import BODIES, body_named
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.files import irregular
 from rsstp_sim.nesting import too_deep
 
+if TYPE_CHECKING:
+    from rsstp_sim.rover.scenario import RoverScenario
+
 __all__ = [
+    "AnyScenario",
     "Obstacle",
     "Scenario",
     "builtin_scenarios",
@@ -103,6 +108,8 @@ class Scenario:
     source: str = ""
     origin: str = "<string>"
 
+    body: ClassVar[str] = "arm"
+
     @property
     def n_joints(self) -> int:
         return len(self.lengths)
@@ -117,6 +124,10 @@ class Scenario:
         return hashlib.sha256(self.source.encode("utf-8")).hexdigest()
 
 
+AnyScenario: TypeAlias = "Scenario | RoverScenario"
+"""A scenario of any registered body (:mod:`rsstp_sim.bodies`)."""
+
+
 def builtin_scenarios() -> dict[str, str]:
     """Names of the built-in scenarios with their one-line descriptions, sorted by name."""
     out: dict[str, str] = {}
@@ -128,7 +139,7 @@ def builtin_scenarios() -> dict[str, str]:
     return out
 
 
-def load_scenario(name_or_path: str | Path) -> Scenario:
+def load_scenario(name_or_path: str | Path) -> AnyScenario:
     """Load a built-in scenario by name, or a scenario file by path."""
     text_name = str(name_or_path)
     if isinstance(name_or_path, str) and text_name in builtin_scenarios():
@@ -156,7 +167,7 @@ def load_scenario(name_or_path: str | Path) -> Scenario:
     return parse_scenario(text, origin=str(path))
 
 
-def parse_scenario(text: str, *, origin: str = "<string>") -> Scenario:
+def parse_scenario(text: str, *, origin: str = "<string>") -> AnyScenario:
     """Parse and validate a scenario from TOML text; ``origin`` names it in errors."""
     deep = too_deep(text)
     if deep is not None:
@@ -165,6 +176,17 @@ def parse_scenario(text: str, *, origin: str = "<string>") -> Scenario:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{origin}: TOML syntax error: {exc}") from None
+    present = [name for name in BODIES if name in data]
+    if len(present) != 1:
+        tables = " or ".join(f"[{name}]" for name in BODIES)
+        found = "none" if not present else " and ".join(f"[{name}]" for name in present)
+        raise ScenarioError(f"{origin}: expected one body table, {tables}; found {found}")
+    scenario: AnyScenario = body_named(present[0]).parse(data, text, origin)
+    return scenario
+
+
+def parse_arm(data: Mapping[str, object], text: str, origin: str) -> Scenario:
+    """Validate a parsed TOML document whose body is ``[arm]``."""
     return _Validator(origin).scenario(data, text)
 
 

@@ -36,16 +36,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rsstp_sim._arrays import BoolArray, IntArray
+from rsstp_sim.bodies import body_of
 from rsstp_sim.errors import ModelError, TruthError
-from rsstp_sim.moore import moore_classes
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.interface import PoseMachine, WorldScenario
+from rsstp_sim.moore import moore_classes, reached
 from rsstp_sim.transition_system import TransitionSystem
-from rsstp_sim.world_table import (
-    MAX_TABULATION_CHECKS,
-    WorldTable,
-    pose_space_size,
-    tabulation_checks,
-)
+from rsstp_sim.world_table import MAX_TABULATION_CHECKS, pose_space_size
 
 __all__ = [
     "MAX_TRUTH_CHECKS",
@@ -69,6 +65,12 @@ class GroundTruth:
     ``true_class[p]`` is the pose's class in the minimal machine; classes are
     numbered breadth-first from the start pose's class (0) over the actions in
     order, so the numbering depends only on the machine's behaviour.
+
+    ``pose_values[p]`` is what a recording's steps table says of the pose, one column a
+    value, named ``value_names`` (the arm's joint angles, the rover's cell and heading). A
+    value ``v`` is the digit ``v // units[i]`` of the pose code in base ``radices[i]`` (the
+    last digit most significant); with ``wrap`` a digit is taken modulo its radix (angles),
+    else one out of range names no pose.
     ``seconds`` (wall time of the computation) takes no part in equality.
     Arrays are read-only.
     """
@@ -76,7 +78,7 @@ class GroundTruth:
     scenario_name: str
     actions: tuple[int, ...]
     pose_codes: IntArray
-    angles_deg: IntArray
+    pose_values: IntArray
     sensation: BoolArray
     next_pose: IntArray
     blocked: BoolArray
@@ -84,6 +86,10 @@ class GroundTruth:
     true_class: IntArray
     class_next: IntArray
     class_sensation: BoolArray
+    value_names: tuple[str, ...]
+    radices: tuple[int, ...]
+    units: tuple[int, ...]
+    wrap: bool
     seconds: float = field(default=0.0, compare=False)
 
     def __post_init__(self) -> None:
@@ -93,7 +99,7 @@ class GroundTruth:
     def _arrays(self) -> tuple[np.ndarray, ...]:
         return (
             self.pose_codes,
-            self.angles_deg,
+            self.pose_values,
             self.sensation,
             self.next_pose,
             self.blocked,
@@ -131,57 +137,82 @@ class GroundTruth:
         return int(np.count_nonzero(self.sensation))
 
     @property
-    def n_joints(self) -> int:
-        return int(self.angles_deg.shape[1])
+    def n_values(self) -> int:
+        """How many values say a pose (:attr:`value_names`)."""
+        return len(self.radices)
 
-    def pose_index(self, angles_deg: Sequence[int]) -> int:
-        """Index of the pose with these joint angles (degrees, taken modulo 360)."""
-        angles = list(angles_deg)
-        if len(angles) != self.n_joints:
+    @property
+    def angles_deg(self) -> IntArray:
+        """:attr:`pose_values`, by the arm's name for them."""
+        return self.pose_values
+
+    def pose_index(self, values: Sequence[int]) -> int:
+        """Index of the pose with these values (an arm's joint angles in degrees, taken modulo
+        360; a rover's cell and heading)."""
+        items = list(values)
+        if len(items) != self.n_values:
             raise TruthError(
-                f"{self.scenario_name}: expected {self.n_joints} joint angles, "
-                f"found {len(angles)}: {angles!r}"
+                f"{self.scenario_name}: expected {self.n_values} values "
+                f"({', '.join(self.value_names)}), found {len(items)}: {items!r}"
             )
         try:
-            code = sum((operator.index(a) % 360) * 360**i for i, a in enumerate(angles))
+            items = [operator.index(v) for v in items]
         except TypeError:
             raise TruthError(
-                f"{self.scenario_name}: joint angles must be integers, found {angles!r}"
+                f"{self.scenario_name}: pose values must be integers, found {items!r}"
             ) from None
-        index = int(np.searchsorted(self.pose_codes, code))
-        if index == self.n_poses or int(self.pose_codes[index]) != code:
-            raise TruthError(
-                f"{self.scenario_name}: the pose {[a % 360 for a in angles]} "
-                f"is not reachable from the start pose"
-            )
-        return index
+        if self.wrap:
+            items = [v % (r * u) for v, r, u in zip(items, self.radices, self.units, strict=True)]
+        return int(self.poses_of(np.array([items], dtype=object))[0])
 
-    def poses_of(self, angles_deg: ArrayLike) -> NDArray[np.int64]:
-        """Pose indices of many poses at once: ``angles_deg`` has shape ``(B, n)``.
+    def poses_of(self, values: ArrayLike) -> NDArray[np.int64]:
+        """Pose indices of many poses at once: ``values`` has shape ``(B, n_values)``.
 
         Raises :class:`TruthError` naming the first pose that is not reachable.
         """
-        angles = np.asarray(angles_deg, dtype=np.int64).reshape(-1, self.n_joints) % 360
-        codes = angles @ (360 ** np.arange(self.n_joints, dtype=np.int64))
+        raw = np.asarray(values)
+        if raw.dtype == object:  # Python integers of any size: out of int64 names no pose
+            big = [v for v in raw.ravel().tolist() if not -(2**62) < v < 2**62]
+            if big:
+                raise TruthError(f"{self.scenario_name}: no pose has the value {big[0]}")
+        given = raw.astype(np.int64).reshape(-1, self.n_values)
+        units = np.asarray(self.units, np.int64)
+        radices = np.asarray(self.radices, np.int64)
+        digits = given // units
+        if self.wrap:
+            digits %= radices
+            shown = digits * units
+        else:
+            shown = given
+            bad = ((digits < 0) | (digits >= radices) | (given % units != 0)).any(axis=1)
+            if bad.any():
+                first = int(np.argmax(bad))
+                raise TruthError(
+                    f"{self.scenario_name}: {given[first].tolist()} is not a pose "
+                    f"({', '.join(self.value_names)})"
+                )
+        place = np.concatenate([[1], np.cumprod(radices[:-1])]).astype(np.int64)
+        codes = digits @ place
         index = np.searchsorted(self.pose_codes, codes)
         index = np.minimum(index, len(self.pose_codes) - 1)
         unreachable = self.pose_codes[index] != codes
         if unreachable.any():
             first = int(np.argmax(unreachable))
             raise TruthError(
-                f"{self.scenario_name}: the pose {angles[first].tolist()} is not reachable "
+                f"{self.scenario_name}: the pose {shown[first].tolist()} is not reachable "
                 f"from the start"
             )
         return np.asarray(index, dtype=np.int64)
 
-    def classes_of(self, angles_deg: ArrayLike) -> NDArray[np.int64]:
-        """Classes of many poses at once: ``angles_deg`` has shape ``(B, n)`` (see
+    def classes_of(self, values: ArrayLike) -> NDArray[np.int64]:
+        """Classes of many poses at once: ``values`` has shape ``(B, n_values)`` (see
         :meth:`poses_of`)."""
-        return np.asarray(self.true_class[self.poses_of(angles_deg)], dtype=np.int64)
+        return np.asarray(self.true_class[self.poses_of(values)], dtype=np.int64)
 
-    def class_of(self, angles_deg: Sequence[int]) -> int:
-        """Class (minimal machine state) of the pose with these joint angles."""
-        return int(self.true_class[self.pose_index(angles_deg)])
+    def class_of(self, values: Sequence[int]) -> int:
+        """Class (minimal machine state) of the pose with these values (see
+        :meth:`pose_index`)."""
+        return int(self.true_class[self.pose_index(values)])
 
     def minimal_model(self) -> TransitionSystem:
         """The minimal machine as a deterministic, complete model; current = start class 0."""
@@ -195,12 +226,12 @@ class GroundTruth:
     def classes_reached_from(self, c: int) -> BoolArray:
         """Which classes some action sequence leads to from class ``c`` (``c`` included)."""
         sources = np.repeat(np.arange(self.n_classes, dtype=np.int64), len(self.actions))
-        return _reached(sources, self.class_next.ravel(), c, self.n_classes)
+        return reached(sources, self.class_next.ravel(), c, self.n_classes)
 
     def classes_returning_to(self, c: int) -> BoolArray:
         """From which classes some action sequence leads to class ``c`` (``c`` included)."""
         sources = np.repeat(np.arange(self.n_classes, dtype=np.int64), len(self.actions))
-        return _reached(self.class_next.ravel(), sources, c, self.n_classes)
+        return reached(self.class_next.ravel(), sources, c, self.n_classes)
 
     def class_labels(self) -> dict[int, bool]:
         """The sensation of every class, as :func:`check_equivalence` takes labels."""
@@ -232,25 +263,6 @@ def format_truth(truth: GroundTruth) -> str:
     )
 
 
-def _reached(tail: IntArray, head: IntArray, start: int, n: int) -> BoolArray:
-    """The nodes ``0 .. n-1`` reached from ``start`` along the edges ``tail[i] -> head[i]``,
-    breadth first, a whole frontier per numpy call."""
-    order = np.argsort(tail, kind="stable")
-    heads = head[order]
-    bounds = np.searchsorted(tail[order], np.arange(n + 1, dtype=np.int64))
-    seen = np.zeros(n, np.bool_)
-    seen[start] = True
-    frontier = np.array([start], np.int64)
-    while len(frontier):
-        lo, hi = bounds[frontier], bounds[frontier + 1]
-        sizes = hi - lo
-        offsets = np.repeat(lo - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))
-        following = np.unique(heads[offsets])
-        frontier = following[~seen[following]]
-        seen[frontier] = True
-    return seen
-
-
 # --------------------------------------------------------------- enumeration
 
 
@@ -262,31 +274,16 @@ machine. Three joints at 5 degrees among 1,000 obstacles count 6.7 billion; they
 
 
 def check_truth_size(
-    scenario: Scenario, *, max_poses: int = 2_000_000, max_checks: int = MAX_TRUTH_CHECKS
+    scenario: WorldScenario, *, max_poses: int = 2_000_000, max_checks: int = MAX_TRUTH_CHECKS
 ) -> None:
-    """Refuse (:class:`TruthError`) a world whose :func:`pose_space_size` exceeds
-    ``max_poses``, or whose every move of every pose checked against every obstacle would take
-    more than ``max_checks`` link-obstacle checks: before any work, and the same whether the
-    truth is computed or read from the cache."""
-    bound = pose_space_size(scenario)
-    if bound > max_poses:
-        raise TruthError(
-            f"{scenario.name}: the pose space has {bound:,} poses, more than the "
-            f"limit of {max_poses:,} (pass a larger max_poses)"
-        )
-    n_actions, n_links = len(scenario.actions), scenario.n_joints
-    checks = tabulation_checks(scenario)
-    if checks > max_checks:
-        raise TruthError(
-            f"{scenario.name}: refused: tabulating the world would take about {checks:,} "
-            f"link-obstacle checks ({bound:,} poses x {n_actions} moves x {n_links} links x "
-            f"{len(scenario.obstacles):,} obstacles), more than the {max_checks:,} (about "
-            "20 s) the ground truth takes on"
-        )
+    """Refuse (:class:`TruthError`), before any work, a world too large to enumerate: more
+    than ``max_poses`` poses, or (an arm among obstacles) more than ``max_checks``
+    link-obstacle checks; the same whether the truth is computed or read from the cache."""
+    body_of(scenario).check_size(scenario, max_poses=max_poses, max_checks=max_checks)
 
 
 def compute_truth(
-    scenario: Scenario, *, max_poses: int = 2_000_000, max_checks: int = MAX_TRUTH_CHECKS
+    scenario: WorldScenario, *, max_poses: int = 2_000_000, max_checks: int = MAX_TRUTH_CHECKS
 ) -> GroundTruth:
     """Enumerate the reachable poses of ``scenario`` and minimise their Moore machine.
 
@@ -296,34 +293,36 @@ def compute_truth(
     """
     started = time.perf_counter()
     check_truth_size(scenario, max_poses=max_poses, max_checks=max_checks)
-    table = WorldTable(scenario)
-    table.complete()
-    # The table's rows are in the order the poses were reached; the truth's are by code.
-    codes = np.frombuffer(table.codes, dtype=np.int64)
-    order = np.argsort(codes, kind="stable")
-    rank = np.empty(len(order), dtype=np.int64)
-    rank[order] = np.arange(len(order))
-    pose_codes = codes[order].copy()
-    next_pose = rank[table.next_array()[order]]
-    angles = table.angles()[order]
-    sensation = table.sensations()[order]
-    start_index = int(rank[0])
-    blocked = next_pose == np.arange(len(pose_codes))[:, None]
+    machine = body_of(scenario).machine(scenario)
+    return _minimised(scenario.name, tuple(scenario.actions), machine, started)
 
+
+def _minimised(
+    name: str, actions: tuple[int, ...], machine: PoseMachine, started: float
+) -> GroundTruth:
+    """The machine of reachable poses (by sorted code) and its minimisation."""
+    next_pose, sensation = machine.next_pose, machine.sensation
+    blocked = next_pose == np.arange(len(machine.codes))[:, None]
     classes = moore_classes(next_pose, sensation)
-    true_class, class_next, class_sensation = _canonical(classes, next_pose, sensation, start_index)
+    true_class, class_next, class_sensation = _canonical(
+        classes, next_pose, sensation, machine.start_index
+    )
     return GroundTruth(
-        scenario_name=scenario.name,
-        actions=tuple(scenario.actions),
-        pose_codes=pose_codes,
-        angles_deg=angles,
+        scenario_name=name,
+        actions=actions,
+        pose_codes=machine.codes,
+        pose_values=machine.values,
         sensation=sensation,
         next_pose=next_pose,
         blocked=blocked,
-        start_index=start_index,
+        start_index=machine.start_index,
         true_class=true_class,
         class_next=class_next,
         class_sensation=class_sensation,
+        value_names=machine.value_names,
+        radices=machine.radices,
+        units=machine.units,
+        wrap=machine.wrap,
         seconds=time.perf_counter() - started,
     )
 

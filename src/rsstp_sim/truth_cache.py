@@ -3,10 +3,10 @@
 Tabulating a world and minimising it takes seconds for a few hundred thousand poses, and every
 audit of every recording of that world needs the same truth. :func:`load_truth` keeps it under
 ``$XDG_CACHE_HOME/rsstp/truth/`` (``~/.cache/rsstp/truth/`` when the variable is unset), one
-file per key. The key is a hash of what makes the world (the arm, its actions, the obstacles,
-the feedback points and tolerance, the collision mode) and of the package version, so a
-renamed or re-commented scenario shares its entry, and a new version of the package computes
-afresh.
+file per key. The key is a hash of what makes the world (the body, and every field of its
+scenario but the name, the description, the text and the feedback mode) and of the package
+version, so a renamed or re-commented scenario shares its entry, and a new version of the
+package computes afresh.
 
 An entry is an ``.npz`` archive of plain arrays (no pickles) holding its own key and a SHA-256
 of its arrays. It is written to a side file and renamed into place, so a reader never sees half
@@ -31,14 +31,14 @@ from pathlib import Path
 
 import numpy as np
 
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.interface import WorldScenario
 from rsstp_sim.truth import GroundTruth, check_truth_size, compute_truth
 
 __all__ = ["CacheInfo", "cache_info", "truth_cache_dir", "load_truth", "truth_key"]
 
 _ARRAYS = (
     "pose_codes",
-    "angles_deg",
+    "pose_values",
     "sensation",
     "next_pose",
     "true_class",
@@ -54,29 +54,30 @@ def truth_cache_dir() -> Path:
     return root / "rsstp" / "truth"
 
 
-def truth_key(scenario: Scenario) -> str:
-    """The hash naming a scenario's entry: its world and the package version."""
+_NOT_THE_WORLD = frozenset({"name", "description", "source", "origin", "feedback_mode"})
+"""Scenario fields that do not change the ground truth (a renamed world keeps its entry)."""
+
+
+def truth_key(scenario: WorldScenario) -> str:
+    """The hash naming a scenario's entry: its body, its world and the package version."""
     from rsstp_sim import __version__
 
     world = {
-        "package": __version__,
-        "lengths": [repr(x) for x in scenario.lengths],
-        "initial_deg": list(scenario.initial_deg),
-        "step_deg": scenario.step_deg,
-        "actions": list(scenario.actions),
-        "obstacles": [
-            [repr(o.center[0]), repr(o.center[1]), repr(o.radius)] for o in scenario.obstacles
-        ],
-        "feedback_points": [[repr(x), repr(y)] for x, y in scenario.feedback_points],
-        "tolerance": repr(scenario.tolerance),
-        "collision": scenario.collision,
+        field.name: getattr(scenario, field.name)
+        for field in dataclasses.fields(scenario)  # type: ignore[arg-type]
+        if field.name not in _NOT_THE_WORLD
     }
-    text = json.dumps(world, sort_keys=True, separators=(",", ":"))
+    text = json.dumps(
+        {"package": __version__, "body": scenario.body, "world": world},
+        sort_keys=True,
+        separators=(",", ":"),
+        default=repr,  # floats exactly (repr), and the bodies' small dataclasses
+    )
     return hashlib.sha256(text.encode()).hexdigest()
 
 
 def load_truth(
-    scenario: Scenario, *, cache: bool = True, max_poses: int = 2_000_000
+    scenario: WorldScenario, *, cache: bool = True, max_poses: int = 2_000_000
 ) -> GroundTruth:
     """The ground truth of ``scenario``: read from the cache when a sound entry is there,
     else computed (:func:`~rsstp_sim.truth.compute_truth`) and kept. ``cache=False`` neither
@@ -136,14 +137,14 @@ def cache_info() -> CacheInfo:
 
 def _digest(arrays: dict[str, np.ndarray]) -> str:
     digest = hashlib.sha256()
-    for name in (*_ARRAYS, "actions", "start_index"):
+    for name in (*_ARRAYS, "actions", "start_index", "value_names", "radices", "units", "wrap"):
         array = np.ascontiguousarray(arrays[name])
         digest.update(f"{name}:{array.dtype.str}:{array.shape}".encode())
         digest.update(array.tobytes())
     return digest.hexdigest()
 
 
-def _read(path: Path, key: str, scenario: Scenario) -> GroundTruth | None:
+def _read(path: Path, key: str, scenario: WorldScenario) -> GroundTruth | None:
     """The entry at ``path``, or None when it is missing, unreadable, foreign or damaged."""
     try:
         data = path.read_bytes()
@@ -159,7 +160,7 @@ def _read(path: Path, key: str, scenario: Scenario) -> GroundTruth | None:
             scenario_name=scenario.name,
             actions=tuple(int(a) for a in arrays["actions"]),
             pose_codes=arrays["pose_codes"].astype(np.int64, copy=False),
-            angles_deg=arrays["angles_deg"].astype(np.int64, copy=False),
+            pose_values=arrays["pose_values"].astype(np.int64, copy=False),
             sensation=arrays["sensation"].astype(np.bool_, copy=False),
             next_pose=next_pose,
             blocked=next_pose == np.arange(len(next_pose))[:, None],
@@ -167,6 +168,10 @@ def _read(path: Path, key: str, scenario: Scenario) -> GroundTruth | None:
             true_class=arrays["true_class"].astype(np.int64, copy=False),
             class_next=arrays["class_next"].astype(np.int64, copy=False),
             class_sensation=arrays["class_sensation"].astype(np.bool_, copy=False),
+            value_names=tuple(str(name) for name in arrays["value_names"]),
+            radices=tuple(int(r) for r in arrays["radices"]),
+            units=tuple(int(u) for u in arrays["units"]),
+            wrap=bool(arrays["wrap"]),
         )
     except (KeyError, ValueError, TypeError):
         return None
@@ -181,7 +186,8 @@ def _consistent(truth: GroundTruth) -> bool:
     return bool(
         poses > 0
         and truth.next_pose.shape == (poses, width)
-        and truth.angles_deg.shape[0] == poses
+        and truth.pose_values.shape == (poses, truth.n_values)
+        and len(truth.value_names) == len(truth.units) == truth.n_values
         and truth.sensation.shape == truth.true_class.shape == (poses,)
         and truth.class_next.shape == (classes, width)
         and 0 <= truth.start_index < poses
@@ -199,7 +205,7 @@ def _write(path: Path, key: str, truth: GroundTruth) -> None:
     nothing."""
     arrays: dict[str, np.ndarray] = {
         "pose_codes": truth.pose_codes,
-        "angles_deg": truth.angles_deg,
+        "pose_values": truth.pose_values,
         "sensation": truth.sensation,
         "next_pose": truth.next_pose,
         "true_class": truth.true_class,
@@ -207,6 +213,10 @@ def _write(path: Path, key: str, truth: GroundTruth) -> None:
         "class_sensation": truth.class_sensation,
         "actions": np.asarray(truth.actions, np.int64),
         "start_index": np.asarray(truth.start_index, np.int64),
+        "value_names": np.asarray(truth.value_names, np.str_),
+        "radices": np.asarray(truth.radices, np.int64),
+        "units": np.asarray(truth.units, np.int64),
+        "wrap": np.asarray(truth.wrap),
     }
     arrays["digest"] = np.asarray(_digest(arrays))
     arrays["key"] = np.asarray(key)

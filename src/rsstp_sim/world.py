@@ -11,18 +11,19 @@ obstacles) move by move, each new move checked alone.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from rsstp_sim._arrays import FloatArray, IntArray
-from rsstp_sim.errors import ActionError, UnknownPose
+from rsstp_sim.errors import ActionError, TruthError, UnknownPose
 from rsstp_sim.geometry import Blocker
-from rsstp_sim.scenario import Scenario
-from rsstp_sim.world_table import WorldTable
+from rsstp_sim.interface import PoseMachine
+from rsstp_sim.scenario import MANY_OBSTACLES, Scenario, parse_arm
+from rsstp_sim.world_table import WorldTable, pose_space_size, tabulation_checks, unsensable
 
-__all__ = ["Pose", "World"]
+__all__ = ["ARM", "Pose", "World"]
 
 _FIRST_BLOCK = 256
 """The poses a table grown in blocks grows by at its first miss (doubling at each)."""
@@ -265,3 +266,74 @@ class World:
     def cache_info(self) -> tuple[int, int]:
         """(poses in the world's table, poses with at least one move computed)."""
         return len(self.table), self.table.moves_computed()
+
+
+class _Arm:
+    """The arm as a body (:class:`~rsstp_sim.interface.Body`)."""
+
+    name = "arm"
+
+    def parse(self, data: Mapping[str, object], text: str, origin: str) -> Scenario:
+        return parse_arm(data, text, origin)
+
+    def world(self, scenario: Scenario) -> World:
+        return World(scenario)
+
+    def warnings(self, scenario: Scenario) -> list[str]:
+        """A feedback point no pose can sense, and so many obstacles that steps slow down."""
+        found = []
+        problem = unsensable(scenario)
+        if problem is not None:
+            found.append(
+                f"no pose can sense the feedback point, every sensation will be false: {problem}"
+            )
+        n = len(scenario.obstacles)
+        if n > MANY_OBSTACLES:
+            found.append(
+                f"{n:,} obstacles: every step measures each joint's distance to each of them, "
+                f"so steps run about {1 + n / 60:.0f} times slower than with a few"
+            )
+        return found
+
+    def check_size(self, scenario: Scenario, *, max_poses: int, max_checks: int) -> None:
+        bound = pose_space_size(scenario)
+        if bound > max_poses:
+            raise TruthError(
+                f"{scenario.name}: the pose space has {bound:,} poses, more than the "
+                f"limit of {max_poses:,} (pass a larger max_poses)"
+            )
+        n_actions, n_links = len(scenario.actions), scenario.n_joints
+        checks = tabulation_checks(scenario)
+        if checks > max_checks:
+            raise TruthError(
+                f"{scenario.name}: refused: tabulating the world would take about {checks:,} "
+                f"link-obstacle checks ({bound:,} poses x {n_actions} moves x {n_links} links x "
+                f"{len(scenario.obstacles):,} obstacles), more than the {max_checks:,} (about "
+                "20 s) the ground truth takes on"
+            )
+
+    def machine(self, scenario: Scenario) -> PoseMachine:
+        """The world table completed (breadth first, whole frontiers per vectorised batch),
+        its rows put in code order."""
+        table = WorldTable(scenario)
+        table.complete()
+        codes = np.frombuffer(table.codes, dtype=np.int64)
+        order = np.argsort(codes, kind="stable")
+        rank = np.empty(len(order), dtype=np.int64)
+        rank[order] = np.arange(len(order))
+        n = scenario.n_joints
+        return PoseMachine(
+            codes=codes[order].copy(),
+            values=table.angles()[order],
+            next_pose=rank[table.next_array()[order]],
+            sensation=table.sensations()[order],
+            start_index=int(rank[0]),
+            value_names=tuple(f"angle_deg_{j}" for j in range(n)),
+            radices=(360,) * n,
+            units=(1,) * n,
+            wrap=True,
+        )
+
+
+ARM = _Arm()
+"""The arm, as the body registry (:mod:`rsstp_sim.bodies`) names it."""

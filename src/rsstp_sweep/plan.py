@@ -166,6 +166,11 @@ def _scenarios(origin: str, value: object, base: Path) -> list[tuple[str, Scenar
             scenario = load_scenario(path if given.endswith(".toml") else given)
         except RsstpError as exc:
             raise SweepError(f"{origin}: scenarios: {exc}") from None
+        if not isinstance(scenario, Scenario):
+            raise SweepError(
+                f"{origin}: scenarios: {given}: a {scenario.body}'s runs cannot be recorded "
+                "yet, and a sweep records every run"
+            )
         loaded.append((given, scenario))
     names = [scenario.name for _, scenario in loaded]
     for name in names:

@@ -30,9 +30,10 @@ from jsonschema import Draft202012Validator
 from steps import step_record_after
 
 import rsstp_sim
+from builtin_worlds import builtins_of
 from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.recording import builders, records, schemas
-from rsstp_sim.scenario import builtin_scenarios, load_scenario
+from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import RandomStrategy, strategy_origin
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -265,7 +266,7 @@ def record_run(name: str) -> Corpus:
     return Corpus(name, messages, models)
 
 
-@pytest.fixture(scope="module", params=sorted(builtin_scenarios()))
+@pytest.fixture(scope="module", params=builtins_of("arm"))
 def corpus(request: pytest.FixtureRequest) -> Corpus:
     return record_run(request.param)
 

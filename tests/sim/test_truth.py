@@ -304,7 +304,7 @@ def test_class_of_and_pose_index() -> None:
     assert truth.pose_index([100]) == 9
     with pytest.raises(TruthError, match=r"^thesis-obstacles: the pose \[60\] is not reachable"):
         truth.class_of([60])
-    with pytest.raises(TruthError, match="expected 1 joint angles, found 2"):
+    with pytest.raises(TruthError, match=r"expected 1 values \(angle_deg_0\), found 2"):
         truth.class_of([95, 0])
     with pytest.raises(TruthError, match="must be integers"):
         truth.class_of([95.0])  # type: ignore[list-item]

@@ -68,7 +68,7 @@ class TruthSource(Protocol):
 
 def step_true_classes(steps: pd.DataFrame, truth: GroundTruth) -> NDArray[np.int64]:
     """The true class of every row's pose (columns ``angle_deg_0 .. angle_deg_{n-1}``)."""
-    columns = [f"angle_deg_{j}" for j in range(truth.n_joints)]
+    columns = list(truth.value_names)
     return truth.classes_of(steps[columns].to_numpy(dtype=np.int64))
 
 
@@ -83,7 +83,7 @@ def truth_table(
     truth = load_truth(source.scenario) if truth is None else truth
     findings = audit_truth(source, truth=truth) if findings is None else findings
     table = source.steps()
-    columns = [f"angle_deg_{j}" for j in range(truth.n_joints)]
+    columns = list(truth.value_names)
     table["true_class"] = findings.true_class
     table["pose"] = truth.poses_of(table[columns].to_numpy(dtype=np.int64))
     table["aliased"] = findings.aliased_step
@@ -318,7 +318,7 @@ def audit_truth(
     states = np.asarray(memory.internal_states, dtype=np.int64)
     step_numbers = np.arange(len(states), dtype=np.int64)
     index = version_index(versions, step_numbers)
-    columns = [f"angle_deg_{j}" for j in range(truth.n_joints)]
+    columns = list(truth.value_names)
     verdict, equivalent = judge_versions(
         versions,
         truth=truth,

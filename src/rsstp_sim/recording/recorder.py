@@ -65,7 +65,7 @@ from rsstp_sim.recording.schemas import (
     schema_bytes,
 )
 from rsstp_sim.recording.step_messages import Block, BlockMessages, StepMessages
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.scenario import AnyScenario, Scenario
 from rsstp_sim.strategies import Strategy, strategy_origin
 from rsstp_sim.transition_system import Operation
 
@@ -157,7 +157,7 @@ class Recorder:
     def __init__(
         self,
         path: str | Path,
-        scenario: Scenario,
+        scenario: AnyScenario,
         strategy: Strategy,
         *,
         seed: int,
@@ -168,6 +168,12 @@ class Recorder:
     ) -> None:
         if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1024:
             raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
+        if not isinstance(scenario, Scenario):
+            raise RecordingError(
+                f"{scenario.name}: a {scenario.body}'s run cannot be recorded yet: the "
+                "recording format holds an arm's ground truth (joint angles and positions); "
+                "`rsstp-sim run` runs it"
+            )
         self.path = Path(path)
         # What waits for the next step's message to be written, in order: (step, event
         # message) and (step, operations) of a model change, whose message is built when the
@@ -613,7 +619,7 @@ def _check_steps(steps: object) -> None:
 
 def record(
     path: str | Path,
-    scenario: Scenario,
+    scenario: AnyScenario,
     strategy: Strategy,
     *,
     steps: int,

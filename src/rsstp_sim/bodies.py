@@ -1,0 +1,42 @@
+"""The registry of bodies: one line each, the scenario table that picks it and where it lives.
+
+A body's module is imported when a scenario first needs it, so the registry imports none of
+them, and a scenario module can ask it for a parser without an import cycle.
+
+>>> sorted(BODIES)
+['arm', 'rover']
+>>> body_named("rover").name
+'rover'
+"""
+
+from __future__ import annotations
+
+from importlib import import_module
+from typing import Any
+
+from rsstp_sim.interface import Body
+
+__all__ = ["BODIES", "body_named", "body_of", "make_world"]
+
+BODIES: dict[str, str] = {
+    "arm": "rsstp_sim.world:ARM",
+    "rover": "rsstp_sim.rover:ROVER",
+}
+"""Body name (its scenario table) -> ``module:attribute`` of its :class:`Body`."""
+
+
+def body_named(name: str) -> Body:
+    """The registered body ``name`` (KeyError for none)."""
+    module, attribute = BODIES[name].split(":")
+    body: Body = getattr(import_module(module), attribute)
+    return body
+
+
+def body_of(scenario: Any) -> Body:
+    """The body a scenario describes."""
+    return body_named(scenario.body)
+
+
+def make_world(scenario: Any) -> Any:
+    """A world of the scenario's body, at its start pose."""
+    return body_of(scenario).world(scenario)

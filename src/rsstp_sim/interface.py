@@ -1,0 +1,122 @@
+"""The world interface: what everything downstream of the agent knows of a body.
+
+A *body* (the arm, the rover) is a finite deterministic world: poses numbered by integer
+codes, actions that move between them or are blocked, and in each pose a boolean sensation
+and a float feedback in ``[0, 1]``. The runner drives a :class:`World` through
+:meth:`World.reset` and :meth:`World.move` and reads the current :class:`Pose`'s sensation and
+feedback; the ground truth reads the body's :class:`PoseMachine`. A body is registered in
+:mod:`rsstp_sim.bodies` as a :class:`Body`: how its scenario table is parsed, how its world is
+made, and how its reachable poses are enumerated.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from rsstp_sim._arrays import BoolArray, IntArray
+
+__all__ = ["Blocker", "Body", "Pose", "PoseMachine", "World", "WorldScenario"]
+
+
+class WorldScenario(Protocol):
+    """What every body's scenario says: its name, its actions, how feedback is read."""
+
+    @property
+    def name(self) -> str: ...
+    @property
+    def description(self) -> str: ...
+    @property
+    def actions(self) -> tuple[int, ...]: ...
+    @property
+    def feedback_mode(self) -> str: ...
+    @property
+    def source(self) -> str: ...
+    @property
+    def origin(self) -> str: ...
+    @property
+    def sha256(self) -> str: ...
+    @property
+    def body(self) -> str: ...
+
+
+class Pose(Protocol):
+    """One pose of a body: its code, and what the agent senses there."""
+
+    @property
+    def code(self) -> int: ...
+    @property
+    def sensation(self) -> bool: ...
+    @property
+    def feedback(self) -> float: ...
+
+
+class Blocker(Protocol):
+    """Why a move was blocked: a kind and the indices of what blocked it."""
+
+    @property
+    def kind(self) -> str: ...
+    @property
+    def indices(self) -> tuple[int, ...]: ...
+    def describe(self) -> str: ...
+
+
+class World(Protocol):
+    """A body in its world, one pose at a time."""
+
+    @property
+    def scenario(self) -> Any: ...
+    def reset(self) -> Any: ...
+    def move(self, action: int) -> Any:
+        """Execute an action: None when the body moved, else its :class:`Blocker`."""
+
+    @property
+    def current(self) -> Any: ...
+    @property
+    def sensation(self) -> bool: ...
+    @property
+    def feedback(self) -> float: ...
+
+
+@dataclass(frozen=True, eq=False)
+class PoseMachine:
+    """A body's reachable poses as a machine, sorted by code: ``next_pose[p, k]`` is the
+    index of the pose action ``actions[k]`` leads to from pose ``p`` (``p`` itself when
+    blocked). ``values[p]`` says the pose in the columns ``value_names`` of a steps table;
+    value ``i`` is digit ``values[p, i] // units[i]`` of the code in base ``radices[i]``, taken
+    modulo the radix when ``wrap`` (angles)."""
+
+    codes: IntArray
+    values: IntArray
+    next_pose: IntArray
+    sensation: BoolArray
+    start_index: int
+    value_names: tuple[str, ...]
+    radices: tuple[int, ...]
+    units: tuple[int, ...]
+    wrap: bool
+
+
+class Body(Protocol):
+    """A kind of body, as the registry (:mod:`rsstp_sim.bodies`) holds it."""
+
+    name: str
+    """The scenario table that picks it (``[arm]``, ``[rover]``)."""
+
+    def parse(self, data: Mapping[str, object], text: str, origin: str) -> Any:
+        """The validated scenario of a parsed TOML document that has this body's table."""
+
+    def world(self, scenario: Any) -> Any:
+        """A :class:`World` at the scenario's start pose."""
+
+    def warnings(self, scenario: Any) -> list[str]:
+        """What a user should hear before a run of ``scenario`` (one line each): a feedback
+        region nothing can sense, a world whose steps are slow."""
+
+    def check_size(self, scenario: Any, *, max_poses: int, max_checks: int) -> None:
+        """Refuse (:class:`~rsstp_sim.errors.TruthError`), before any work, a world whose
+        enumeration would pass ``max_poses`` poses or ``max_checks`` collision checks."""
+
+    def machine(self, scenario: Any) -> PoseMachine:
+        """Every pose reachable from the start."""

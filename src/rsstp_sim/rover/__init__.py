@@ -1,0 +1,87 @@
+"""The roaming robot: a round robot on a grid of cells among walls, one-way doors and
+circular obstacles, turned and driven forward and back, sensing only a feedback region.
+
+Its pose is a cell and a heading in fixed steps; :mod:`~rsstp_sim.rover.table` computes
+every pose's moves at once, :mod:`~rsstp_sim.rover.world` answers one move at a time.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from rsstp_sim.errors import ScenarioError, TruthError
+from rsstp_sim.interface import PoseMachine
+from rsstp_sim.moore import reached
+from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario, parse_rover
+from rsstp_sim.rover.table import RoverTable, cell_clearance
+from rsstp_sim.rover.world import RoverBlocker, RoverPose, RoverWorld
+
+__all__ = ["ACTION_NAMES", "ROVER", "RoverBlocker", "RoverPose", "RoverScenario", "RoverWorld"]
+
+
+class _Rover:
+    """The rover as a body (:class:`~rsstp_sim.interface.Body`)."""
+
+    name = "rover"
+
+    def parse(self, data: Mapping[str, object], text: str, origin: str) -> RoverScenario:
+        scenario = parse_rover(data, text, origin)
+        x, y = scenario.start
+        if not cell_clearance(scenario, np.array([[x + 0.5], [y + 0.5]]))[0]:
+            raise ScenarioError(
+                f"{origin}: rover.start: the robot at cell {[x, y]} touches a wall, a door "
+                "or an obstacle"
+            )
+        return scenario
+
+    def world(self, scenario: RoverScenario) -> RoverWorld:
+        return RoverWorld(scenario)
+
+    def warnings(self, scenario: RoverScenario) -> list[str]:
+        """A feedback region no reachable pose senses."""
+        machine = self.machine(scenario)
+        if machine.sensation.any():
+            return []
+        return [
+            "no reachable pose senses the feedback region, every sensation will be false "
+            f"(centre {list(scenario.feedback_center)}, radius {scenario.feedback_radius:g})"
+        ]
+
+    def check_size(self, scenario: RoverScenario, *, max_poses: int, max_checks: int) -> None:
+        width, height = scenario.room
+        poses = width * height * scenario.headings
+        if poses > max_poses:
+            raise TruthError(
+                f"{scenario.name}: the pose space has {poses:,} poses, more than the "
+                f"limit of {max_poses:,} (pass a larger max_poses)"
+            )
+
+    def machine(self, scenario: RoverScenario) -> PoseMachine:
+        """Every pose's moves at once (:class:`RoverTable`), then the poses reached from the
+        start, breadth first."""
+        table = RoverTable.of(scenario)
+        n_codes = len(table.next_code)
+        tail = np.repeat(np.arange(n_codes, dtype=np.int64), len(scenario.actions))
+        codes = np.flatnonzero(reached(tail, table.next_code.ravel(), table.start_code, n_codes))
+        rank = np.full(n_codes, -1, dtype=np.int64)
+        rank[codes] = np.arange(len(codes))
+        values = table.values_of(codes)
+        values[:, 2] *= scenario.turn_deg
+        width, height = scenario.room
+        return PoseMachine(
+            codes=codes.astype(np.int64),
+            values=values,
+            next_pose=rank[table.next_code[codes]],
+            sensation=table.sensation[codes],
+            start_index=int(rank[table.start_code]),
+            value_names=("cell_x", "cell_y", "heading_deg"),
+            radices=(width, height, scenario.headings),
+            units=(1, 1, scenario.turn_deg),
+            wrap=False,
+        )
+
+
+ROVER = _Rover()
+"""The rover, as the body registry (:mod:`rsstp_sim.bodies`) names it."""
