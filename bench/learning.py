@@ -82,7 +82,7 @@ PASSIVE_LIMIT = 40
 
 
 def budget_for(name: str, truth: GroundTruth) -> int:
-    return TWO_JOINT_BUDGET if truth.n_joints > 1 else 4 * truth.n_classes**2
+    return TWO_JOINT_BUDGET if truth.n_values > 1 else 4 * truth.n_classes**2
 
 
 # ------------------------------------------------------------------ judging

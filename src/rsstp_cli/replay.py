@@ -37,6 +37,7 @@ from rsstp_replay.table_files import (
     write_table_parts,
 )
 from rsstp_replay.tables import TABLES, recording_table
+from rsstp_sim.bodies import body_of
 from rsstp_sim.files import check_output
 from rsstp_sim.words import counted
 
@@ -80,19 +81,8 @@ def _cmd_info(args: argparse.Namespace) -> int:
         )
         print(f"file: {recording.path} ({size:,} bytes, {state})")
         print(f"scenario: {record.name} ({record.description})")
-        lengths = ", ".join(f"{length:g}" for length in record.lengths)
-        print(
-            f"  joints: {record.n_joints} (lengths {lengths}; start {list(record.initial_deg)} "
-            f"deg; step {record.step_deg} deg; actions {list(record.actions)})"
-        )
-        obstacles = "; ".join(
-            f"centre ({o.center.x:g}, {o.center.y:g}) radius {o.radius:g}" for o in record.obstacles
-        )
-        print(f"  obstacles: {len(record.obstacles)}" + (f": {obstacles}" if obstacles else ""))
-        print(
-            f"  feedback: {scenario.feedback_mode} (tolerance {record.feedback.tolerance:g}); "
-            f"collision: {record.collision}"
-        )
+        for line in body_of(scenario).describe(scenario):
+            print(line)
         params = json.dumps(recording.strategy_params, sort_keys=True)
         strategy = record.strategy
         origin = " ".join(filter(None, (strategy.distribution, strategy.version)))

@@ -34,9 +34,16 @@ from rsstp_replay._chunks import Messages, count_messages, topic_chunks, topics_
 from rsstp_replay._container import ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
 from rsstp_sim.errors import ScenarioError
-from rsstp_sim.recording.records import RecordFormatError, ScenarioRecord, decode, decode_many
+from rsstp_sim.recording.records import (
+    RecordFormatError,
+    RoverScenarioRecord,
+    ScenarioRecord,
+    decode,
+    decode_many,
+)
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_NAME,
+    BODY_TOPICS,
     MESSAGE_ENCODING,
     METADATA_CHECKSUM_KEY,
     METADATA_CHECKSUM_SINCE,
@@ -51,7 +58,8 @@ from rsstp_sim.recording.schemas import (
     parse_version,
     version_refusal,
 )
-from rsstp_sim.scenario import Scenario, parse_scenario
+from rsstp_sim.rover import RoverScenario
+from rsstp_sim.scenario import AnyScenario, Scenario, parse_scenario
 
 __all__ = ["CheckedFile", "check_file"]
 
@@ -74,8 +82,14 @@ class CheckedFile:
     topic_counts: dict[str, int]
     limit_ns: int | None
     n_steps: int
-    scenario_record: ScenarioRecord
-    scenario: Scenario
+    scenario_record: ScenarioRecord | RoverScenarioRecord
+    scenario: AnyScenario
+    topics: dict[str, str]
+    """Topic -> schema name, of the recording's body (:data:`BODY_TOPICS`)."""
+
+    @property
+    def body(self) -> str:
+        return self.scenario.body
 
     def chunks(
         self, topic: str, *, step: int | None = None
@@ -94,13 +108,14 @@ class CheckedFile:
 
     def decode_one(self, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
         """The record of one message of ``topic``."""
-        return _decode_one(self.container.path, topic, part, log_time, ref)
+        return _decode_one(self.container.path, self.topics[topic], topic, part, log_time, ref)
 
     def decode_many(
         self, topic: str, parts: list[memoryview], log_times: _Ints, ref: ChunkRef
     ) -> list[Any]:
         """The records of a chunk's messages of ``topic``, decoded at once."""
-        return _decode_many(self.container.path, topic, parts, log_times, ref)
+        path = self.container.path
+        return _decode_many(path, self.topics[topic], topic, parts, log_times, ref)
 
 
 def check_file(container: Container) -> CheckedFile:
@@ -113,7 +128,8 @@ def check_file(container: Container) -> CheckedFile:
             f"{container.recovered_bytes} of {container.size} bytes): nothing to recover"
         )
     channels = rsstp_channels(container)
-    schema_versions = check_schemas(container, channels)
+    topics = _body_topics(container, channels)
+    schema_versions = check_schemas(container, channels, topics)
     metadata, verified = read_metadata(container, schema_versions)
     counts = container.counts if container.counts is not None else count_messages(container)
     limit_ns: int | None = None
@@ -131,7 +147,7 @@ def check_file(container: Container) -> CheckedFile:
     if n_step_messages == 0:
         what = "no complete step" if not container.finished else "no step message"
         raise CorruptRecording(f"{path}: {what} to read (expected step 0, the reset)")
-    record = _scenario_message(container, channels, topic_counts, limit_ns)
+    record = _scenario_message(container, channels, topics, topic_counts, limit_ns)
     return CheckedFile(
         container,
         channels,
@@ -143,12 +159,32 @@ def check_file(container: Container) -> CheckedFile:
         n_step_messages - 1,
         record,
         rebuild_scenario(container, record, metadata),
+        topics,
+    )
+
+
+def _body_topics(container: Container, channels: dict[str, int]) -> dict[str, str]:
+    """The topics' schema names of the body whose scenario schema the scenario channel has."""
+    channel = container.channels[channels["/rsstp/scenario"]]
+    schema = container.schemas.get(channel.schema_id)
+    if schema is None:
+        return BODY_TOPICS["arm"]  # (check_schemas names the missing schema)
+    for topics in BODY_TOPICS.values():
+        if schema.name == topics["/rsstp/scenario"]:
+            return topics
+    known = " or ".join(repr(t["/rsstp/scenario"]) for t in BODY_TOPICS.values())
+    raise CorruptRecording(
+        f"{container.path}: channel /rsstp/scenario: expected schema {known}, found {schema.name!r}"
     )
 
 
 def _scenario_message(
-    container: Container, channels: dict[str, int], counts: dict[str, int], limit_ns: int | None
-) -> ScenarioRecord:
+    container: Container,
+    channels: dict[str, int],
+    topics: dict[str, str],
+    counts: dict[str, int],
+    limit_ns: int | None,
+) -> ScenarioRecord | RoverScenarioRecord:
     """The one ``/rsstp/scenario`` message."""
     count = counts.get("/rsstp/scenario", 0)
     if count != 1:
@@ -159,30 +195,36 @@ def _scenario_message(
     with closing(topic_chunks(container, channel, limit_ns)) as chunks:
         for ref, _, parts, times in chunks:
             if parts:
-                record = _decode_one(container.path, "/rsstp/scenario", parts[0], times[0], ref)
-                assert isinstance(record, ScenarioRecord)
+                name = topics["/rsstp/scenario"]
+                record = _decode_one(
+                    container.path, name, "/rsstp/scenario", parts[0], times[0], ref
+                )
+                assert isinstance(record, ScenarioRecord | RoverScenarioRecord)
                 return record
     raise CorruptRecording(f"{container.path}: the /rsstp/scenario message is missing")
 
 
 def _decode_many(
-    path: Path, topic: str, parts: list[memoryview], log_times: _Ints, ref: ChunkRef
+    path: Path, name: str, topic: str, parts: list[memoryview], log_times: _Ints, ref: ChunkRef
 ) -> list[Any]:
     try:
-        return decode_many(TOPICS[topic], parts)
+        return decode_many(name, parts)
     except (RecordFormatError, msgspec.DecodeError):
         pass
     for part, log_time in zip(parts, log_times, strict=True):  # which one, and why
-        _decode_one(path, topic, part, int(log_time), ref)
+        _decode_one(path, name, topic, part, int(log_time), ref)
     raise CorruptRecording(
         f"{path}: the {topic} messages of the chunk at byte {ref.offset} decode one by one but "
         f"not together (a message holding more than one JSON value)"
     )
 
 
-def _decode_one(path: Path, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
+def _decode_one(
+    path: Path, name: str, topic: str, part: memoryview, log_time: int, ref: ChunkRef
+) -> Any:
+    """The record of one message of ``topic``, whose schema is ``name``."""
     try:
-        return decode(TOPICS[topic], bytes(part))
+        return decode(name, bytes(part))
     except (RecordFormatError, msgspec.DecodeError) as exc:
         raise CorruptRecording(
             f"{path}: the {topic} message at step {log_time / STEP_NS:g} (chunk at byte "
@@ -215,14 +257,17 @@ def rsstp_channels(container: Container) -> dict[str, int]:
     return channels
 
 
-def check_schemas(container: Container, channels: dict[str, int]) -> dict[str, str]:
-    """Each channel's schema: name, encodings, a known major version; name -> version."""
+def check_schemas(
+    container: Container, channels: dict[str, int], topics: dict[str, str]
+) -> dict[str, str]:
+    """Each channel's schema (``topics``: topic -> the body's schema name): name, encodings,
+    a known major version; name -> version."""
     path = container.path
     versions: dict[str, str] = {}
     supported, _ = parse_version(SCHEMA_VERSION)
     for topic, channel_id in channels.items():
         channel = container.channels[channel_id]
-        name = TOPICS[topic]
+        name = topics[topic]
         schema = container.schemas.get(channel.schema_id)
         where = f"{path}: channel {topic}"
         if schema is None:
@@ -297,8 +342,8 @@ def cut_time(container: Container, step_channel: int) -> int:
 
 
 def rebuild_scenario(
-    container: Container, record: ScenarioRecord, metadata: dict[str, str]
-) -> Scenario:
+    container: Container, record: ScenarioRecord | RoverScenarioRecord, metadata: dict[str, str]
+) -> AnyScenario:
     path = container.path
     attachments = [a for a in container.attachments if a.name == ATTACHMENT_NAME]
     if not attachments:
@@ -321,17 +366,29 @@ def rebuild_scenario(
         scenario = parse_scenario(text, origin=record.origin)
     except ScenarioError as exc:
         raise CorruptRecording(f"{path}: the {ATTACHMENT_NAME} attachment: {exc}") from None
-    if not isinstance(scenario, Scenario):
+    if isinstance(record, RoverScenarioRecord) != isinstance(scenario, RoverScenario):
+        said = "a rover" if isinstance(record, RoverScenarioRecord) else "an arm"
         raise CorruptRecording(
             f"{path}: the {ATTACHMENT_NAME} attachment describes a {scenario.body}, the "
-            "/rsstp/scenario message an arm"
+            f"/rsstp/scenario message {said}"
         )
-    if scenario.n_joints != record.n_joints or len(scenario.obstacles) != len(record.obstacles):
-        raise CorruptRecording(
-            f"{path}: the /rsstp/scenario message has {record.n_joints} joints and "
-            f"{len(record.obstacles)} obstacles, its scenario file {scenario.n_joints} and "
-            f"{len(scenario.obstacles)}"
-        )
+    if isinstance(record, ScenarioRecord) and isinstance(scenario, Scenario):
+        if scenario.n_joints != record.n_joints or len(scenario.obstacles) != len(record.obstacles):
+            raise CorruptRecording(
+                f"{path}: the /rsstp/scenario message has {record.n_joints} joints and "
+                f"{len(record.obstacles)} obstacles, its scenario file {scenario.n_joints} and "
+                f"{len(scenario.obstacles)}"
+            )
+    elif isinstance(record, RoverScenarioRecord) and isinstance(scenario, RoverScenario):
+        told = (len(record.obstacles), len(record.rover.walls), len(record.rover.doors))
+        given = (len(scenario.obstacles), len(scenario.walls), len(scenario.doors))
+        if list(record.rover.room) != list(scenario.room) or told != given:
+            raise CorruptRecording(
+                f"{path}: the /rsstp/scenario message has a {record.rover.room[0]} x "
+                f"{record.rover.room[1]} room with {told[0]} obstacles, {told[1]} walls and "
+                f"{told[2]} doors, its scenario file a {scenario.room[0]} x {scenario.room[1]} "
+                f"one with {given[0]}, {given[1]} and {given[2]}"
+            )
     if metadata["seed"] != str(record.seed) or metadata["strategy"] != record.strategy.name:
         raise CorruptRecording(
             f"{path}: the metadata says seed {metadata['seed']} and strategy "

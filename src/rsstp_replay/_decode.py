@@ -28,18 +28,13 @@ import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_replay.errors import BadStep, ReplayError
-from rsstp_sim.geometry import (
-    BLOCKER_ARITY,
-    BLOCKER_KINDS,
-    ArmGeometry,
-    BlockerKind,
-    joint_positions,
-    obstacle_distances,
-)
+from rsstp_sim.geometry import ArmGeometry, joint_positions, obstacle_distances
+from rsstp_sim.interface import BLOCKER_ARITY, BLOCKER_KINDS, BlockerKind
 from rsstp_sim.recording.records import json_array
 
 __all__ = [
     "BLOCKED_COLUMNS",
+    "ROVER_COLUMNS",
     "BLOCKER_KINDS",
     "StepColumns",
     "blocker_label",
@@ -106,6 +101,22 @@ class _PoseStep(msgspec.Struct, gc=False):
     truth: _PoseTruth
 
 
+class _RoverTruth(msgspec.Struct, gc=False):
+    """A rover's ground truth after a step (``rsstp.RoverStep``)."""
+
+    cell: Annotated[list[_Count], msgspec.Meta(min_length=2, max_length=2)]
+    heading_deg: _Angle
+    position: _Point
+    blocked: bool
+    blocked_by: _BlockedBy | None = None
+
+
+class _RoverStep(msgspec.Struct, gc=False):
+    step: _Count
+    agent: _Agent
+    truth: _RoverTruth
+
+
 class _AgentStep(msgspec.Struct, gc=False):
     """A step message without its ground truth (skipped by the parser, not built)."""
 
@@ -113,11 +124,16 @@ class _AgentStep(msgspec.Struct, gc=False):
     agent: _Agent
 
 
-_DECODERS: dict[bool, tuple[msgspec.json.Decoder[Any], msgspec.json.Decoder[Any]]] = {
-    True: (msgspec.json.Decoder(list[_PoseStep]), msgspec.json.Decoder(_Step)),
-    False: (msgspec.json.Decoder(list[_AgentStep]), msgspec.json.Decoder(_AgentStep)),
+_DECODERS: dict[tuple[str, bool], tuple[msgspec.json.Decoder[Any], msgspec.json.Decoder[Any]]] = {
+    ("arm", True): (msgspec.json.Decoder(list[_PoseStep]), msgspec.json.Decoder(_Step)),
+    ("rover", True): (msgspec.json.Decoder(list[_RoverStep]), msgspec.json.Decoder(_RoverStep)),
 }
-# BLOCKER_KINDS (rsstp_sim.geometry) are the categories of the steps table's ``blocked_kind``
+for _body in ("arm", "rover"):
+    _DECODERS[_body, False] = (
+        msgspec.json.Decoder(list[_AgentStep]),
+        msgspec.json.Decoder(_AgentStep),
+    )
+# BLOCKER_KINDS (rsstp_sim.interface) are the categories of the steps table's ``blocked_kind``
 # column, in that order in every recording (so tables of several recordings concatenate with
 # the categorical kept).
 
@@ -125,6 +141,9 @@ BLOCKED_COLUMNS: dict[str, tuple[str, ...]] = {
     "fold": ("blocked_joint",),
     "obstacle": ("blocked_link", "blocked_obstacle"),
     "links": ("blocked_link_i", "blocked_link_j"),
+    "room": ("blocked_edge",),
+    "wall": ("blocked_wall",),
+    "door": ("blocked_door",),
 }
 """The steps table's index columns of each blocker kind, in the order of the step message's
 ``truth.blocked_by.indices``: a column holds a value exactly at the steps blocked by its kind
@@ -132,10 +151,20 @@ BLOCKED_COLUMNS: dict[str, tuple[str, ...]] = {
 
 _KIND_DTYPE = pd.CategoricalDtype(list(BLOCKER_KINDS))
 
+_BODY_KINDS: dict[str, tuple[str, ...]] = {
+    "arm": ("fold", "obstacle", "links"),
+    "rover": ("room", "obstacle", "wall", "door"),
+}
+"""The blocker kinds of each body: its steps table has their index columns."""
+
+ROVER_COLUMNS = ("cell_x", "cell_y", "heading_deg")
+"""A rover's pose in the steps table: its cell and heading (degrees), the ground truth's
+``value_names``."""
+
 
 def blocker_label(kind: BlockerKind, indices: tuple[int, ...]) -> str:
     """A blocker as text (the viewer's label): ``fold joint 1``, ``obstacle 1 link 2``,
-    ``links 0 2``."""
+    ``links 0 2``; a rover's ``room edge 3``, ``wall 0``, ``door 1``."""
     arity = BLOCKER_ARITY[kind]
     if len(indices) != arity:
         found = list(indices)
@@ -144,7 +173,11 @@ def blocker_label(kind: BlockerKind, indices: tuple[int, ...]) -> str:
         return f"fold joint {indices[0]}"
     if kind == "obstacle":
         return f"obstacle {indices[1]} link {indices[0]}"
-    return f"links {indices[0]} {indices[1]}"
+    if kind == "links":
+        return f"links {indices[0]} {indices[1]}"
+    if kind == "room":
+        return f"room edge {indices[0]}"
+    return f"{kind} {indices[0]}"
 
 
 class StepColumns:
@@ -161,9 +194,11 @@ class StepColumns:
         n_obstacles: int,
         truth: bool = True,
         geometry: ArmGeometry | None = None,
+        body: str = "arm",
     ) -> None:
-        if truth and geometry is None:
+        if truth and geometry is None and body == "arm":
             raise ReplayError("the ground truth columns need the scenario's geometry")
+        self.body = body
         self.geometry = geometry
         self.n_rows = n_rows
         self.n_joints = n_joints
@@ -187,6 +222,7 @@ class StepColumns:
             self.blocker_labels: dict[_BlockedBy, int] = {}
             # One row per column, so each DataFrame column is a contiguous array.
             self.angles_deg = np.empty((n_joints, n_rows), np.int64)
+            self.rover_values = np.empty((3 if body == "rover" else 0, n_rows), np.int64)
 
     # -- filling ----------------------------------------------------------------------------
 
@@ -195,7 +231,7 @@ class StepColumns:
         next rows."""
         if not parts:
             return
-        batch, one = _DECODERS[self.truth]
+        batch, one = _DECODERS[self.body, self.truth]
         try:
             rows: list[Any] = batch.decode(json_array(parts))
         except (msgspec.DecodeError, RecursionError):
@@ -234,7 +270,7 @@ class StepColumns:
         """The first message of a batch, decoded whole: its joint positions and distances must
         be, bit for bit, what its angles give (see the module docstring)."""
         try:
-            truth = _DECODERS[True][1].decode(message).truth
+            truth = _DECODERS["arm", True][1].decode(message).truth
         except msgspec.DecodeError as exc:
             raise BadStep(_describe(exc), index=0) from None
         positions, distances = pose_numbers(self._geometry(), angles[None, :])
@@ -262,15 +298,34 @@ class StepColumns:
         assert self.geometry is not None  # checked in __init__
         return self.geometry
 
-    def _add_truth(self, truths: list[_PoseTruth], r: int, first: memoryview) -> None:
+    def _add_rover_truth(self, truths: list[_RoverTruth], s: slice) -> None:
+        """A rover's cell and heading; its position must be its cell's centre."""
+        k = s.stop - s.start
+        cells = np.fromiter(chain.from_iterable(t.cell for t in truths), np.int64, 2 * k)
+        self.rover_values[:2, s] = cells.reshape(k, 2).T
+        self.rover_values[2, s] = [t.heading_deg for t in truths]
+        found = np.array([(t.position.x, t.position.y) for t in truths], np.float64)
+        wrong = np.flatnonzero((found != cells.reshape(k, 2) + 0.5).any(axis=1))
+        if wrong.size:
+            index = int(wrong[0])
+            raise BadStep(
+                f"truth.position {found[index].tolist()} is not the centre of its cell "
+                f"{cells.reshape(k, 2)[index].tolist()}",
+                index=index,
+            )
+
+    def _add_truth(self, truths: list[Any], r: int, first: memoryview) -> None:
         k = len(truths)
         n = self.n_joints
         s = slice(r, r + k)
-        angles = [t.angles_deg for t in truths]
-        _check_lengths(angles, n, "truth.angles_deg", "angles")
-        flat = np.fromiter(chain.from_iterable(angles), np.int64, k * n)
-        self.angles_deg[:, s] = flat.reshape(k, n).T
-        self._check_numbers(first, flat[:n])
+        if self.body == "rover":
+            self._add_rover_truth(truths, s)
+        else:
+            angles = [t.angles_deg for t in truths]
+            _check_lengths(angles, n, "truth.angles_deg", "angles")
+            flat = np.fromiter(chain.from_iterable(angles), np.int64, k * n)
+            self.angles_deg[:, s] = flat.reshape(k, n).T
+            self._check_numbers(first, flat[:n])
         self.blocked[s] = np.array([t.blocked for t in truths], np.bool_)
         labels = self.blocker_labels
         bys = [t.blocked_by for t in truths]
@@ -360,7 +415,12 @@ class StepColumns:
                 columns |= self._blocked_columns(part)
             for j in range(self.n_joints):
                 columns[f"angle_deg_{j}"] = self.angles_deg[j, part]
-        if self.truth and geometry:
+            for name, values in zip(ROVER_COLUMNS, self.rover_values, strict=False):
+                columns[name] = values[part]
+        if self.truth and geometry and self.body == "rover":
+            columns["x"] = self.rover_values[0, part] + 0.5
+            columns["y"] = self.rover_values[1, part] + 0.5
+        elif self.truth and geometry:
             columns |= self._geometry_columns(part)
         return pd.DataFrame(columns, index=pd.RangeIndex(start, stop, name="step"), copy=copy)
 
@@ -390,8 +450,8 @@ class StepColumns:
         kinds = np.full(n_codes + 1, -1, np.int8)
         values = {
             name: np.full(n_codes + 1, -1, np.int64)
-            for names in BLOCKED_COLUMNS.values()
-            for name in names
+            for kind in _BODY_KINDS[self.body]
+            for name in BLOCKED_COLUMNS[kind]
         }
         for by, code in self.blocker_labels.items():
             kinds[code] = BLOCKER_KINDS.index(by.kind)
@@ -411,7 +471,7 @@ def blocker_texts(steps: pd.DataFrame, rows: npt.NDArray[np.int64]) -> npt.NDArr
     """The :func:`blocker_label` of each of ``rows`` of a steps table, from its blocked
     columns (``""`` where the move was not blocked); each distinct blocker is formatted once."""
     kinds = steps["blocked_kind"].cat.codes.to_numpy()[rows].astype(np.int64)
-    names = [name for names in BLOCKED_COLUMNS.values() for name in names]
+    names = [name for names in BLOCKED_COLUMNS.values() for name in names if name in steps]
     parts = [steps[name].to_numpy(np.int64, na_value=-1)[rows] for name in names]
     keys, inverse = np.unique(np.stack([kinds, *parts], axis=1), axis=0, return_inverse=True)
     texts = []
@@ -420,7 +480,9 @@ def blocker_texts(steps: pd.DataFrame, rows: npt.NDArray[np.int64]) -> npt.NDArr
             texts.append("")
             continue
         kind = BLOCKER_KINDS[key[0]]
-        indices = tuple(key[1 + names.index(name)] for name in BLOCKED_COLUMNS[kind])
+        indices = tuple(
+            key[1 + names.index(name)] for name in BLOCKED_COLUMNS[kind]
+        )  # (its body's)
         texts.append(blocker_label(kind, indices))
     return np.array(texts, object)[inverse.reshape(-1)]
 

@@ -78,11 +78,11 @@ from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.schemas import STEP_NS
+from rsstp_sim.scenario import Scenario
 from rsstp_sim.words import counted
 
 if TYPE_CHECKING:
     from rsstp_replay.recording import Recording
-    from rsstp_sim.scenario import Scenario
 
 __all__ = [
     "ARM_TOPIC",
@@ -144,6 +144,11 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
     """
     out = Path(path)
     scenario = recording.scenario
+    if not isinstance(scenario, Scenario):
+        raise ReplayError(
+            f"{recording.path}: a {scenario.body}'s recording has no Foxglove scene yet (the "
+            "scene draws an arm); info, audit, table and check read it"
+        )
     steps = recording.steps(geometry=False)
     n_steps = len(steps)
     poses = _ArmPoses.from_steps(steps, scenario, source=recording.path)

@@ -50,6 +50,7 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
 from rsstp_sim.recording.records import EventKind, EventRecord, ModelRecord, json_array
 from rsstp_sim.recording.schemas import STEP_NS
+from rsstp_sim.rover import RoverScenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
 from rsstp_sim.truth_cache import load_truth
@@ -487,13 +488,17 @@ class Recording:
             yield columns.frame(rows=slice(done, columns.n_rows))
 
     def _new_step_columns(self, *, truth: bool) -> StepColumns:
-        record = self.scenario_record
+        scenario = self.scenario
+        if isinstance(scenario, RoverScenario):
+            return StepColumns(
+                self.n_steps + 1, n_joints=0, n_obstacles=0, truth=truth, body="rover"
+            )
         return StepColumns(
             self.n_steps + 1,
-            n_joints=record.n_joints,
-            n_obstacles=len(record.obstacles),
+            n_joints=scenario.n_joints,
+            n_obstacles=len(scenario.obstacles),
             truth=truth,
-            geometry=ArmGeometry.from_scenario(self.scenario) if truth else None,
+            geometry=ArmGeometry.from_scenario(scenario) if truth else None,
         )
 
     def _decoding(
@@ -536,10 +541,10 @@ class Recording:
             row = _row(columns, step)
             if row is not None:
                 return row
-        n_joints = self.scenario_record.n_joints
+        body = self.scenario.body
         with closing(self._chunks("/rsstp/step", step=step)) as chunks:
             for ref, data, parts, times in chunks:
-                columns = StepColumns(len(parts), n_joints=n_joints, n_obstacles=0, truth=False)
+                columns = StepColumns(len(parts), n_joints=0, n_obstacles=0, truth=False, body=body)
                 self._decode_steps(columns, ref, data, parts, times)
                 if len(self._agent_cache) >= _CACHED_CHUNKS:
                     self._agent_cache.pop(next(iter(self._agent_cache)))

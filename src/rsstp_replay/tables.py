@@ -24,7 +24,7 @@ import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_replay.errors import TableError
 from rsstp_replay.recording import Recording
-from rsstp_sim.recording.records import ModelRecord, ScenarioRecord
+from rsstp_sim.recording.records import ModelRecord, RoverScenarioRecord, ScenarioRecord
 
 __all__ = ["TABLES", "model_table", "recording_table", "scenario_table"]
 
@@ -38,7 +38,7 @@ class _Models(Protocol):
 
 class _Scenario(Protocol):
     @property
-    def scenario_record(self) -> ScenarioRecord: ...
+    def scenario_record(self) -> ScenarioRecord | RoverScenarioRecord: ...
 
 
 def model_table(source: _Models) -> pd.DataFrame:

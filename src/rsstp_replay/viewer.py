@@ -57,7 +57,7 @@ from rsstp_sim.errors import OutputError, RsstpError
 from rsstp_sim.files import side_file, write_whole
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.scenario import AnyScenario, Scenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth_cache import load_truth
 from rsstp_sim.words import counted
@@ -117,7 +117,10 @@ class ViewSource(Protocol):
     """What the viewer reads of a recording (:class:`rsstp_replay.recording.Recording`)."""
 
     @property
-    def scenario(self) -> Scenario: ...
+    def path(self) -> Path: ...
+
+    @property
+    def scenario(self) -> AnyScenario: ...
 
     @property
     def n_steps(self) -> int: ...
@@ -234,6 +237,7 @@ def view(
     viewer is spawned. Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a bad range and
     :class:`~rsstp_replay.errors.ReplayError` for an unwritable ``save`` or a port in use.
     """
+    _check_drawable(recording)
     first, last = _step_range(recording, start, end)
     if save is not None:
         save = Path(save)
@@ -256,7 +260,7 @@ def view(
     writing = None if target is None else side_file(target)
     loaded = _load(recording)
     stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
-    blueprint = default_blueprint(recording.scenario, first=first, last=last)
+    blueprint = default_blueprint(_check_drawable(recording), first=first, last=last)
     spawned = False
     in_memory: rr.BinaryStream | None = None
     if target is not None and not spawn:
@@ -368,6 +372,7 @@ def log_recording(
     (the caller sets its sinks, and the blueprint if it wants one, and flushes it). The audits
     run over the whole recording; the model version in force at ``start`` is shown from
     ``start`` on."""
+    _check_drawable(recording)
     first, last = _step_range(recording, start, end)
     return _log(recording, _load(recording), stream, first, last)
 
@@ -395,7 +400,7 @@ def _load(recording: ViewSource) -> _Loaded:
     events = recording.events()
     read = time.perf_counter()
     within, determinism = _audits(steps, versions)
-    scenario = recording.scenario
+    scenario = _check_drawable(recording)
     places = model_part.state_places(
         steps, versions, n_joints=scenario.n_joints, reach=scenario.total_length
     )
@@ -421,7 +426,7 @@ def _log(
 ) -> LogSummary:
     began = time.perf_counter()
     window = loaded.steps.iloc[first : last + 1]
-    scenario = recording.scenario
+    scenario = _check_drawable(recording)
     stream.send_recording_name(f"{scenario.name} ({getattr(recording, 'path', 'recording')})")
     # The small entities first: a viewer reads the file in order, so the model, its size and
     # the audit log show while the per-step series still load.
@@ -502,7 +507,7 @@ def render_graph(recording: ViewSource, step: int, path: Path, *, on_world: bool
     model = recording.model_at(step)
     versions = recording.model_versions()
     if on_world:
-        scenario = recording.scenario
+        scenario = _check_drawable(recording)
         places = model_part.state_places(
             recording.steps(), versions, n_joints=scenario.n_joints, reach=scenario.total_length
         ).places
@@ -514,6 +519,17 @@ def render_graph(recording: ViewSource, step: int, path: Path, *, on_world: bool
 
 
 # ------------------------------------------------------------------------------ helpers
+
+
+def _check_drawable(recording: ViewSource) -> Scenario:
+    """The recording's arm scenario; a rover's recording is refused in one line."""
+    scenario = recording.scenario
+    if not isinstance(scenario, Scenario):
+        raise ReplayError(
+            f"{recording.path}: a {scenario.body}'s recording cannot be drawn yet (the viewer "
+            "draws an arm); info, audit, table and check read it"
+        )
+    return scenario
 
 
 def _step_range(recording: ViewSource, start: int | None, end: int | None) -> tuple[int, int]:

@@ -27,14 +27,16 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal, Protocol, get_args
+from typing import Protocol
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rsstp_sim._arrays import FloatArray, IntArray
+from rsstp_sim.interface import BlockerKind
 
 __all__ = [
+    "ARM_BLOCKER_KINDS",
     "ArmGeometry",
     "Blocker",
     "COS_DEG",
@@ -218,16 +220,8 @@ def arc_segment_distance(
     return np.asarray(best, dtype=np.float64)
 
 
-BlockerKind = Literal["fold", "obstacle", "links"]
-"""Why a move was blocked (:class:`Blocker`): the one definition of the blocker kinds, which
-the records, the schemas generated from them and the replay side's tables take from here."""
-
-BLOCKER_KINDS: tuple[BlockerKind, ...] = get_args(BlockerKind)
-"""The blocker kinds in their order (the order of a steps table's ``blocked_kind``
-categories)."""
-
-BLOCKER_ARITY: dict[BlockerKind, int] = {"fold": 1, "obstacle": 2, "links": 2}
-"""How many indices a blocker of each kind has (:class:`Blocker`)."""
+ARM_BLOCKER_KINDS: tuple[BlockerKind, ...] = ("fold", "obstacle", "links")
+"""The kinds of :data:`~rsstp_sim.interface.BlockerKind` that block an arm."""
 
 
 @dataclass(frozen=True, slots=True)

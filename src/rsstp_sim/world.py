@@ -279,6 +279,21 @@ class _Arm:
     def world(self, scenario: Scenario) -> World:
         return World(scenario)
 
+    def describe(self, scenario: Scenario) -> list[str]:
+        lengths = ", ".join(f"{length:g}" for length in scenario.lengths)
+        obstacles = "; ".join(
+            f"centre ({o.center[0]:g}, {o.center[1]:g}) radius {o.radius:g}"
+            for o in scenario.obstacles
+        )
+        return [
+            f"  joints: {scenario.n_joints} (lengths {lengths}; start "
+            f"{list(scenario.initial_deg)} deg; step {scenario.step_deg} deg; actions "
+            f"{list(scenario.actions)})",
+            f"  obstacles: {len(scenario.obstacles)}" + (f": {obstacles}" if obstacles else ""),
+            f"  feedback: {scenario.feedback_mode} (tolerance {scenario.tolerance:g}); "
+            f"collision: {scenario.collision}",
+        ]
+
     def warnings(self, scenario: Scenario) -> list[str]:
         """A feedback point no pose can sense, and so many obstacles that steps slow down."""
         found = []

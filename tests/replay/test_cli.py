@@ -162,7 +162,7 @@ def test_table_truth_adds_class_pose_and_aliasing(
         pd.testing.assert_frame_equal(table.iloc[:, :31], recording.steps())
     assert table["true_class"].tolist() == findings.true_class.tolist()
     assert table["aliased"].tolist() == findings.aliased_step.tolist()
-    angles = table[[f"angle_deg_{j}" for j in range(truth.n_joints)]].to_numpy()
+    angles = table[list(truth.value_names)].to_numpy()
     assert (truth.angles_deg[table["pose"].to_numpy()] == angles).all()
 
 

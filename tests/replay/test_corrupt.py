@@ -29,6 +29,7 @@ from rsstp_replay import Recording, errors, open_recording
 from rsstp_replay.table_files import write_table_parts
 from rsstp_sim import AgentView, StrategyBase, load_scenario
 from rsstp_sim.recording.recorder import record
+from rsstp_sim.recording.schemas import SCHEMA_VERSION
 from waiting import HANG_S
 
 SRC = Path(__file__).resolve().parents[2] / "src"
@@ -37,6 +38,9 @@ STEPS = 400
 CHUNK_SIZE = 8 * 1024
 CHUNK_DATA = 1 + 8 + 8 + 8 + 8 + 4 + 4 + len("zstd") + 8
 """Bytes from a chunk record's opcode to its compressed data."""
+
+_NOW = f'"version": "{SCHEMA_VERSION}"'.encode()
+"""How the schemas this package writes say their version."""
 
 
 class Splitter(StrategyBase):
@@ -269,9 +273,7 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
     foreign_mcap(files["foreign"])
 
     def version1(name: str, data: bytes) -> bytes:
-        return (
-            data.replace(b'"version": "2.2"', b'"version": "1.0"') if name == "rsstp.Step" else data
-        )
+        return data.replace(_NOW, b'"version": "1.0"') if name == "rsstp.Step" else data
 
     rewrite(original, files["version1"], schema=version1)
     raw = original.read_bytes()
@@ -340,7 +342,7 @@ def test_api_raises_a_one_line_error(name: str, damaged: dict[str, Path]) -> Non
 
 def test_a_later_minor_version_with_new_fields_is_read(original: Path, tmp_path: Path) -> None:
     def minor(name: str, data: bytes) -> bytes:
-        return data.replace(b'"version": "2.2"', b'"version": "2.3"')
+        return data.replace(_NOW, b'"version": "2.99"')
 
     def extra_fields(topic: str, log_time: int, data: bytes) -> bytes:
         value = json.loads(data)
@@ -352,7 +354,7 @@ def test_a_later_minor_version_with_new_fields_is_read(original: Path, tmp_path:
 
     newer = rewrite(original, tmp_path / "newer.mcap", schema=minor, message=extra_fields)
     with open_recording(newer) as recording, open_recording(original) as before:
-        assert recording.schema_versions["rsstp.Step"] == "2.3"
+        assert recording.schema_versions["rsstp.Step"] == "2.99"
         assert recording.memory() == before.memory()
         assert recording.steps().equals(before.steps())
         assert recording.events().equals(before.events())
@@ -616,7 +618,7 @@ def _older(values: dict[str, str]) -> dict[str, str]:
 
 def _to_version(version: str) -> Callable[[str, bytes], bytes]:
     def schema(name: str, data: bytes) -> bytes:
-        return data.replace(b'"version": "2.2"', f'"version": "{version}"'.encode())
+        return data.replace(_NOW, f'"version": "{version}"'.encode())
 
     return schema
 

@@ -160,10 +160,10 @@ def test_open_reads_the_scenario_metadata_and_counts(random_run: tuple[Path, Any
         assert recording.metadata["seed"] == str(SEED)
         assert recording.metadata["scenario_sha256"] == recording.scenario.sha256
         assert recording.schema_versions == {
-            "rsstp.Scenario": "2.2",
-            "rsstp.Step": "2.2",
-            "rsstp.Model": "2.2",
-            "rsstp.Event": "2.2",
+            "rsstp.Scenario": "2.3",
+            "rsstp.Step": "2.3",
+            "rsstp.Model": "2.3",
+            "rsstp.Event": "2.3",
         }
         assert "steps=0..2000" in repr(recording)
 
@@ -206,7 +206,14 @@ def test_steps_table_has_flat_typed_columns(random_run: tuple[Path, Any]) -> Non
     assert table["action"].isna().tolist() == [True] + [False] * STEPS
     assert table["state_before"].isna().sum() == 1
     assert table["blocked"].any()  # the random walk meets the obstacles
-    assert list(table["blocked_kind"].cat.categories) == ["fold", "obstacle", "links"]
+    assert list(table["blocked_kind"].cat.categories) == [
+        "fold",
+        "obstacle",
+        "links",
+        "room",
+        "wall",
+        "door",
+    ]
     assert table.groupby("step")["action"].first().equals(table["action"])  # no ambiguity
 
 

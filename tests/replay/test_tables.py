@@ -77,7 +77,7 @@ def test_blocked_columns_say_what_blocked_each_kind(
     with open_recording(path) as recording:
         steps = recording.steps()
     kind = steps["blocked_kind"]
-    assert kind.dtype == pd.CategoricalDtype(["fold", "obstacle", "links"])
+    assert kind.dtype == pd.CategoricalDtype(["fold", "obstacle", "links", "room", "wall", "door"])
     assert set(kind.dropna()) == {"fold", "obstacle", "links"}  # every kind is tested
     every = [name for names in BLOCKED_COLUMNS.values() for name in names]
     assert all(str(steps[name].dtype) == "Int64" for name in every)
@@ -219,7 +219,9 @@ def test_the_csv_sidecar_describes_every_column(
     assert list(meta["dtypes"]) == header
     assert meta["dtypes"]["step"] == "int64" and meta["dtypes"]["action"] == "Int64"
     assert meta["dtypes"]["blocked_kind"] == "category"
-    assert meta["categories"] == {"blocked_kind": ["fold", "obstacle", "links"]}
+    assert meta["categories"] == {
+        "blocked_kind": ["fold", "obstacle", "links", "room", "wall", "door"]
+    }
 
 
 def test_the_truth_table_reads_back_from_csv(

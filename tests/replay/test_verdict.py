@@ -73,7 +73,7 @@ def expected_verdict(
     """(learned, learned_at_step, equivalent per version, confined_since_step,
     reachable_classes), the slow way."""
     steps = recording.steps()
-    columns = [f"angle_deg_{j}" for j in range(truth.n_joints)]
+    columns = list(truth.value_names)
     classes = [truth.class_of(row) for row in steps[columns].to_numpy().tolist()]
     memory = recording.memory()
     states = [int(s) for s in memory.internal_states]

@@ -10,7 +10,7 @@ from rsstp_sim.transition_system import TransitionSystem
 
 def step_record_after(
     pose: Pose, model: TransitionSystem, out: StepOutcome | None
-) -> records.StepRecord:
+) -> records.StepRecord | records.RoverStepRecord:
     """The step record after ``out`` (None: the reset), ending at ``pose`` with ``model`` as
     it is now, as the recorder builds it."""
     return builders.step_record(

@@ -30,10 +30,10 @@ from jsonschema import Draft202012Validator
 from steps import step_record_after
 
 import rsstp_sim
-from builtin_worlds import builtins_of
 from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.recording import builders, records, schemas
-from rsstp_sim.scenario import load_scenario
+from rsstp_sim.rover import RoverScenario
+from rsstp_sim.scenario import Scenario, builtin_scenarios, load_scenario
 from rsstp_sim.strategies import RandomStrategy, strategy_origin
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -94,10 +94,14 @@ def test_every_property_has_a_description_and_objects_are_open(name: str) -> Non
 
 
 def test_topics_schemas_and_record_types_agree() -> None:
-    assert list(schemas.TOPICS.values()) == list(schemas.SCHEMA_NAMES)
-    assert list(records.RECORD_TYPES) == list(schemas.SCHEMA_NAMES)
-    for topic, name in schemas.TOPICS.items():
-        assert topic == "/rsstp/" + name.split(".")[1].lower()
+    assert schemas.TOPICS == schemas.BODY_TOPICS["arm"]
+    named = {name for topics in schemas.BODY_TOPICS.values() for name in topics.values()}
+    assert named == set(schemas.SCHEMA_NAMES) == set(records.RECORD_TYPES)
+    for body, topics in schemas.BODY_TOPICS.items():
+        assert list(topics) == ["/rsstp/scenario", "/rsstp/step", "/rsstp/model", "/rsstp/event"]
+        for topic, name in topics.items():  # the body's own name before its message's
+            prefix = "" if body == "arm" or topic in ("/rsstp/model", "/rsstp/event") else body
+            assert name.lower() == "rsstp." + prefix + topic.removeprefix("/rsstp/")
     assert schemas.log_time_ns(7) == 7_000_000
 
 
@@ -153,7 +157,9 @@ def _with_version(name: str, version: str) -> bytes:
 
 @pytest.mark.parametrize("name", schemas.SCHEMA_NAMES)
 def test_a_reader_accepts_any_2_x(name: str) -> None:
-    assert schemas.check_schema_version(name, schemas.schema_bytes(name)) == (2, 2)
+    now = schemas.parse_version(schemas.SCHEMA_VERSION)
+    assert now[0] == 2
+    assert schemas.check_schema_version(name, schemas.schema_bytes(name)) == now
     assert schemas.check_schema_version(name, _with_version(name, "2.7")) == (2, 7)
 
 
@@ -196,6 +202,10 @@ class Corpus:
 
     def of(self, cls: type[records.MessageRecord]) -> list[Any]:
         return [m for m in self.messages if isinstance(m, cls)]
+
+    def steps(self) -> list[Any]:
+        """The step messages, of any body."""
+        return self.of(records.StepRecord) + self.of(records.RoverStepRecord)
 
 
 def _edit_by_hand(model: TransitionSystem, actions: Sequence[int]) -> None:
@@ -266,7 +276,7 @@ def record_run(name: str) -> Corpus:
     return Corpus(name, messages, models)
 
 
-@pytest.fixture(scope="module", params=builtins_of("arm"))
+@pytest.fixture(scope="module", params=sorted(builtin_scenarios()))
 def corpus(request: pytest.FixtureRequest) -> Corpus:
     return record_run(request.param)
 
@@ -298,7 +308,7 @@ def test_the_corpus_has_every_kind_of_message(corpus: Corpus) -> None:
     kinds = {event.kind for event in corpus.of(records.EventRecord)}
     expected = {"split", "merge", "add", "delete", "note", "no_transition", "contradiction"}
     assert expected <= kinds
-    steps = corpus.of(records.StepRecord)
+    steps = corpus.steps()
     assert [s.step for s in steps] == list(range(STEPS + 1))
     assert any(s.agent.no_transition for s in steps)
     assert not corpus.models[-1][0].deterministic
@@ -309,19 +319,32 @@ def test_the_corpus_has_every_kind_of_message(corpus: Corpus) -> None:
 
 def test_step_records_carry_the_pose_and_the_outcome(corpus: Corpus) -> None:
     scenario = load_scenario(corpus.scenario)
-    n, m = scenario.n_joints, len(scenario.obstacles)
-    for step in corpus.of(records.StepRecord):
+    for step in corpus.steps():
         truth, agent = step.truth, step.agent
-        assert len(truth.angles_deg) == n
-        assert len(truth.joint_positions) == n + 1
-        assert truth.joint_positions[0] == records.PointRecord(x=0.0, y=0.0)
-        assert len(truth.distances) == n
-        assert all(len(tip.obstacles) == m for tip in truth.distances)
+        if isinstance(truth, records.RoverTruthRecord):
+            assert isinstance(scenario, RoverScenario)
+            x, y = truth.cell
+            assert 0 <= x < scenario.room[0] and 0 <= y < scenario.room[1]
+            assert truth.position == records.PointRecord(x=x + 0.5, y=y + 0.5)
+            assert truth.heading_deg % scenario.turn_deg == 0
+        else:
+            assert isinstance(scenario, Scenario)
+            n, m = scenario.n_joints, len(scenario.obstacles)
+            assert len(truth.angles_deg) == n
+            assert len(truth.joint_positions) == n + 1
+            assert truth.joint_positions[0] == records.PointRecord(x=0.0, y=0.0)
+            assert len(truth.distances) == n
+            assert all(len(tip.obstacles) == m for tip in truth.distances)
         assert truth.blocked == (truth.blocked_by is not None)
         assert (agent.action is None) == (agent.state_before is None) == (step.step == 0)
         assert agent.sensation == (agent.feedback == 1.0) or not agent.sensation
-    scenario_message = corpus.of(records.ScenarioRecord)[0]
-    assert scenario_message.n_joints == n and scenario_message.origin == corpus.scenario
+    scenario_message = corpus.messages[0]
+    assert isinstance(scenario_message, records.ScenarioRecord | records.RoverScenarioRecord)
+    if isinstance(scenario_message, records.ScenarioRecord):
+        assert isinstance(scenario, Scenario) and scenario_message.n_joints == scenario.n_joints
+    else:
+        assert list(scenario_message.rover.room) == list(scenario.room)  # type: ignore[union-attr]
+    assert scenario_message.origin == corpus.scenario
     assert scenario_message.sha256 == scenario.sha256
     strategy = scenario_message.strategy
     assert strategy.param_values() == {"block": 4096, "tags": ["a", "b"]}
@@ -390,12 +413,19 @@ def _three_joint() -> Corpus:
     return record_run("three-joint")
 
 
+@functools.cache
+def _rover() -> Corpus:
+    return record_run("rover-two-rooms")
+
+
 def _sample(name: str) -> dict[str, Any]:
     """A message with every optional object present (a blocked step, a blocked event)."""
-    for record in _three_joint().messages:
+    for record in [*_three_joint().messages, *_rover().messages]:
         if record.schema_name != name:
             continue
-        if isinstance(record, records.StepRecord) and record.truth.blocked_by is None:
+        if isinstance(record, records.StepRecord | records.RoverStepRecord) and (
+            record.truth.blocked_by is None
+        ):
             continue
         if isinstance(record, records.EventRecord) and record.kind != "blocked":
             continue
@@ -470,8 +500,8 @@ def test_a_missing_field_fails_validation_and_from_json(name: str, path: tuple[A
         (
             "rsstp.Step",
             ("truth", "blocked_by", "kind"),
-            "wall",
-            r"truth.blocked_by.kind: invalid enum value 'wall'",
+            "tree",
+            r"truth.blocked_by.kind: invalid enum value 'tree'",
         ),
         (
             "rsstp.Model",

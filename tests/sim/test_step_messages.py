@@ -27,7 +27,8 @@ from rsstp_sim import (
     StrategyBase,
     load_scenario,
 )
-from rsstp_sim.geometry import BLOCKER_ARITY, BLOCKER_KINDS, Blocker
+from rsstp_sim.geometry import ARM_BLOCKER_KINDS, Blocker
+from rsstp_sim.interface import BLOCKER_ARITY
 from rsstp_sim.recording import builders, records
 from rsstp_sim.recording.chunks import Message
 from rsstp_sim.recording.step_messages import BlockMessages, StepMessages, Steps
@@ -71,6 +72,8 @@ CASES: list[tuple[str, Callable[[], Strategy]]] = [
     ("one-joint-10", EvenActionsOnly),
     ("thesis-algo", lambda: make_strategy("splitter")),
     ("seven", RandomStrategy),
+    ("rover-two-rooms", RandomStrategy),  # the rover's own truth (walls, obstacles, edges)
+    ("rover-one-way", RandomStrategy),  # and its one-way door
 ]
 
 
@@ -297,7 +300,7 @@ def poses(draw: st.DrawFn, n: int, m: int) -> FakePose:
 
 @st.composite
 def blockers(draw: st.DrawFn) -> Blocker:
-    kind = draw(st.sampled_from(BLOCKER_KINDS))
+    kind = draw(st.sampled_from(ARM_BLOCKER_KINDS))
     indices = draw(st.lists(st.integers(0, 50), min_size=1, max_size=1))
     if BLOCKER_ARITY[kind] == 2:
         indices.append(draw(st.integers(0, 50)))

@@ -30,11 +30,13 @@ from rsstp_replay._chunks import gc_paused
 from rsstp_replay.errors import PhysicsDifference
 from rsstp_sim.errors import ActionError
 from rsstp_sim.recording import builders, records
+from rsstp_sim.rover import RoverScenario, RoverWorld
 from rsstp_sim.strategies import StrategyOrigin
 from rsstp_sim.world import World
 from rsstp_sim.world_table import pose_space_size
 
 IntArray = NDArray[np.int64]  # (rsstp_sim._arrays is the simulator's own)
+AnyWorld = World | RoverWorld
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -129,11 +131,20 @@ def _plain(value: object) -> str:
 
 def _simulate(
     recording: Recording, actions: IntArray, steps: pd.DataFrame
-) -> tuple[World, IntArray, IntArray]:
+) -> tuple[AnyWorld, IntArray, IntArray]:
     """The world after the recorded actions, the table row of every step's pose and the
     blocker code of every move (step 0 is the start pose, not blocked)."""
-    world = World(recording.scenario)
-    if not world.per_move and recording.n_steps >= pose_space_size(recording.scenario):
+    scenario = recording.scenario
+    if isinstance(scenario, RoverScenario):
+        rover = RoverWorld(scenario)
+        try:
+            codes, blocked = rover.walk(actions[1:].tolist())
+        except ActionError:
+            raise _unknown_action(actions, scenario.actions) from None
+        start = np.array([rover.table.start_code], np.int64)
+        return rover, np.concatenate([start, codes]), np.concatenate([[0], blocked])
+    world = World(scenario)
+    if not world.per_move and recording.n_steps >= pose_space_size(scenario):
         world.table.complete()  # a long walk meets most poses: all at once costs less
         followed = _followed(world, actions, steps)
         if followed is not None:
@@ -141,14 +152,33 @@ def _simulate(
     try:
         rows, blockers = world.walk(actions[1:].tolist())
     except ActionError:
-        known = set(world.table.actions)
-        step = 1 + int(np.flatnonzero(~np.isin(actions[1:], list(known)))[0])
-        raise PhysicsDifference(
-            step,
-            "agent.action",
-            f"{actions[step]} is not one of the scenario's actions {sorted(known)}",
-        ) from None
+        raise _unknown_action(actions, world.table.actions) from None
     return world, np.concatenate([[0], rows]), np.concatenate([[0], blockers])
+
+
+def _unknown_action(actions: IntArray, known: tuple[int, ...]) -> PhysicsDifference:
+    step = 1 + int(np.flatnonzero(~np.isin(actions[1:], list(known)))[0])
+    return PhysicsDifference(
+        step,
+        "agent.action",
+        f"{actions[step]} is not one of the scenario's actions {sorted(known)}",
+    )
+
+
+def _pose_arrays(world: AnyWorld) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
+    """The sensation and the feedback of every pose, indexed as :func:`_simulate`'s rows."""
+    table = world.table
+    if isinstance(world, RoverWorld):
+        return world.table.sensation, world.table.feedback
+    sensation = np.frombuffer(table.sensation, np.int8).astype(bool)
+    return sensation, np.frombuffer(table.feedback, np.float64)
+
+
+def _truth_of(world: AnyWorld, row: int, code: int) -> Any:
+    """The truth record of a step ending at ``row`` after a move blocked by ``code``."""
+    if isinstance(world, RoverWorld):
+        return builders.rover_truth_record(world.pose(row), world.blocker_of(code))
+    return builders.truth_record(world.pose_at(row), world.blocker_of(code))
 
 
 _BLOCK_STEPS = 1 << 20
@@ -201,11 +231,10 @@ def _followed(
     return rows, blockers
 
 
-def _check_agent_view(steps: pd.DataFrame, world: World, rows: IntArray) -> None:
+def _check_agent_view(steps: pd.DataFrame, world: AnyWorld, rows: IntArray) -> None:
     """The sensation and the feedback the agent was given are the world's at its pose."""
-    table = world.table
-    sensation = np.frombuffer(table.sensation, np.int8)[rows].astype(bool)
-    feedback = np.frombuffer(table.feedback, np.float64)[rows]
+    all_sensations, all_feedback = _pose_arrays(world)
+    sensation, feedback = all_sensations[rows], all_feedback[rows]
     for name, want, got in (
         ("agent.sensation", sensation, steps["sensation"].to_numpy(bool)),
         ("agent.feedback", feedback, steps["feedback"].to_numpy(np.float64)),
@@ -218,7 +247,7 @@ def _check_agent_view(steps: pd.DataFrame, world: World, rows: IntArray) -> None
             )
 
 
-def _check_truth(recording: Recording, world: World, rows: IntArray, blockers: IntArray) -> None:
+def _check_truth(recording: Recording, world: AnyWorld, rows: IntArray, blockers: IntArray) -> None:
     """Every step message's truth, against the bytes the recorder writes for its pose and
     blocker (each pair encoded once)."""
     width = int(blockers.max(initial=0)) + 1
@@ -227,7 +256,7 @@ def _check_truth(recording: Recording, world: World, rows: IntArray, blockers: I
     expected = []
     for key in distinct.tolist():
         row, code = divmod(key, width)
-        truth = builders.truth_record(world.pose_at(row), world.blocker_of(code))
+        truth = _truth_of(world, row, code)
         expected.append(_TRUTH_KEY + records.encode_json(truth) + b"}")
     step = 0
     with gc_paused():
@@ -301,7 +330,7 @@ def _scalar(value: object) -> str:
 
 
 def _check_blocked_events(
-    recording: Recording, world: World, actions: IntArray, blockers: IntArray
+    recording: Recording, world: AnyWorld, actions: IntArray, blockers: IntArray
 ) -> None:
     """A ``blocked`` event at exactly the blocked steps, with the action and the blocker.
 

@@ -44,7 +44,7 @@ from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.truth import GroundTruth
 from rsstp_sim.truth_cache import load_truth
 from rsstp_sim.words import counted
@@ -56,7 +56,7 @@ class TruthSource(Protocol):
     """What the truth audit reads from a recording."""
 
     @property
-    def scenario(self) -> Scenario: ...
+    def scenario(self) -> AnyScenario: ...
     @property
     def n_steps(self) -> int: ...
     def steps(self, *, geometry: bool = True) -> pd.DataFrame: ...

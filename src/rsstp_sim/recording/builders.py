@@ -21,6 +21,7 @@ from rsstp_sim.recording.records import (
     AgentRecord,
     BlockedByRecord,
     DistancesRecord,
+    DoorRecord,
     EventKind,
     EventRecord,
     FeedbackRecord,
@@ -29,19 +30,26 @@ from rsstp_sim.recording.records import (
     OperationRecord,
     ParamRecord,
     PointRecord,
+    RegionRecord,
+    RoverRecord,
+    RoverScenarioRecord,
+    RoverStepRecord,
+    RoverTruthRecord,
     ScenarioRecord,
+    SegmentRecord,
     StepRecord,
     StrategyRecord,
     TransitionsRecord,
     TruthRecord,
     encode_json,
 )
+from rsstp_sim.rover import RoverBlocker, RoverPose, RoverScenario
 from rsstp_sim.transition_system import Operation
 
 if TYPE_CHECKING:
     from rsstp_sim.coupling import Event
     from rsstp_sim.geometry import Blocker
-    from rsstp_sim.scenario import Scenario
+    from rsstp_sim.scenario import AnyScenario
     from rsstp_sim.strategies import StrategyOrigin
     from rsstp_sim.transition_system import TransitionSystem
     from rsstp_sim.world import Pose
@@ -63,14 +71,14 @@ __all__ = [
 
 
 def scenario_record(
-    scenario: Scenario,
+    scenario: AnyScenario,
     *,
     seed: int,
     strategy_name: str,
     strategy_params: Mapping[str, Any],
     strategy_origin: StrategyOrigin,
-) -> ScenarioRecord:
-    """The ``rsstp.Scenario`` message of a run.
+) -> ScenarioRecord | RoverScenarioRecord:
+    """The scenario message of a run (``rsstp.Scenario``, a rover's ``rsstp.RoverScenario``).
 
     ``origin`` keeps only the base name of a scenario file (recordings must not depend on
     the directory they were made in); ``strategy_params`` must be JSON-serialisable, and are
@@ -85,21 +93,34 @@ def scenario_record(
                 f"rsstp.Scenario: strategy.params: expected JSON values, found "
                 f"{name}={value!r} ({exc})"
             ) from None
+    strategy = StrategyRecord(
+        name=str(strategy_name),
+        import_path=strategy_origin.import_path,
+        distribution=strategy_origin.distribution,
+        version=strategy_origin.version,
+        params=tuple(params),
+    )
+    common: dict[str, Any] = {
+        "name": scenario.name,
+        "description": scenario.description,
+        "origin": re.split(r"[\\/]", scenario.origin)[-1],
+        "sha256": scenario.sha256,
+        "actions": tuple(int(v) for v in scenario.actions),
+        "obstacles": tuple(
+            ObstacleRecord(center=_point(o.center), radius=float(o.radius))
+            for o in scenario.obstacles
+        ),
+        "seed": int(seed),
+        "strategy": strategy,
+    }
+    if isinstance(scenario, RoverScenario):
+        return _rover_scenario_record(scenario, common)
     target = scenario.feedback_target_deg
     return ScenarioRecord(
-        name=scenario.name,
-        description=scenario.description,
-        origin=re.split(r"[\\/]", scenario.origin)[-1],
-        sha256=scenario.sha256,
         n_joints=scenario.n_joints,
         lengths=tuple(float(v) for v in scenario.lengths),
         initial_deg=tuple(int(v) for v in scenario.initial_deg),
         step_deg=int(scenario.step_deg),
-        actions=tuple(int(v) for v in scenario.actions),
-        obstacles=tuple(
-            ObstacleRecord(center=_point(o.center), radius=float(o.radius))
-            for o in scenario.obstacles
-        ),
         feedback=FeedbackRecord(
             mode=scenario.feedback_mode,
             tolerance=float(scenario.tolerance),
@@ -108,14 +129,34 @@ def scenario_record(
             target_deg=None if target is None else tuple(int(v) for v in target),
         ),
         collision=scenario.collision,
-        seed=int(seed),
-        strategy=StrategyRecord(
-            name=str(strategy_name),
-            import_path=strategy_origin.import_path,
-            distribution=strategy_origin.distribution,
-            version=strategy_origin.version,
-            params=tuple(params),
+        **common,
+    )
+
+
+def _rover_scenario_record(scenario: RoverScenario, common: dict[str, Any]) -> RoverScenarioRecord:
+    heading = scenario.feedback_heading
+    return RoverScenarioRecord(
+        rover=RoverRecord(
+            room=scenario.room,
+            start=scenario.start,
+            heading_deg=scenario.start_heading * scenario.turn_deg,
+            turn_deg=scenario.turn_deg,
+            radius=float(scenario.robot_radius),
+            walls=tuple(
+                SegmentRecord(start=_point(w.start), end=_point(w.end)) for w in scenario.walls
+            ),
+            doors=tuple(
+                DoorRecord(start=_point(d.start), end=_point(d.end), toward=_point(d.toward))
+                for d in scenario.doors
+            ),
         ),
+        feedback=RegionRecord(
+            mode=scenario.feedback_mode,
+            center=_point(scenario.feedback_center),
+            radius=float(scenario.feedback_radius),
+            heading_deg=None if heading is None else heading * scenario.turn_deg,
+        ),
+        **common,
     )
 
 
@@ -125,33 +166,36 @@ def _point(xy: Any) -> PointRecord:
 
 def step_record(
     step: int,
-    pose: Pose,
+    pose: Pose | RoverPose,
     *,
     action: int | None,
     state_before: int | None,
     internal_state: int,
     model_version: int,
     no_transition: bool,
-    blocker: Blocker | None,
-) -> StepRecord:
-    """The ``rsstp.Step`` message of step ``step`` ending in the world pose ``pose``.
+    blocker: Blocker | RoverBlocker | None,
+) -> StepRecord | RoverStepRecord:
+    """The step message of step ``step`` ending in the world pose ``pose`` (``rsstp.Step``;
+    a rover's ``rsstp.RoverStep``).
 
     ``action`` and ``state_before`` are None at step 0 (the reset); ``blocker`` is the
     world's answer to the move (None when the arm moved, and at step 0).
     """
-    return StepRecord(
-        step=int(step),
-        agent=AgentRecord(
-            action=None if action is None else int(action),
-            state_before=None if state_before is None else int(state_before),
-            internal_state=int(internal_state),
-            sensation=bool(pose.sensation),
-            feedback=float(pose.feedback),
-            model_version=int(model_version),
-            no_transition=bool(no_transition),
-        ),
-        truth=truth_record(pose, blocker),
+    agent = AgentRecord(
+        action=None if action is None else int(action),
+        state_before=None if state_before is None else int(state_before),
+        internal_state=int(internal_state),
+        sensation=bool(pose.sensation),
+        feedback=float(pose.feedback),
+        model_version=int(model_version),
+        no_transition=bool(no_transition),
     )
+    if isinstance(pose, RoverPose):
+        assert blocker is None or isinstance(blocker, RoverBlocker)
+        truth = rover_truth_record(pose, blocker)
+        return RoverStepRecord(step=int(step), agent=agent, truth=truth)
+    assert not isinstance(blocker, RoverBlocker)  # (an arm's pose: an arm's blocker)
+    return StepRecord(step=int(step), agent=agent, truth=truth_record(pose, blocker))
 
 
 @functools.lru_cache(maxsize=1 << 12)
@@ -177,7 +221,19 @@ def truth_record(pose: Pose, blocker: Blocker | None) -> TruthRecord:
     )
 
 
-def blocked_by_record(blocker: Blocker | None) -> BlockedByRecord | None:
+def rover_truth_record(pose: RoverPose, blocker: RoverBlocker | None) -> RoverTruthRecord:
+    """The truth record of a rover's step ending in ``pose`` (``blocker``: None when it
+    moved)."""
+    return RoverTruthRecord(
+        cell=pose.cell,
+        heading_deg=pose.heading_deg,
+        position=_point(pose.position),
+        blocked=blocker is not None,
+        blocked_by=blocked_by_record(blocker),
+    )
+
+
+def blocked_by_record(blocker: Blocker | RoverBlocker | None) -> BlockedByRecord | None:
     """The record of a :class:`~rsstp_sim.geometry.Blocker` (None stays None)."""
     if blocker is None:
         return None
@@ -216,7 +272,7 @@ def model_record(
     )
 
 
-def blocked_event(step: int, *, action: int, blocker: Blocker) -> EventRecord:
+def blocked_event(step: int, *, action: int, blocker: Blocker | RoverBlocker) -> EventRecord:
     """A ``blocked`` event: ``action`` did not move the arm, because of ``blocker``."""
     by = {"kind": blocker.kind, "indices": [int(i) for i in blocker.indices]}
     return _event(

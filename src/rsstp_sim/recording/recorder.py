@@ -55,17 +55,17 @@ from rsstp_sim.recording.output import SideFileWriter, open_side_file
 from rsstp_sim.recording.schemas import (
     ATTACHMENT_MEDIA_TYPE,
     ATTACHMENT_NAME,
+    BODY_TOPICS,
     METADATA_CHECKSUM_KEY,
     METADATA_KEYS,
     METADATA_NAME,
     SCHEMA_NAMES,
     STEP_NS,
-    TOPICS,
     metadata_checksum,
     schema_bytes,
 )
 from rsstp_sim.recording.step_messages import Block, BlockMessages, StepMessages
-from rsstp_sim.scenario import AnyScenario, Scenario
+from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.strategies import Strategy, strategy_origin
 from rsstp_sim.transition_system import Operation
 
@@ -168,19 +168,14 @@ class Recorder:
     ) -> None:
         if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1024:
             raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
-        if not isinstance(scenario, Scenario):
-            raise RecordingError(
-                f"{scenario.name}: a {scenario.body}'s run cannot be recorded yet: the "
-                "recording format holds an arm's ground truth (joint angles and positions); "
-                "`rsstp-sim run` runs it"
-            )
         self.path = Path(path)
         # What waits for the next step's message to be written, in order: (step, event
         # message) and (step, operations) of a model change, whose message is built when the
         # step is written, since the runner also reports changes made during its own reset,
         # before ``self.runner`` exists.
         self._waiting: list[tuple[int, bytes | tuple[Operation, ...]]] = []
-        self._topics = {t: name for t, name in TOPICS.items() if model or t != "/rsstp/model"}
+        topics = BODY_TOPICS[scenario.body]
+        self._topics = {t: name for t, name in topics.items() if model or t != "/rsstp/model"}
         self.runner = Runner(
             scenario,
             strategy,
@@ -232,7 +227,7 @@ class Recorder:
 
     # -- writing ----------------------------------------------------------------
 
-    def _write_header(self, scenario: Scenario, strategy: Strategy, seed: int) -> None:
+    def _write_header(self, scenario: AnyScenario, strategy: Strategy, seed: int) -> None:
         writer = self._writer
         writer.start(profile="", library=f"rsstp {self._versions['package_version']}")
         self._channels: dict[str, int] = {}

@@ -39,7 +39,7 @@ from typing import Annotated, Any, ClassVar, Literal, Self, TypeVar
 import msgspec
 
 from rsstp_sim.errors import RecordFormatError
-from rsstp_sim.geometry import BlockerKind
+from rsstp_sim.interface import BlockerKind
 from rsstp_sim.scenario import CollisionMode, FeedbackMode
 from rsstp_sim.transition_system import Operation, OperationKind, snapshot_form
 
@@ -53,11 +53,18 @@ __all__ = [
     "ModelRecord",
     "ObstacleRecord",
     "OperationRecord",
+    "DoorRecord",
     "ParamRecord",
     "PointRecord",
     "RECORD_TYPES",
     "RecordFormatError",
+    "RegionRecord",
+    "RoverRecord",
+    "RoverScenarioRecord",
+    "RoverStepRecord",
+    "RoverTruthRecord",
     "ScenarioRecord",
+    "SegmentRecord",
     "StepRecord",
     "StrategyRecord",
     "TransitionsRecord",
@@ -361,21 +368,25 @@ class AgentRecord(_Record, frozen=True, kw_only=True):
 
 
 class BlockedByRecord(_Record, frozen=True, kw_only=True):
-    """Why a move was blocked: ``fold`` ``[joint]``, ``obstacle`` ``[link, obstacle]``,
-    ``links`` ``[link_i, link_j]``."""
+    """Why a move was blocked: an arm's ``fold`` ``[joint]``, ``obstacle`` ``[link,
+    obstacle]``, ``links`` ``[link_i, link_j]``; a rover's ``room`` ``[edge]``, ``obstacle``
+    ``[0, obstacle]``, ``wall`` ``[wall]``, ``door`` ``[door]``."""
 
     kind: Annotated[
         BlockerKind,
         _schema(
-            '"fold": a joint would fold back onto the previous link; "obstacle": a link would '
-            'meet an obstacle; "links": two links would intersect'
+            '"fold": a joint would fold back onto the previous link; "obstacle": a link (the '
+            'rover: the robot) would meet an obstacle; "links": two links would intersect; '
+            '"room": the rover would leave the room; "wall": it would meet a wall; "door": it '
+            "would cross a one-way door the other way"
         ),
     ]
     indices: Annotated[
         tuple[_Id, ...],
         _schema(
-            "fold: [joint]; obstacle: [link, obstacle]; links: [link_i, link_j] with "
-            "link_i < link_j - 1 (0-based indices)",
+            "fold: [joint]; obstacle: [link, obstacle] (the rover: [0, obstacle]); links: "
+            "[link_i, link_j] with link_i < link_j - 1; room: [edge] (0 east, 1 north, 2 west, "
+            "3 south); wall: [wall]; door: [door] (0-based indices)",
             minItems=1,
             maxItems=2,
         ),
@@ -448,6 +459,187 @@ class StepRecord(_Record, frozen=True, kw_only=True):
     step: Annotated[int, _schema("step index t (steps; 0 = the reset)", minimum=0)]
     agent: Annotated[AgentRecord, _schema("what the agent knows after this step")]
     truth: Annotated[TruthRecord, _schema("ground truth after the step (for analysis only)")]
+
+
+# ------------------------------------------------------- rsstp.RoverScenario, RoverStep
+
+
+_Cell = Annotated[
+    tuple[_Id, ...],
+    _schema(
+        "a cell [x, y] of the room's grid (cells; cell [x, y] has its centre at "
+        "(x + 0.5, y + 0.5))",
+        minItems=2,
+        maxItems=2,
+    ),
+]
+
+
+class SegmentRecord(_Record, frozen=True, kw_only=True):
+    """A wall: the segment from ``start`` to ``end`` (length units)."""
+
+    start: Annotated[PointRecord, _schema("one end {x, y} (length units, world frame)")]
+    end: Annotated[PointRecord, _schema("the other end {x, y} (length units, world frame)")]
+
+
+class DoorRecord(_Record, frozen=True, kw_only=True):
+    """A one-way door: a segment crossed only by a move along ``toward``."""
+
+    start: Annotated[PointRecord, _schema("one end {x, y} (length units, world frame)")]
+    end: Annotated[PointRecord, _schema("the other end {x, y} (length units, world frame)")]
+    toward: Annotated[
+        PointRecord,
+        _schema(
+            "the direction {x, y} a move must have a positive component along to cross the "
+            "door; any other move that meets it is blocked"
+        ),
+    ]
+
+
+class RoverRecord(_Record, frozen=True, kw_only=True):
+    """The rover and its room: the grid, the start pose, the turn step, the robot's size,
+    the walls and the one-way doors."""
+
+    room: Annotated[
+        tuple[Annotated[int, _schema(minimum=1)], ...],
+        _schema("the room's width and height (cells, each 1 length unit)", minItems=2, maxItems=2),
+    ]
+    start: Annotated[_Cell, _schema("the start cell [x, y]")]
+    heading_deg: Annotated[
+        int,
+        _schema(
+            "the start heading, counter-clockwise from +x (integer degrees)", minimum=0, maximum=359
+        ),
+    ]
+    turn_deg: Annotated[
+        int,
+        _schema("how far a turn turns the robot (integer degrees: 45 or 90)", enum=[45, 90]),
+    ]
+    radius: Annotated[float, _schema("the robot's radius (length units)", minimum=0)]
+    walls: Annotated[
+        tuple[Annotated[SegmentRecord, _schema("one wall")], ...],
+        _schema("the walls, in scenario order"),
+    ]
+    doors: Annotated[
+        tuple[Annotated[DoorRecord, _schema("one one-way door")], ...],
+        _schema("the one-way doors, in scenario order"),
+    ]
+
+
+class RegionRecord(_Record, frozen=True, kw_only=True):
+    """The rover's feedback region: a disk, and the heading it must face, if any."""
+
+    mode: Annotated[
+        FeedbackMode,
+        _schema(
+            'the observation the scenario intends: "bool" (the sensation) or "float" (the '
+            "feedback value); every step records both"
+        ),
+    ]
+    center: Annotated[PointRecord, _schema("the region's centre {x, y} (length units)")]
+    radius: Annotated[
+        float,
+        _schema(
+            "the region's radius: the sensation is true when the robot's centre is at "
+            "most this far from the region's (length units)",
+            minimum=0,
+        ),
+    ]
+    heading_deg: (
+        Annotated[
+            int,
+            _schema(
+                "the heading the robot must face to sense (integer degrees); absent: any",
+                minimum=0,
+                maximum=359,
+            ),
+        ]
+        | None
+    ) = None
+
+
+class RoverScenarioRecord(_Record, frozen=True, kw_only=True):
+    """``rsstp.RoverScenario`` on ``/rsstp/scenario`` of a rover's run."""
+
+    schema_name: ClassVar[str] = "rsstp.RoverScenario"
+    schema_description: ClassVar[str] = (
+        "The scenario of a rover's run: the room, its walls, doors and obstacles, the feedback "
+        "region, the seed and the strategy. Topic /rsstp/scenario, one message, first in the "
+        "file, log_time 0."
+    )
+
+    name: Annotated[str, _schema("scenario name (no unit)")]
+    description: Annotated[str, _schema("one-line description of the scenario (no unit)")]
+    origin: Annotated[
+        str,
+        _schema(
+            "where the scenario came from: a built-in scenario's name, or the scenario file's "
+            "base name (never a directory: recordings are byte-identical across machines)"
+        ),
+    ]
+    sha256: Annotated[
+        str,
+        _schema(
+            "SHA-256 of the scenario file's text (UTF-8), 64 lowercase hex digits",
+            pattern="^[0-9a-f]{64}$",
+        ),
+    ]
+    rover: Annotated[RoverRecord, _schema("the robot and its room")]
+    actions: Annotated[
+        tuple[Annotated[int, _schema(minimum=0, maximum=3)], ...],
+        _schema(
+            "the actions the agent may take, sorted (0 forward, 1 back, 2 turn left, 3 turn right)",
+            minItems=1,
+        ),
+    ]
+    obstacles: Annotated[
+        tuple[Annotated[ObstacleRecord, _schema("one circular obstacle")], ...],
+        _schema("circular obstacles (closed disks), in scenario order"),
+    ]
+    feedback: Annotated[RegionRecord, _schema("where the robot senses, and how")]
+    seed: Annotated[int, _schema("seed of the run's random generator (integer >= 0)", minimum=0)]
+    strategy: Annotated[StrategyRecord, _schema("the learning strategy of the run")]
+
+
+class RoverTruthRecord(_Record, frozen=True, kw_only=True):
+    """Ground truth of a rover after a step: its cell, heading and position; ``blocked_by``
+    None (absent) when it moved."""
+
+    cell: Annotated[_Cell, _schema("the robot's cell [x, y]")]
+    heading_deg: Annotated[
+        int,
+        _schema(
+            "the robot's heading, counter-clockwise from +x (integer degrees)",
+            minimum=0,
+            maximum=359,
+        ),
+    ]
+    position: Annotated[
+        PointRecord, _schema("the robot's centre {x, y} (length units, world frame)")
+    ]
+    blocked: Annotated[
+        bool,
+        _schema("the move was blocked, so the robot did not move (always false at step 0)"),
+    ]
+    blocked_by: (
+        Annotated[BlockedByRecord, _schema("why the move was blocked; absent when it was not")]
+        | None
+    ) = None
+
+
+class RoverStepRecord(_Record, frozen=True, kw_only=True):
+    """``rsstp.RoverStep`` on ``/rsstp/step`` of a rover's run."""
+
+    schema_name: ClassVar[str] = "rsstp.RoverStep"
+    schema_description: ClassVar[str] = (
+        "One coupled step of a rover. Topic /rsstp/step, one message per step, log_time = "
+        "step * 1_000_000 ns. Step 0 is the reset (no action). `agent` is what the agent "
+        "knows; `truth` is the world's ground truth, which the agent never sees."
+    )
+
+    step: Annotated[int, _schema("step index t (steps; 0 = the reset)", minimum=0)]
+    agent: Annotated[AgentRecord, _schema("what the agent knows after this step")]
+    truth: Annotated[RoverTruthRecord, _schema("ground truth after the step (for analysis only)")]
 
 
 # ------------------------------------------------------------------- rsstp.Model
@@ -750,11 +942,21 @@ class EventRecord(_Record, frozen=True, kw_only=True):
             ) from None
 
 
-MessageRecord = ScenarioRecord | StepRecord | ModelRecord | EventRecord
+MessageRecord = (
+    ScenarioRecord | StepRecord | ModelRecord | EventRecord | RoverScenarioRecord | RoverStepRecord
+)
 """The records that are MCAP messages (one per schema)."""
 
 RECORD_TYPES: dict[str, type[MessageRecord]] = {
-    cls.schema_name: cls for cls in (ScenarioRecord, StepRecord, ModelRecord, EventRecord)
+    cls.schema_name: cls
+    for cls in (
+        ScenarioRecord,
+        StepRecord,
+        ModelRecord,
+        EventRecord,
+        RoverScenarioRecord,
+        RoverStepRecord,
+    )
 }
 """Schema name -> record class."""
 

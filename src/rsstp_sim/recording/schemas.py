@@ -43,6 +43,7 @@ __all__ = [
     "SCHEMA_VERSION",
     "STEP_NS",
     "TOPICS",
+    "BODY_TOPICS",
     "check_schema_version",
     "log_time_ns",
     "metadata_checksum",
@@ -54,19 +55,38 @@ __all__ = [
     "version_refusal",
 ]
 
-SCHEMA_VERSION = "2.2"
+SCHEMA_VERSION = "2.3"
 """The version (``major.minor``) of the schemas this package writes."""
 
-SCHEMA_NAMES = ("rsstp.Scenario", "rsstp.Step", "rsstp.Model", "rsstp.Event")
+SCHEMA_NAMES = (
+    "rsstp.Scenario",
+    "rsstp.Step",
+    "rsstp.Model",
+    "rsstp.Event",
+    "rsstp.RoverScenario",
+    "rsstp.RoverStep",
+)
 """The MCAP schema names, which are also the schemas' titles and file names."""
 
-TOPICS: dict[str, str] = {
-    "/rsstp/scenario": "rsstp.Scenario",
-    "/rsstp/step": "rsstp.Step",
-    "/rsstp/model": "rsstp.Model",
-    "/rsstp/event": "rsstp.Event",
+BODY_TOPICS: dict[str, dict[str, str]] = {
+    "arm": {
+        "/rsstp/scenario": "rsstp.Scenario",
+        "/rsstp/step": "rsstp.Step",
+        "/rsstp/model": "rsstp.Model",
+        "/rsstp/event": "rsstp.Event",
+    },
+    "rover": {
+        "/rsstp/scenario": "rsstp.RoverScenario",
+        "/rsstp/step": "rsstp.RoverStep",
+        "/rsstp/model": "rsstp.Model",
+        "/rsstp/event": "rsstp.Event",
+    },
 }
-"""Topic -> schema name."""
+"""Body -> topic -> schema name: every body has the same topics; the scenario and the step
+messages are its own (its world, its ground truth), the model and the events everyone's."""
+
+TOPICS: dict[str, str] = BODY_TOPICS["arm"]
+"""Topic -> schema name, of an arm's recording."""
 
 MESSAGE_ENCODING = "json"
 SCHEMA_ENCODING = "jsonschema"

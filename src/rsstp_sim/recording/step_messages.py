@@ -142,14 +142,20 @@ class StepMessages:
         """Blocked events given as a blocked step's tail in :class:`Steps` (not by ``then``)."""
 
     def _parts(self, pose: Pose) -> tuple[bytes, bytes, int]:
-        angles, positions, distances = pose.truth_values()
-        if self._truth is None:
-            self._truth = _truth_templates(len(angles), len(distances) // len(angles))
-        texts = encode_json([pose.feedback, *positions, *distances])[1:-1].split(b",")
-        points = 1 + len(positions)
-        before = self._truth[0] % (*angles, *texts[1:points])
-        after = self._truth[1] % tuple(texts[points:])
-        head = _AGENT % (b"true" if pose.sensation else b"false", texts[0])
+        own = getattr(pose, "truth_json", None)  # a body whose pose writes its own truth
+        if own is not None:
+            before, after = own()
+            feedback = encode_json(pose.feedback)
+        else:  # the arm: numbers into templates, one encoder call a pose
+            angles, positions, distances = pose.truth_values()
+            if self._truth is None:
+                self._truth = _truth_templates(len(angles), len(distances) // len(angles))
+            texts = encode_json([pose.feedback, *positions, *distances])[1:-1].split(b",")
+            points = 1 + len(positions)
+            before = self._truth[0] % (*angles, *texts[1:points])
+            after = self._truth[1] % tuple(texts[points:])
+            feedback = texts[0]
+        head = _AGENT % (b"true" if pose.sensation else b"false", feedback)
         moved = b"".join((_MOVED, before, _UNBLOCKED, after, b"}}"))
         parts = (head, moved, len(_MOVED) + len(before))
         if self._room > 0:  # bounded: many obstacles, long runs

@@ -39,6 +39,25 @@ class _Rover:
     def world(self, scenario: RoverScenario) -> RoverWorld:
         return RoverWorld(scenario)
 
+    def describe(self, scenario: RoverScenario) -> list[str]:
+        s = scenario
+        names = ", ".join(f"{a} {ACTION_NAMES[a]}" for a in s.actions)
+        obstacles = "; ".join(
+            f"centre ({o.center[0]:g}, {o.center[1]:g}) radius {o.radius:g}" for o in s.obstacles
+        )
+        heading = (
+            "" if s.feedback_heading is None else f", facing {s.feedback_heading * s.turn_deg} deg"
+        )
+        return [
+            f"  rover: a {s.room[0]} x {s.room[1]} room, start cell {list(s.start)} facing "
+            f"{s.start_heading * s.turn_deg} deg; turns of {s.turn_deg} deg; radius "
+            f"{s.robot_radius:g}; actions {names}",
+            f"  walls: {len(s.walls)}; one-way doors: {len(s.doors)}; obstacles: "
+            f"{len(s.obstacles)}" + (f": {obstacles}" if obstacles else ""),
+            f"  feedback: {s.feedback_mode} (region centre ({s.feedback_center[0]:g}, "
+            f"{s.feedback_center[1]:g}) radius {s.feedback_radius:g}{heading})",
+        ]
+
     def warnings(self, scenario: RoverScenario) -> list[str]:
         """A feedback region no reachable pose senses."""
         machine = self.machine(scenario)

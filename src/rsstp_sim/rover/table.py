@@ -19,11 +19,10 @@ import numpy as np
 from rsstp_sim._arrays import BoolArray, FloatArray, IntArray
 from rsstp_sim.rover.scenario import Door, RoverScenario, Wall
 
-__all__ = ["ROVER_BLOCKER_KINDS", "RoverTable", "headings_xy", "segment_distance"]
+__all__ = ["ROOM_EDGES", "RoverTable", "cell_clearance", "headings_xy", "segment_distance"]
 
-ROVER_BLOCKER_KINDS = ("room", "obstacle", "wall", "door")
-"""What blocks a rover's move; blocker code 0 is a free move, 1 the room's edge, then one
-code per obstacle, wall and door in the scenario's order."""
+ROOM_EDGES = 4
+"""Blocker codes 1 to 4 are the room's edges: east (x = width), north, west, south."""
 
 
 def headings_xy(turn_deg: int) -> IntArray:
@@ -96,8 +95,11 @@ class RoverTable:
                 dx, dy = sign * steps[heading, 0], sign * steps[heading, 1]
                 tx, ty = x + dx, y + dy
                 code = _move_blocker(scenario, centers, dx, dy)
-                outside = (tx < 0) | (tx >= width) | (ty < 0) | (ty >= height)
-                code[outside] = 1
+                # The room's edge it would cross comes first (at a corner, east or west).
+                edge = np.select(
+                    [tx >= width, tx < 0, ty >= height, ty < 0], [1, 3, 2, 4], default=0
+                )
+                code = np.where(edge > 0, edge, code)
                 moved = code == 0
                 next_code[:, k] = np.where(moved, codes + dx + width * dy, codes)
                 blocker[:, k] = code
@@ -155,7 +157,7 @@ def _move_blocker(
     p = centers
     q = np.stack([centers[0] + dx, centers[1] + dy])
     code = np.zeros(centers.shape[1], np.int64)
-    base = 2
+    base = 1 + ROOM_EDGES
     for j, obstacle in enumerate(scenario.obstacles):
         centre = np.array(obstacle.center)
         met = _point_segment(centre[0], centre[1], p, q) <= obstacle.radius + r

@@ -2,32 +2,39 @@
 
 from __future__ import annotations
 
+import json
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
+from rsstp_sim._arrays import IntArray
 from rsstp_sim.errors import ActionError
+from rsstp_sim.interface import BlockerKind
 from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario
-from rsstp_sim.rover.table import ROVER_BLOCKER_KINDS, RoverTable
+from rsstp_sim.rover.table import ROOM_EDGES, RoverTable
 
 __all__ = ["RoverBlocker", "RoverPose", "RoverWorld"]
 
 
 @dataclass(frozen=True, slots=True)
 class RoverBlocker:
-    """Why a rover's move was blocked: ``kind`` one of ``room``, ``obstacle``, ``wall``,
-    ``door``; ``indices`` the obstacle's, wall's or door's number in the scenario (empty for
-    the room's edge)."""
+    """Why a rover's move was blocked (:data:`~rsstp_sim.interface.BlockerKind`): ``room``
+    ``(edge,)`` (0 east, 1 north, 2 west, 3 south), ``obstacle`` ``(0, j)`` (the robot, part 0
+    of its body, meets obstacle ``j``), ``wall`` ``(w,)``, ``door`` ``(d,)``."""
 
-    kind: str
+    kind: BlockerKind
     indices: tuple[int, ...]
 
     def describe(self) -> str:
         if self.kind == "room":
-            return "the robot would leave the room"
+            edge = ("east", "north", "west", "south")[self.indices[0]]
+            return f"the robot would leave the room by its {edge} edge"
         if self.kind == "door":
             return f"door {self.indices[0]} is one-way, the other way"
-        return f"the robot meets {self.kind} {self.indices[0]}"
+        if self.kind == "obstacle":
+            return f"the robot meets obstacle {self.indices[1]}"
+        return f"the robot meets wall {self.indices[0]}"
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,6 +50,16 @@ class RoverPose:
     @property
     def position(self) -> tuple[float, float]:
         return (self.cell[0] + 0.5, self.cell[1] + 0.5)
+
+    def truth_json(self) -> tuple[bytes, bytes]:
+        """The pose's members of its ``rsstp.RoverStep`` truth (JSON, keys in schema order),
+        before its ``blocked`` field and after it (nothing): what a step's message repeats
+        at every visit."""
+        x, y = json.dumps(self.position)[1:-1].encode().split(b", ")  # (shortest reprs)
+        before = b'"cell":[%d,%d],"heading_deg":%d,"position":{"x":%b,"y":%b},' % (
+            self.cell[0], self.cell[1], self.heading_deg, x, y,
+        )  # fmt: skip
+        return before, b""
 
 
 class RoverWorld:
@@ -98,21 +115,42 @@ class RoverWorld:
         self.last_blocker = self.blocker_of(blocker_code) if blocker_code else None
         return self.last_blocker
 
+    def walk(self, actions: Sequence[int]) -> tuple[IntArray, IntArray]:
+        """Take ``actions`` in order (as :meth:`move` does); the pose code after each move and
+        each move's blocker code (0: it moved; :meth:`blocker_of` decodes one)."""
+        index, nxt, blocker, width = self._index, self._next, self._blocker_codes, self._n_actions
+        codes: list[int] = []
+        blocked: list[int] = []
+        code = self._code
+        for action in actions:
+            k = index.get(action) if action.__class__ is not bool else None
+            if k is None:
+                self.move(action)  # (raises the one-line ActionError)
+            at = code * width + k  # type: ignore[operator]  # (k is not None here)
+            code = nxt[at]
+            codes.append(code)
+            blocked.append(blocker[at])
+        self._code = code
+        self._pose = self.pose(code)
+        self.last_blocker = self.blocker_of(blocked[-1]) if blocked else None
+        return np.array(codes, np.int64), np.array(blocked, np.int64)
+
     def blocker_of(self, blocker_code: int) -> RoverBlocker | None:
         """The :class:`RoverBlocker` of a blocker code (None for 0: it moved)."""
         if not blocker_code:
             return None
-        if blocker_code == 1:
-            return RoverBlocker("room", ())
+        if blocker_code <= ROOM_EDGES:
+            return RoverBlocker("room", (blocker_code - 1,))
         s = self.scenario
-        index = blocker_code - 2
-        kinds = zip(ROVER_BLOCKER_KINDS[1:], (s.obstacles, s.walls, s.doors), strict=True)
-        for kind, items in kinds:
-            if index < len(items) or kind == "door":
-                assert index < len(items), f"no blocker has code {blocker_code}"  # (the table's)
-                return RoverBlocker(kind, (index,))
-            index -= len(items)
-        return None  # pragma: no cover - the loop ends at the doors
+        index = blocker_code - 1 - ROOM_EDGES
+        if index < len(s.obstacles):
+            return RoverBlocker("obstacle", (0, index))
+        index -= len(s.obstacles)
+        if index < len(s.walls):
+            return RoverBlocker("wall", (index,))
+        index -= len(s.walls)
+        assert index < len(s.doors), f"no blocker has code {blocker_code}"  # (the table's own)
+        return RoverBlocker("door", (index,))
 
     @property
     def current(self) -> RoverPose:
