@@ -2,25 +2,34 @@
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import random
 import subprocess
 import sys
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 import shapely
 
 from builtin_worlds import builtins_of
+from rsstp_replay import errors, open_recording
 from rsstp_sim import ArmEnv, Runner, make_strategy
 from rsstp_sim.bodies import body_of, make_world
 from rsstp_sim.errors import ActionError, EnvError, ScenarioError
+from rsstp_sim.recording.recorder import record
+from rsstp_sim.recording.schemas import SCHEMA_VERSION, STEP_NS
 from rsstp_sim.rover import RoverScenario, RoverWorld
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.truth import compute_truth
 from waiting import HANG_S
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "replay"))
+from test_corrupt import rewrite  # noqa: E402
 
 SRC = Path(__file__).resolve().parents[2] / "src"
 
@@ -245,3 +254,91 @@ def test_run_and_truth_take_a_rover_scenario(tmp_path: Path) -> None:
 def test_a_rover_has_no_gymnasium_env_yet_in_one_line() -> None:
     with pytest.raises(EnvError, match=r"^rover-room: a rover has no Gymnasium env yet"):
         ArmEnv(scenario="rover-room")
+
+
+# -- a rover's recording ------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def rover_recording(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("rover") / "walk.mcap"
+    record(path, load_scenario("rover-two-rooms"), make_strategy("random"), steps=4000, seed=5)
+    return path
+
+
+def _walk(scenario: RoverScenario, actions: list[int]) -> list[tuple[int, int, int, str | None]]:
+    """Cell, heading and blocker kind after each action, by :func:`_reference_move` (shapely),
+    from the start: step 0 first."""
+    x, y = scenario.start
+    heading = scenario.start_heading
+    out: list[tuple[int, int, int, str | None]] = [(x, y, heading * scenario.turn_deg, None)]
+    for action in actions:
+        (x, y, heading), blocker = _reference_move(scenario, x, y, heading, action)
+        out.append((x, y, heading * scenario.turn_deg, None if blocker is None else blocker[0]))
+    return out
+
+
+def test_a_rover_recording_reads_back_as_the_world_walked_it(rover_recording: Path) -> None:
+    scenario = load_scenario("rover-two-rooms")
+    assert isinstance(scenario, RoverScenario)
+    with open_recording(rover_recording) as recording:
+        assert recording.scenario == scenario
+        assert recording.schema_versions["rsstp.RoverStep"] == SCHEMA_VERSION
+        steps = recording.steps()
+        events = recording.events()
+    actions = steps["action"].iloc[1:].astype(int).tolist()
+    walked = _walk(scenario, actions)
+    assert steps[["cell_x", "cell_y", "heading_deg"]].to_numpy().tolist() == [
+        list(w[:3]) for w in walked
+    ]
+    kinds = [None if pd.isna(k) else k for k in steps["blocked_kind"]]
+    assert kinds == [w[3] for w in walked]
+    assert (steps["x"] == steps["cell_x"] + 0.5).all() and (
+        steps["y"] == steps["cell_y"] + 0.5
+    ).all()
+    assert set(kinds) >= {None, "room"}
+    blocked = events.loc[events["kind"] == "blocked", "step"].tolist()
+    assert blocked == [t for t, w in enumerate(walked) if w[3] is not None]
+
+
+def test_the_commands_audit_table_and_check_a_rover_recording(
+    rover_recording: Path, tmp_path: Path
+) -> None:
+    from rsstp_cli.replay import main
+
+    assert main(["check", str(rover_recording), "--physics"]) == 0
+    assert main(["audit", "--truth", "--json", str(rover_recording)]) == 0
+    table = tmp_path / "steps.parquet"
+    assert main(["table", str(rover_recording), "--truth", "-o", str(table)]) == 0
+    frame = pd.read_parquet(table)
+    truth = compute_truth(load_scenario("rover-two-rooms"))
+    expected = truth.classes_of(frame[["cell_x", "cell_y", "heading_deg"]].to_numpy())
+    assert frame["true_class"].tolist() == expected.tolist()
+
+
+def test_a_rover_step_moved_by_hand_is_named_by_the_physics_check(
+    rover_recording: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from rsstp_cli.replay import main
+
+    def moved(topic: str, log_time: int, data: bytes) -> bytes:
+        if topic == "/rsstp/step" and log_time == 700 * STEP_NS:
+            value = json.loads(data)
+            value["truth"]["heading_deg"] = (value["truth"]["heading_deg"] + 90) % 360
+            return json.dumps(value, separators=(",", ":")).encode()
+        return data
+
+    bad = rewrite(rover_recording, tmp_path / "moved.mcap", message=moved)
+    capsys.readouterr()
+    assert main(["check", str(bad), "--physics"]) == 1
+    out = capsys.readouterr().out
+    assert "physics: broken at step 700, truth.heading_deg: recorded" in out
+
+
+def test_a_rover_scenario_under_an_arm_message_is_refused_in_one_line(
+    rover_recording: Path, tmp_path: Path
+) -> None:
+    arm = (resources.files("rsstp_sim.scenarios") / "two-joint-30.toml").read_bytes()
+    bad = rewrite(rover_recording, tmp_path / "swapped.mcap", attachment=lambda data: arm)
+    with pytest.raises(errors.CorruptRecording, match=r"hashes to"):
+        open_recording(bad)
