@@ -342,3 +342,24 @@ def test_a_rover_scenario_under_an_arm_message_is_refused_in_one_line(
     bad = rewrite(rover_recording, tmp_path / "swapped.mcap", attachment=lambda data: arm)
     with pytest.raises(errors.CorruptRecording, match=r"hashes to"):
         open_recording(bad)
+
+
+@pytest.mark.slow
+def test_a_sweep_runs_rover_worlds_and_each_recording_is_the_one_record_writes(
+    tmp_path: Path,
+) -> None:
+    (tmp_path / "rover.toml").write_text(
+        'steps = 500\nseeds = 2\nscenarios = ["rover-one-way"]\n[[strategy]]\nname = "random"\n'
+    )
+    out = tmp_path / "out"
+    done = _sim("sweep", str(tmp_path / "rover.toml"), "-o", str(out), "--workers", "2", "--quiet")
+    assert done.returncode == 0, done.stderr
+    runs = pd.read_parquet(out / "runs.parquet")
+    assert list(runs["status"]) == ["done", "done"]
+    assert (runs["minimal_states"] == compute_truth(load_scenario("rover-one-way")).n_classes).all()
+    for row in runs.itertuples():
+        alone = tmp_path / f"{row.run}.mcap"
+        record(
+            alone, load_scenario("rover-one-way"), make_strategy("random"), steps=500, seed=row.seed
+        )
+        assert alone.read_bytes() == (out / row.recording).read_bytes()
