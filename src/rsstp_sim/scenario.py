@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, ClassVar, Literal, TypeAlias
 
 from rsstp_sim import geometry
+from rsstp_sim._validation import MISSING, KeyedValidator
 from rsstp_sim.bodies import BODIES, body_named
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.files import irregular
@@ -190,26 +191,10 @@ def parse_arm(data: Mapping[str, object], text: str, origin: str) -> Scenario:
     return _Validator(origin).scenario(data, text)
 
 
-class _Validator:
-    def __init__(self, origin: str) -> None:
-        self.origin = origin
-
-    def fail(self, key: str, expected: str, found: object) -> ScenarioError:
-        shown = "missing" if found is _MISSING else f"found {found!r}"
-        return ScenarioError(f"{self.origin}: {key}: expected {expected}, {shown}")
-
-    def unknown_keys(
-        self, table: Mapping[str, object], allowed: frozenset[str], where: str
-    ) -> None:
-        for key in sorted(set(table) - allowed):
-            path = f"{where}.{key}" if where else key
-            raise ScenarioError(
-                f"{self.origin}: {path}: unknown key (allowed: {', '.join(sorted(allowed))})"
-            )
-
+class _Validator(KeyedValidator):
     def table(self, data: Mapping[str, object], key: str, *, required: bool) -> dict[str, object]:
-        value = data.get(key, _MISSING)
-        if value is _MISSING and not required:
+        value = data.get(key, MISSING)
+        if value is MISSING and not required:
             return {}
         if not isinstance(value, dict):
             raise self.fail(f"[{key}]", "a table", value)
@@ -256,18 +241,18 @@ class _Validator:
     def scenario(self, data: Mapping[str, object], text: str) -> Scenario:
         self.unknown_keys(data, _TOP_LEVEL, "")
         arm = self.table(data, "arm", required=True)
-        lengths_raw = self.array(arm.get("lengths", _MISSING), "arm.lengths")
+        lengths_raw = self.array(arm.get("lengths", MISSING), "arm.lengths")
         lengths = tuple(
             self.number(v, f"arm.lengths[{i}]", positive=True) for i, v in enumerate(lengths_raw)
         )
         n = len(lengths)
         if n > MAX_JOINTS:
             raise self.fail("arm.lengths", f"at most {MAX_JOINTS} links", f"{n} items")
-        initial_raw = self.array(arm.get("initial_deg", _MISSING), "arm.initial_deg", length=n)
+        initial_raw = self.array(arm.get("initial_deg", MISSING), "arm.initial_deg", length=n)
         initial = tuple(
             self.integer(v, f"arm.initial_deg[{i}]") % 360 for i, v in enumerate(initial_raw)
         )
-        step = self.integer(arm.get("step_deg", _MISSING), "arm.step_deg", low=1, high=359)
+        step = self.integer(arm.get("step_deg", MISSING), "arm.step_deg", low=1, high=359)
         if "actions" in arm:
             actions_raw = self.array(arm["actions"], "arm.actions")
             actions = tuple(
@@ -294,8 +279,8 @@ class _Validator:
             if not isinstance(entry, dict):
                 raise self.fail(where, "a table with center and radius", entry)
             self.unknown_keys(entry, _OBSTACLE_KEYS, where)
-            center = self.point(entry.get("center", _MISSING), f"{where}.center")
-            radius = self.number(entry.get("radius", _MISSING), f"{where}.radius", positive=True)
+            center = self.point(entry.get("center", MISSING), f"{where}.center")
+            radius = self.number(entry.get("radius", MISSING), f"{where}.radius", positive=True)
             obstacles.append(Obstacle(center, radius))
 
         feedback = self.table(data, "feedback", required=False)
@@ -361,11 +346,3 @@ class _Validator:
                 f"({blocker.describe()})"
             )
         return scenario
-
-
-class _Missing:
-    def __repr__(self) -> str:
-        return "missing"
-
-
-_MISSING: object = _Missing()

@@ -243,6 +243,28 @@ class StrategyRecord(_Record, frozen=True, kw_only=True):
         return {p.name: _DECODE_JSON(p.value) for p in self.params}
 
 
+_ScenarioName = Annotated[str, _schema("scenario name (no unit)")]
+_ScenarioDescription = Annotated[str, _schema("one-line description of the scenario (no unit)")]
+_ScenarioOrigin = Annotated[
+    str,
+    _schema(
+        "where the scenario came from: a built-in scenario's name, or the scenario file's "
+        "base name (never a directory: recordings are byte-identical across machines)"
+    ),
+]
+_ScenarioSha256 = Annotated[
+    str,
+    _schema(
+        "SHA-256 of the scenario file's text (UTF-8), 64 lowercase hex digits",
+        pattern="^[0-9a-f]{64}$",
+    ),
+]
+_Seed = Annotated[int, _schema("seed of the run's random generator (integer >= 0)", minimum=0)]
+_Strategy = Annotated[StrategyRecord, _schema("the learning strategy of the run")]
+"""The fields every body's scenario message has, defined once (``rsstp.Scenario``,
+``rsstp.RoverScenario``)."""
+
+
 class ScenarioRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Scenario`` on ``/rsstp/scenario``: the run's world, seed and strategy."""
 
@@ -252,22 +274,10 @@ class ScenarioRecord(_Record, frozen=True, kw_only=True):
         "strategy. Topic /rsstp/scenario, one message, first in the file, log_time 0."
     )
 
-    name: Annotated[str, _schema("scenario name (no unit)")]
-    description: Annotated[str, _schema("one-line description of the scenario (no unit)")]
-    origin: Annotated[
-        str,
-        _schema(
-            "where the scenario came from: a built-in scenario's name, or the scenario file's "
-            "base name (never a directory: recordings are byte-identical across machines)"
-        ),
-    ]
-    sha256: Annotated[
-        str,
-        _schema(
-            "SHA-256 of the scenario file's text (UTF-8), 64 lowercase hex digits",
-            pattern="^[0-9a-f]{64}$",
-        ),
-    ]
+    name: _ScenarioName
+    description: _ScenarioDescription
+    origin: _ScenarioOrigin
+    sha256: _ScenarioSha256
     n_joints: Annotated[int, _schema("number of joints n, one link per joint (count)", minimum=1)]
     lengths: Annotated[
         tuple[Annotated[float, _schema(exclusiveMinimum=0)], ...],
@@ -309,8 +319,8 @@ class ScenarioRecord(_Record, frozen=True, kw_only=True):
             "the end pose is checked, as in the thesis)"
         ),
     ]
-    seed: Annotated[int, _schema("seed of the run's random generator (integer >= 0)", minimum=0)]
-    strategy: Annotated[StrategyRecord, _schema("the learning strategy of the run")]
+    seed: _Seed
+    strategy: _Strategy
 
 
 # -------------------------------------------------------------------- rsstp.Step
@@ -568,22 +578,10 @@ class RoverScenarioRecord(_Record, frozen=True, kw_only=True):
         "file, log_time 0."
     )
 
-    name: Annotated[str, _schema("scenario name (no unit)")]
-    description: Annotated[str, _schema("one-line description of the scenario (no unit)")]
-    origin: Annotated[
-        str,
-        _schema(
-            "where the scenario came from: a built-in scenario's name, or the scenario file's "
-            "base name (never a directory: recordings are byte-identical across machines)"
-        ),
-    ]
-    sha256: Annotated[
-        str,
-        _schema(
-            "SHA-256 of the scenario file's text (UTF-8), 64 lowercase hex digits",
-            pattern="^[0-9a-f]{64}$",
-        ),
-    ]
+    name: _ScenarioName
+    description: _ScenarioDescription
+    origin: _ScenarioOrigin
+    sha256: _ScenarioSha256
     rover: Annotated[RoverRecord, _schema("the robot and its room")]
     actions: Annotated[
         tuple[Annotated[int, _schema(minimum=0, maximum=3)], ...],
@@ -597,8 +595,8 @@ class RoverScenarioRecord(_Record, frozen=True, kw_only=True):
         _schema("circular obstacles (closed disks), in scenario order"),
     ]
     feedback: Annotated[RegionRecord, _schema("where the robot senses, and how")]
-    seed: Annotated[int, _schema("seed of the run's random generator (integer >= 0)", minimum=0)]
-    strategy: Annotated[StrategyRecord, _schema("the learning strategy of the run")]
+    seed: _Seed
+    strategy: _Strategy
 
 
 class RoverTruthRecord(_Record, frozen=True, kw_only=True):

@@ -38,7 +38,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import ClassVar, Literal
 
-from rsstp_sim.errors import ScenarioError
+from rsstp_sim._validation import MISSING, KeyedValidator
 
 __all__ = ["ACTION_NAMES", "MAX_ROOM", "Door", "RoverScenario", "Wall", "parse_rover"]
 
@@ -123,21 +123,7 @@ def parse_rover(data: Mapping[str, object], text: str, origin: str) -> RoverScen
     return _Validator(origin).scenario(data, text)
 
 
-class _Validator:
-    def __init__(self, origin: str) -> None:
-        self.origin = origin
-
-    def fail(self, key: str, expected: str, found: object) -> ScenarioError:
-        shown = "missing" if found is None else f"found {found!r}"
-        return ScenarioError(f"{self.origin}: {key}: expected {expected}, {shown}")
-
-    def known(self, table: Mapping[str, object], allowed: frozenset[str], where: str) -> None:
-        for key in sorted(set(table) - allowed):
-            path = f"{where}.{key}" if where else key
-            raise ScenarioError(
-                f"{self.origin}: {path}: unknown key (allowed: {', '.join(sorted(allowed))})"
-            )
-
+class _Validator(KeyedValidator):
     def integer(self, value: object, key: str, low: int, high: int) -> int:
         if isinstance(value, bool) or not isinstance(value, int) or not low <= value <= high:
             raise self.fail(key, f"an integer in {low}..{high}", value)
@@ -170,21 +156,21 @@ class _Validator:
         if len(raw) > MAX_ITEMS:
             raise self.fail(key, f"at most {MAX_ITEMS:,} tables", f"{len(raw):,}")
         for i, item in enumerate(raw):
-            self.known(item, keys, f"{key}[{i}]")
+            self.unknown_keys(item, keys, f"{key}[{i}]")
         return raw
 
     def scenario(self, data: Mapping[str, object], text: str) -> RoverScenario:
-        self.known(data, _TOP_LEVEL, "")
+        self.unknown_keys(data, _TOP_LEVEL, "")
         rover = data["rover"]
         if not isinstance(rover, dict):
             raise self.fail("[rover]", "a table", rover)
-        self.known(rover, _ROVER_KEYS, "rover")
-        width_raw, height_raw = self.pair(rover.get("room"), "rover.room")
+        self.unknown_keys(rover, _ROVER_KEYS, "rover")
+        width_raw, height_raw = self.pair(rover.get("room", MISSING), "rover.room")
         room = (
             self.integer(width_raw, "rover.room[0]", 1, MAX_ROOM),
             self.integer(height_raw, "rover.room[1]", 1, MAX_ROOM),
         )
-        x_raw, y_raw = self.pair(rover.get("start"), "rover.start")
+        x_raw, y_raw = self.pair(rover.get("start", MISSING), "rover.start")
         start = (
             self.integer(x_raw, "rover.start[0]", 0, room[0] - 1),
             self.integer(y_raw, "rover.start[1]", 0, room[1] - 1),
@@ -208,27 +194,29 @@ class _Validator:
 
         walls = tuple(
             Wall(
-                self.point(w.get("from"), f"walls[{i}].from"),
-                self.point(w.get("to"), f"walls[{i}].to"),
+                self.point(w.get("from", MISSING), f"walls[{i}].from"),
+                self.point(w.get("to", MISSING), f"walls[{i}].to"),
             )
             for i, w in enumerate(self.items(data, "walls", frozenset({"from", "to"})))
         )
         doors = []
         for i, d in enumerate(self.items(data, "doors", frozenset({"from", "to", "toward"}))):
-            toward = self.point(d.get("toward"), f"doors[{i}].toward")
+            toward = self.point(d.get("toward", MISSING), f"doors[{i}].toward")
             if toward == (0.0, 0.0):
                 raise self.fail(f"doors[{i}].toward", "a direction other than [0, 0]", [0, 0])
             doors.append(
                 Door(
-                    self.point(d.get("from"), f"doors[{i}].from"),
-                    self.point(d.get("to"), f"doors[{i}].to"),
+                    self.point(d.get("from", MISSING), f"doors[{i}].from"),
+                    self.point(d.get("to", MISSING), f"doors[{i}].to"),
                     toward,
                 )
             )
         obstacles = tuple(
             RoverObstacle(
-                self.point(o.get("center"), f"obstacles[{i}].center"),
-                self.number(o.get("radius"), f"obstacles[{i}].radius", 1e-9, _MAX_MAGNITUDE),
+                self.point(o.get("center", MISSING), f"obstacles[{i}].center"),
+                self.number(
+                    o.get("radius", MISSING), f"obstacles[{i}].radius", 1e-9, _MAX_MAGNITUDE
+                ),
             )
             for i, o in enumerate(self.items(data, "obstacles", frozenset({"center", "radius"})))
         )
@@ -236,7 +224,7 @@ class _Validator:
         feedback = data.get("feedback", {})
         if not isinstance(feedback, dict):
             raise self.fail("[feedback]", "a table", feedback)
-        self.known(feedback, _FEEDBACK_KEYS, "feedback")
+        self.unknown_keys(feedback, _FEEDBACK_KEYS, "feedback")
         center = (
             self.point(feedback["center"], "feedback.center")
             if "center" in feedback
