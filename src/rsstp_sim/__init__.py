@@ -7,7 +7,7 @@ them one step at a time with one seeded generator per run.
 """
 
 from rsstp_sim.coupling import Event, Runner, RunSummary, StepOutcome
-from rsstp_sim.env import ArmEnv, register_envs
+from rsstp_sim.env import ArmEnv, RoverEnv, register_envs
 from rsstp_sim.errors import (
     ActionError,
     GraphvizFailed,
@@ -67,6 +67,7 @@ __all__ = [
     "Pose",
     "RandomStrategy",
     "RecordingError",
+    "RoverEnv",
     "RsstpError",
     "RunSummary",
     "Runner",

@@ -27,18 +27,21 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec
 from numpy.typing import NDArray
 
-from rsstp_sim import palette
+from rsstp_sim.bodies import body_of
 from rsstp_sim.errors import ActionError, EnvError
-from rsstp_sim.geometry import Blocker
+from rsstp_sim.interface import Blocker
+from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import Scenario, load_scenario
-from rsstp_sim.world import Pose, World
 
-__all__ = ["ENV_ID", "MAX_EPISODE_STEPS", "ArmEnv", "register_envs"]
+__all__ = ["ENV_ID", "MAX_EPISODE_STEPS", "ROVER_ENV_ID", "ArmEnv", "RoverEnv", "register_envs"]
 
 ENV_ID = "rsstp/Arm-v0"
 """The id under which :func:`register_envs` registers :class:`ArmEnv`."""
 
 _ENTRY_POINT = "rsstp_sim.env:ArmEnv"
+ROVER_ENV_ID = "rsstp/Rover-v0"
+"""The id under which :func:`register_envs` registers :class:`RoverEnv`."""
+_ROVER_ENTRY_POINT = "rsstp_sim.env:RoverEnv"
 MAX_EPISODE_STEPS = 1000
 """The time limit ``gymnasium.make(ENV_ID)`` puts on an episode (steps)."""
 _REWARDS = ("none", "sensation")
@@ -135,10 +138,11 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 10}
+    env_id: str = ENV_ID
 
     def __init__(
         self,
-        scenario: Scenario | str | Path = "three-joint",
+        scenario: Scenario | RoverScenario | str | Path = "three-joint",
         *,
         render_mode: str | None = None,
         reward: str = "none",
@@ -155,15 +159,13 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
             raise EnvError(f"step_cost must be a number, got {step_cost!r}")
         self._reward = reward
         self._step_cost = float(step_cost)
-        loaded = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
-        if not isinstance(loaded, Scenario):
-            raise EnvError(
-                f"{loaded.name}: a {loaded.body} has no Gymnasium env yet (its observation and "
-                "drawing are the arm's); the Runner runs it"
-            )
+        loaded = (
+            scenario if isinstance(scenario, Scenario | RoverScenario) else load_scenario(scenario)
+        )
         self.scenario = loaded
         self.render_mode = render_mode
-        self.world = World(self.scenario)
+        self._body = body_of(loaded)
+        self.world = self._body.world(loaded)
         self._actions = self.scenario.actions
         self.action_space = spaces.Discrete(len(self._actions))
         self._float_mode = self.scenario.feedback_mode == "float"
@@ -174,7 +176,7 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
         )
         self.observation_space = observation_space
         self.spec = EnvSpec(
-            id=ENV_ID,
+            id=self.env_id,
             entry_point=_ENTRY_POINT,
             kwargs={
                 "scenario": scenario,
@@ -184,7 +186,7 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
             },
         )
         self._last_blocker: Blocker | None = None
-        self._canvas: _Canvas | None = None
+        self._picture: Any = None
 
     # -- the Gymnasium interface -------------------------------------------------------
 
@@ -214,9 +216,12 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
         """The current picture (``rgb_array`` mode), or ``None`` without a render mode."""
         if self.render_mode is None:
             return None
-        if self._canvas is None:
-            self._canvas = _Canvas(self.scenario)
-        return self._canvas.draw(self.world.joint_positions, blocked=self._last_blocker is not None)
+        if self._picture is None:
+            self._picture = self._body.picture(self.scenario)
+        frame: NDArray[np.uint8] = self._picture.draw(
+            self.world, blocked=self._last_blocker is not None
+        )
+        return frame
 
     # -- helpers -------------------------------------------------------------------------
 
@@ -238,116 +243,53 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
             )
         return index
 
-    def _observe(self, pose: Pose) -> ArmObs:
+    def _observe(self, pose: Any) -> ArmObs:
         if self._float_mode:
             return np.array([min(max(pose.feedback, 0.0), 1.0)], dtype=np.float32)
         return int(pose.sensation)
 
-    @staticmethod
-    def _info(pose: Pose, action: int | None, blocker: Blocker | None) -> dict[str, Any]:
+    def _info(self, pose: Any, action: int | None, blocker: Any) -> dict[str, Any]:
         return {
-            "angles_deg": pose.angles_deg,
-            "joint_positions": pose.joint_positions.copy(),
+            **self._body.pose_info(pose),
+            "pose_code": pose.code,
             "blocked": blocker is not None,
             "blocked_by": None if blocker is None else blocker.describe(),
-            "distances": pose.distances.copy(),
             "sensation": pose.sensation,
             "feedback": pose.feedback,
             "action": action,
         }
 
 
+class RoverEnv(ArmEnv):
+    """The rover (the second body, ``docs/scenarios.md``) as a Gymnasium environment: the same
+    spaces, rewards and episodes as :class:`ArmEnv`, its actions 0 forward, 1 back, 2 turn
+    left, 3 turn right, and its ``info`` the rover's ground truth: ``cell`` ``(x, y)``,
+    ``heading_deg``, ``position`` (the cell's centre, length units), with ``pose_code``,
+    ``blocked``, ``blocked_by``, ``sensation``, ``feedback`` and ``action`` as every body's.
+    ``gymnasium.make("rsstp/Rover-v0")`` builds it (default scenario ``rover-room``)."""
+
+    env_id = ROVER_ENV_ID
+
+    def __init__(
+        self,
+        scenario: Scenario | RoverScenario | str | Path = "rover-room",
+        *,
+        render_mode: str | None = None,
+        reward: str = "none",
+        step_cost: float = 0.0,
+    ) -> None:
+        super().__init__(scenario, render_mode=render_mode, reward=reward, step_cost=step_cost)
+
+
 def register_envs() -> None:
-    """Register :class:`ArmEnv` as ``rsstp/Arm-v0`` with Gymnasium (idempotent), with a
-    :data:`MAX_EPISODE_STEPS` time limit."""
-    if ENV_ID not in gymnasium.registry:
-        gymnasium.register(id=ENV_ID, entry_point=_ENTRY_POINT, max_episode_steps=MAX_EPISODE_STEPS)
+    """Register :class:`ArmEnv` as ``rsstp/Arm-v0`` and :class:`RoverEnv` as
+    ``rsstp/Rover-v0`` with Gymnasium (idempotent), with a :data:`MAX_EPISODE_STEPS` time
+    limit."""
+    for env_id, entry_point in ((ENV_ID, _ENTRY_POINT), (ROVER_ENV_ID, _ROVER_ENTRY_POINT)):
+        if env_id not in gymnasium.registry:
+            gymnasium.register(
+                id=env_id, entry_point=entry_point, max_episode_steps=MAX_EPISODE_STEPS
+            )
 
 
 # -- rgb_array drawing, numpy only ---------------------------------------------------------
-
-_SIZE_PX = 400
-
-
-class _Canvas:
-    """Pixels of one scenario: the static background once, the arm on a copy per frame."""
-
-    def __init__(self, scenario: Scenario) -> None:
-        self.half_width = 1.1 * scenario.total_length  # the arm always fits
-        self.px_per_unit = _SIZE_PX / (2.0 * self.half_width)
-        background = np.empty((_SIZE_PX, _SIZE_PX, 3), dtype=np.uint8)
-        background[:] = palette.BACKGROUND
-        for obstacle in scenario.obstacles:
-            self._disk(
-                background, obstacle.center, obstacle.radius * self.px_per_unit, palette.OBSTACLE
-            )
-        for point in scenario.feedback_points:
-            self._disk(background, point, 6.0, palette.FEEDBACK)
-            self._disk(background, point, 3.5, palette.BACKGROUND)
-        self.background = background
-
-    def to_px(self, xy: tuple[float, float] | NDArray[np.float64]) -> tuple[float, float]:
-        """(column, row) of a world point; rows grow downwards, +y points up."""
-        return (
-            (float(xy[0]) + self.half_width) * self.px_per_unit,
-            (self.half_width - float(xy[1])) * self.px_per_unit,
-        )
-
-    def _disk(
-        self,
-        image: NDArray[np.uint8],
-        center: tuple[float, float] | NDArray[np.float64],
-        radius_px: float,
-        color: tuple[int, int, int],
-    ) -> None:
-        cx, cy = self.to_px(center)
-        rows, cols = _window(image, cx, cy, cx, cy, radius_px)
-        if rows is None or cols is None:
-            return
-        inside = (cols[None, :] + 0.5 - cx) ** 2 + (rows[:, None] + 0.5 - cy) ** 2 <= radius_px**2
-        image[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1][inside] = color
-
-    def _segment(
-        self,
-        image: NDArray[np.uint8],
-        a: NDArray[np.float64],
-        b: NDArray[np.float64],
-        half_width_px: float,
-        color: tuple[int, int, int],
-    ) -> None:
-        ax, ay = self.to_px(a)
-        bx, by = self.to_px(b)
-        rows, cols = _window(
-            image, min(ax, bx), min(ay, by), max(ax, bx), max(ay, by), half_width_px
-        )
-        if rows is None or cols is None:
-            return
-        px = cols[None, :] + 0.5
-        py = rows[:, None] + 0.5
-        dx, dy = bx - ax, by - ay
-        length2 = dx * dx + dy * dy
-        t = ((px - ax) * dx + (py - ay) * dy) / length2 if length2 > 0 else np.zeros(1)
-        t = np.clip(t, 0.0, 1.0)
-        inside = (px - ax - t * dx) ** 2 + (py - ay - t * dy) ** 2 <= half_width_px**2
-        image[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1][inside] = color
-
-    def draw(self, joint_positions: NDArray[np.float64], *, blocked: bool) -> NDArray[np.uint8]:
-        image = self.background.copy()
-        color = palette.ARM_BLOCKED if blocked else palette.ARM
-        for k in range(len(joint_positions) - 1):
-            self._segment(image, joint_positions[k], joint_positions[k + 1], 3.0, color)
-        for point in joint_positions:
-            self._disk(image, point, 4.5, palette.JOINT)
-        return image
-
-
-def _window(
-    image: NDArray[np.uint8], x0: float, y0: float, x1: float, y1: float, margin: float
-) -> tuple[NDArray[np.int64] | None, NDArray[np.int64] | None]:
-    """Pixel rows and columns of the box ``[x0, x1] x [y0, y1]`` grown by ``margin``, clipped."""
-    height, width = image.shape[:2]
-    c0, c1 = max(int(np.floor(x0 - margin)), 0), min(int(np.ceil(x1 + margin)), width - 1)
-    r0, r1 = max(int(np.floor(y0 - margin)), 0), min(int(np.ceil(y1 + margin)), height - 1)
-    if c0 > c1 or r0 > r1:
-        return None, None
-    return np.arange(r0, r1 + 1, dtype=np.int64), np.arange(c0, c1 + 1, dtype=np.int64)

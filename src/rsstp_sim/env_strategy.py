@@ -143,12 +143,12 @@ class StrategyPolicy(gymnasium.Wrapper[Any, Any, Any, Any]):
         self._proposed.proposal = self._actions[proposed]
         observation, reward, terminated, truncated, info = self.env.step(action)
         runner.step()
-        mirrored = runner.world.current.angles_deg
-        if tuple(mirrored) != tuple(info["angles_deg"]):
+        mirrored = runner.world.current.code
+        if mirrored != info["pose_code"]:
             raise EnvError(
-                f"step {runner.step_index:,}: the strategy's arm is at {list(mirrored)} "
-                f"degrees, the environment's at {list(info['angles_deg'])}: was the "
-                f"environment moved outside step()?"
+                f"step {runner.step_index:,}: the strategy's body is at pose {mirrored}, the "
+                f"environment's at pose {info['pose_code']}: was the environment moved "
+                f"outside step()?"
             )
         info = self._told(info)
         return observation, reward, terminated or runner.stopped is not None, truncated, info

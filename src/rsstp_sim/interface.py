@@ -147,6 +147,13 @@ class Body(Protocol):
     def describe(self, scenario: Any) -> list[str]:
         """The body in its world, a few indented lines (``rsstp-replay info``)."""
 
+    def pose_info(self, pose: Any) -> dict[str, Any]:
+        """A pose's ground truth for a Gymnasium ``info`` (fresh arrays, plain values)."""
+
+    def picture(self, scenario: Any) -> Any:
+        """What draws the body's frames: ``draw(world, *, blocked)`` gives a
+        ``(400, 400, 3)`` uint8 picture (:mod:`rsstp_sim.canvas`)."""
+
     def warnings(self, scenario: Any) -> list[str]:
         """What a user should hear before a run of ``scenario`` (one line each): a feedback
         region nothing can sense, a world whose steps are slow."""

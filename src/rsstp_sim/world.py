@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -293,6 +294,19 @@ class _Arm:
             f"  feedback: {scenario.feedback_mode} (tolerance {scenario.tolerance:g}); "
             f"collision: {scenario.collision}",
         ]
+
+    def pose_info(self, pose: Pose) -> dict[str, Any]:
+        """Angles, joint positions (``(n + 1, 2)``) and obstacle distances (``(n, m)``)."""
+        return {
+            "angles_deg": pose.angles_deg,
+            "joint_positions": pose.joint_positions.copy(),
+            "distances": pose.distances.copy(),
+        }
+
+    def picture(self, scenario: Scenario) -> Any:
+        from rsstp_sim.arm_picture import ArmPicture  # (drawing imports the world)
+
+        return ArmPicture(scenario)
 
     def warnings(self, scenario: Scenario) -> list[str]:
         """A feedback point no pose can sense, and so many obstacles that steps slow down."""

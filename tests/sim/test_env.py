@@ -106,8 +106,10 @@ def test_info_contents() -> None:
         "sensation",
         "feedback",
         "action",
+        "pose_code",
     }
     assert info["angles_deg"] == (330, 3, 357)
+    assert info["pose_code"] == 330 + 3 * 360 + 357 * 360**2  # angle j in base 360
     assert info["action"] is None
     assert info["blocked"] is False and info["blocked_by"] is None
     assert info["sensation"] is True and info["feedback"] == pytest.approx(1.0)

@@ -11,6 +11,7 @@ import sys
 from importlib import resources
 from pathlib import Path
 
+import gymnasium
 import numpy as np
 import pandas as pd
 import pytest
@@ -18,9 +19,10 @@ import shapely
 
 from builtin_worlds import builtins_of
 from rsstp_replay import errors, open_recording
-from rsstp_sim import ArmEnv, Runner, make_strategy
+from rsstp_sim import Runner, make_strategy, palette
 from rsstp_sim.bodies import body_of, make_world
-from rsstp_sim.errors import ActionError, EnvError, ScenarioError
+from rsstp_sim.errors import ActionError, ScenarioError
+from rsstp_sim.recording.env_wrapper import RecordMcap
 from rsstp_sim.recording.recorder import record
 from rsstp_sim.recording.schemas import SCHEMA_VERSION, STEP_NS
 from rsstp_sim.rover import RoverScenario, RoverWorld
@@ -251,9 +253,43 @@ def test_run_and_truth_take_a_rover_scenario(tmp_path: Path) -> None:
     assert runner.run(5000).to_text() in done.stdout
 
 
-def test_a_rover_has_no_gymnasium_env_yet_in_one_line() -> None:
-    with pytest.raises(EnvError, match=r"^rover-room: a rover has no Gymnasium env yet"):
-        ArmEnv(scenario="rover-room")
+def test_gymnasium_makes_the_rover_and_its_frames_show_it(tmp_path: Path) -> None:
+    env = gymnasium.make("rsstp/Rover-v0", scenario="rover-one-way", render_mode="rgb_array")
+    observation, info = env.reset(seed=0)
+    scenario = load_scenario("rover-one-way")
+    assert isinstance(scenario, RoverScenario)
+    assert info["cell"] == scenario.start and info["heading_deg"] == 0 and observation == 0
+    frame = env.render()
+    assert frame.shape == (400, 400, 3) and frame.dtype == np.uint8
+    robot = (np.abs(frame.astype(int) - palette.ARM).sum(axis=2) == 0).sum()
+    assert robot > 20  # the robot is drawn
+    _, _, _, _, info = env.step(0)
+    assert info["cell"] == (scenario.start[0] + 1, scenario.start[1]) and not info["blocked"]
+    walk = [3, 0, 0, 0, 0, 0, 0, 0, 0, 0]  # right (south), then forward into the south edge
+    for action in walk:
+        _, _, _, _, info = env.step(action)
+    assert (
+        info["blocked"] and info["blocked_by"] == "the robot would leave the room by its south edge"
+    )
+    env.close()
+
+
+def test_a_gymnasium_rover_run_is_recorded_as_the_runner_records_it(tmp_path: Path) -> None:
+    env = RecordMcap(gymnasium.make("rsstp/Rover-v0", scenario="rover-two-rooms"), tmp_path)
+    env.reset(seed=0)
+    rng = np.random.default_rng(7)
+    actions = rng.integers(0, 4, size=300).tolist()
+    for action in actions:
+        env.step(action)
+    env.close()
+    [path] = env.recordings
+    with open_recording(path) as recording:
+        steps = recording.steps()
+    assert steps["action"].iloc[1:].tolist() == actions
+    walked = _walk(load_scenario("rover-two-rooms"), actions)  # type: ignore[arg-type]
+    assert steps[["cell_x", "cell_y", "heading_deg"]].to_numpy().tolist() == [
+        list(w[:3]) for w in walked
+    ]
 
 
 # -- a rover's recording ------------------------------------------------------------------------

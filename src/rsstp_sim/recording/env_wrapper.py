@@ -144,11 +144,11 @@ class RecordMcap(gymnasium.Wrapper[Any, Any, Any, Any]):
         observation, reward, terminated, truncated, info = self.env.step(action)
         agent.action = int(info["action"])  # the action id the arm executed
         outcome = recorder.step()
-        mirrored = recorder.runner.world.current.angles_deg
-        if tuple(mirrored) != tuple(info["angles_deg"]):
+        mirrored = recorder.runner.world.current.code
+        if mirrored != info["pose_code"]:
             raise EnvError(
-                f"step {outcome.step}: the recording's arm is at {list(mirrored)} degrees, the "
-                f"environment's at {list(info['angles_deg'])}: was the environment moved "
+                f"step {outcome.step}: the recording's body is at pose {mirrored}, the "
+                f"environment's at pose {info['pose_code']}: was the environment moved "
                 f"outside step()?"
             )
         stopped = info.get("stopped")

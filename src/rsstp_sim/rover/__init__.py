@@ -8,12 +8,14 @@ every pose's moves at once, :mod:`~rsstp_sim.rover.world` answers one move at a 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
 from rsstp_sim.errors import ScenarioError, TruthError
 from rsstp_sim.interface import PoseMachine
 from rsstp_sim.moore import reached
+from rsstp_sim.rover.picture import RoverPicture
 from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario, parse_rover
 from rsstp_sim.rover.table import RoverTable, cell_clearance
 from rsstp_sim.rover.world import RoverBlocker, RoverPose, RoverWorld
@@ -57,6 +59,13 @@ class _Rover:
             f"  feedback: {s.feedback_mode} (region centre ({s.feedback_center[0]:g}, "
             f"{s.feedback_center[1]:g}) radius {s.feedback_radius:g}{heading})",
         ]
+
+    def pose_info(self, pose: RoverPose) -> dict[str, Any]:
+        """The cell ``(x, y)``, the heading (degrees) and the position (the cell's centre)."""
+        return {"cell": pose.cell, "heading_deg": pose.heading_deg, "position": pose.position}
+
+    def picture(self, scenario: RoverScenario) -> RoverPicture:
+        return RoverPicture(scenario)
 
     def warnings(self, scenario: RoverScenario) -> list[str]:
         """A feedback region no reachable pose senses."""
