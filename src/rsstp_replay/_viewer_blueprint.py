@@ -2,33 +2,55 @@
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import rerun.blueprint as rrb
 
 from rsstp_replay._viewer_chunks import TIMELINE
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.rover import RoverScenario
+from rsstp_sim.scenario import AnyScenario
 
-__all__ = ["default_blueprint", "view_reach"]
+__all__ = ["ViewFrame", "default_blueprint", "view_frame", "view_reach"]
 
 
-def view_reach(scenario: Scenario) -> float:
-    """Half the side of the square both 2D views frame, centred on the base: the arm's reach
-    and every obstacle, with a margin."""
+class ViewFrame(NamedTuple):
+    """The square both 2D views frame: its centre and half its side (world frame, length
+    units), and the length that sizes what is drawn on it (offsets, label room)."""
+
+    center: tuple[float, float]
+    half: float
+    scale: float
+
+
+def view_reach(scenario: AnyScenario) -> float:
+    """Half the side of the square both 2D views frame (:func:`view_frame`)."""
+    return view_frame(scenario).half
+
+
+def view_frame(scenario: AnyScenario) -> ViewFrame:
+    """An arm's: centred on the base, its reach and every obstacle with a margin, sized by
+    its length; a rover's: its room with a margin, sized by half the room's longer side."""
+    if isinstance(scenario, RoverScenario):
+        width, height = scenario.room
+        side = max(width, height)
+        return ViewFrame((width / 2, height / 2), 0.55 * side, side / 2)
     reach = 1.1 * scenario.total_length
     for obstacle in scenario.obstacles:
         reach = max(reach, 1.05 * (float(np.hypot(*obstacle.center)) + obstacle.radius))
-    return reach
+    return ViewFrame((0.0, 0.0), reach, scenario.total_length)
 
 
-def default_blueprint(scenario: Scenario, *, first: int, last: int) -> rrb.Blueprint:
+def default_blueprint(scenario: AnyScenario, *, first: int, last: int) -> rrb.Blueprint:
     """Two 2D views side by side, both framing the arm's reach and the obstacles: the world
     (the arm, obstacles, feedback points, sensor, blocked moves) and the model drawn on the
     world (its states where the arm was, its transitions, the current state, over the
     obstacles); below them the plots (sensation and feedback, obstacle distances, model size,
     their time axes linked and showing steps ``first .. last``) and the audit log; the
     ``step`` timeline selected."""
-    reach = view_reach(scenario)
-    bounds = rrb.VisualBounds2D(x_range=[-reach, reach], y_range=[-reach, reach])
+    (cx, cy), half, _ = view_frame(scenario)
+    # The world's entity mirrors y (Rerun draws y downwards): the bounds are the mirror's.
+    bounds = rrb.VisualBounds2D(x_range=[cx - half, cx + half], y_range=[-cy - half, -cy + half])
     steps = rrb.TimeRange(
         start=rrb.TimeRangeBoundary.absolute(seq=first),
         end=rrb.TimeRangeBoundary.absolute(seq=max(last, first + 1)),

@@ -145,11 +145,18 @@ class StatePlaces:
 
 
 def state_places(
-    steps: pd.DataFrame, versions: Sequence[ModelRecord], *, n_joints: int, reach: float
+    steps: pd.DataFrame,
+    versions: Sequence[ModelRecord],
+    *,
+    columns: tuple[str, str],
+    pose_columns: Sequence[str],
+    reach: float,
 ) -> StatePlaces:
-    """The place of every state of every version (see the module docstring); ``reach`` is the
-    arm's length, which sets the offsets."""
-    tips = steps[[f"joint{n_joints}_x", f"joint{n_joints}_y"]].to_numpy(np.float64)
+    """The place of every state of every version (see the module docstring): the mean of the
+    steps table's ``columns`` (an arm's last tip, a rover's position) while it was current;
+    ``pose_columns`` (integers) tell its poses apart; ``reach`` (the arm's length) sets the
+    offsets."""
+    tips = steps[list(columns)].to_numpy(np.float64)
     states = steps["internal_state"].to_numpy(np.int64)
     # A state means what its last version says: its steps in that version place it (the
     # same id stood for more before a split), all its steps when it was not current there.
@@ -187,8 +194,8 @@ def state_places(
                     )
         for state in record.states:
             places.setdefault(int(state), (0.0, 0.0))
-    angles = steps[[f"angle_deg_{j}" for j in range(n_joints)]].to_numpy(np.int64)[chosen]
-    return StatePlaces(places, _poses(kept_states, angles, kept_tips), scale)
+    poses = steps[list(pose_columns)].to_numpy(np.int64)[chosen]
+    return StatePlaces(places, _poses(kept_states, poses, kept_tips), scale)
 
 
 def roles_by_version(
@@ -227,14 +234,15 @@ def labelled_states(places: dict[int, tuple[float, float]], *, room: float) -> s
 
 
 def _poses(
-    states: npt.NDArray[np.int64], angles: npt.NDArray[np.int64], tips: _Floats
+    states: npt.NDArray[np.int64], values: npt.NDArray[np.int64], tips: _Floats
 ) -> dict[int, _Floats]:
-    """For every state seen at several poses, the tips of its :data:`POSE_LINES` most visited
-    poses."""
+    """For every state seen at several poses (told apart by ``values``, non-negative integers
+    a pose), the tips of its :data:`POSE_LINES` most visited poses."""
     if not len(states):
         return {}
-    n_joints = angles.shape[1]
-    codes = np.unique(angles @ (360 ** np.arange(n_joints, dtype=np.int64)), return_inverse=True)[1]
+    radix = values.max(axis=0) + 1
+    place = np.concatenate([[1], np.cumprod(radix[:-1])]).astype(np.int64)
+    codes = np.unique(values @ place, return_inverse=True)[1]
     ids, inverse = np.unique(states, return_inverse=True)
     n_codes = int(codes.max(initial=0)) + 1
     pairs, first, seen = np.unique(
@@ -334,14 +342,17 @@ def _role(roles: Roles | None, known: dict[int, int], state: int) -> int | None:
     return None if roles is None else known.get(state, UNVISITED)
 
 
-def log_legend(stream: rr.RecordingStream, *, reach: float) -> None:
+def log_legend(
+    stream: rr.RecordingStream, *, reach: float, center: tuple[float, float] = (0.0, 0.0)
+) -> None:
     """The role colours named, as static points in the top left corner of a view of half-side
-    ``reach`` (world coordinates, y up)."""
+    ``reach`` around ``center`` (world coordinates, y up)."""
     order = (EXACT, REDUNDANT, ALIASED, UNVISITED)
+    cx, cy = center
     stream.log(
         LEGEND,
         rr.Points2D(
-            [(-0.92 * reach, (0.92 - 0.12 * k) * reach) for k in range(len(order))],
+            [(cx - 0.92 * reach, cy + (0.92 - 0.12 * k) * reach) for k in range(len(order))],
             colors=[ROLE_COLORS[r] for r in order],
             labels=[f"{ROLE_NAMES[r]} state" for r in order],
             radii=rr.Radius.ui_points(5.0),

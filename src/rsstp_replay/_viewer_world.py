@@ -18,16 +18,21 @@ import rerun as rr
 from rsstp_replay._decode import blocker_texts
 from rsstp_replay._viewer_chunks import send_rows
 from rsstp_sim import palette
+from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import Scenario
 
 __all__ = [
     "ARM",
     "BLOCKED",
+    "ROBOT",
+    "ROOM",
     "FEEDBACK_POINTS",
     "OBSTACLES",
     "SENSOR",
     "WORLD",
     "joint_positions",
+    "log_rover",
+    "log_rover_static",
     "log_world",
     "log_world_static",
     "sensor_segments",
@@ -35,6 +40,8 @@ __all__ = [
 
 WORLD = "world"
 ARM = "world/arm"
+ROBOT = "world/robot"
+ROOM = "world/room"
 OBSTACLES = "world/obstacles"
 FEEDBACK_POINTS = "world/feedback_points"
 SENSOR = "world/sensor"
@@ -44,10 +51,8 @@ BLOCKED = "world/blocked"
 _Floats = npt.NDArray[np.float64]
 
 
-def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
-    """The y-up transform, the obstacles (filled disks with their outline) and the feedback
-    points, as static data; the styles of the per-step entities."""
-    stream.log(WORLD, rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)
+def _log_obstacles(stream: rr.RecordingStream, scenario: Scenario | RoverScenario) -> None:
+    """The obstacles: filled disks with their outline, labelled."""
     if scenario.obstacles:
         centers = np.array([obstacle.center for obstacle in scenario.obstacles], np.float64)
         radii = np.array([obstacle.radius for obstacle in scenario.obstacles], np.float64)
@@ -66,6 +71,15 @@ def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
             ),
             static=True,
         )
+
+
+def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
+    """The y-up transform, the obstacles (filled disks with their outline) and the feedback
+    points, as static data; the styles of the per-step entities."""
+    stream.log(WORLD, rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)
+    _log_obstacles(stream, scenario)
+    if scenario.obstacles:
+        radii = np.array([obstacle.radius for obstacle in scenario.obstacles], np.float64)
         colors = [palette.SENSORS[j % len(palette.SENSORS)] for j in range(len(radii))]
         stream.log(
             SENSOR,
@@ -197,3 +211,110 @@ def _blocked(
     return rr.Points2D.columns(
         positions=tips[rows][mask], labels=labels[rows][mask].tolist()
     ).partition(mask.astype(np.int64))
+
+
+# -- the rover ------------------------------------------------------------------------------
+
+_WALL = (60, 60, 60)
+_DOOR = (150, 150, 150)
+
+
+def log_rover_static(stream: rr.RecordingStream, scenario: RoverScenario) -> None:
+    """The y-up transform, the room's edges, walls, one-way doors (an arrow across each, the
+    way it opens), obstacles and the feedback region, as static data; the robot's style."""
+    stream.log(WORLD, rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)
+    width, height = scenario.room
+    edges = [[(0.0, 0.0), (width, 0.0), (width, height), (0.0, height), (0.0, 0.0)]]
+    walls = [[w.start, w.end] for w in scenario.walls]
+    stream.log(
+        ROOM,
+        rr.LineStrips2D(
+            edges + walls,
+            colors=_WALL,
+            radii=rr.Radius.ui_points(2.0),
+            labels=["room"] + [f"wall {w}" for w in range(len(walls))],
+            draw_order=2.0,
+        ),
+        static=True,
+    )
+    if scenario.doors:
+        doors = [[d.start, d.end] for d in scenario.doors]
+        middles = np.array([np.add(d.start, d.end) / 2 for d in scenario.doors], np.float64)
+        toward = np.array([d.toward for d in scenario.doors], np.float64)
+        toward = 0.6 * toward / np.hypot(toward[:, 0], toward[:, 1])[:, None]
+        stream.log(
+            f"{ROOM}/doors",
+            rr.LineStrips2D(
+                doors,
+                colors=_DOOR,
+                radii=rr.Radius.ui_points(2.0),
+                labels=[f"door {d} (one way)" for d in range(len(doors))],
+                draw_order=2.0,
+            ),
+            rr.Arrows2D(origins=middles - toward / 2, vectors=toward, colors=_DOOR, draw_order=2.5),
+            static=True,
+        )
+    _log_obstacles(stream, scenario)
+    stream.log(
+        FEEDBACK_POINTS,
+        rr.Ellipses2D(
+            centers=[scenario.feedback_center],
+            half_sizes=[(scenario.feedback_radius, scenario.feedback_radius)],
+            colors=palette.FEEDBACK,
+            line_radii=rr.Radius.ui_points(2.0),
+            labels=["feedback region"],
+            draw_order=4.0,
+        ),
+        static=True,
+    )
+    stream.log(
+        ROBOT,
+        rr.Points2D.from_fields(radii=max(scenario.robot_radius, 0.2), draw_order=5.0),
+        rr.Arrows2D.from_fields(colors=palette.JOINT, draw_order=6.0),
+        static=True,
+    )
+    stream.log(
+        BLOCKED,
+        rr.Points2D.from_fields(
+            radii=rr.Radius.ui_points(8.0), colors=palette.ARM_BLOCKED, draw_order=7.0
+        ),
+        static=True,
+    )
+
+
+def log_rover(stream: rr.RecordingStream, steps: pd.DataFrame) -> dict[str, int]:
+    """The robot (its disk, and an arrow for its heading) and the blocked moves over the steps
+    of ``steps``, a row only where something changed. Returns rows per entity path."""
+    times = steps.index.to_numpy(np.int64)
+    position = steps[["x", "y"]].to_numpy(np.float64)
+    heading = np.radians(steps["heading_deg"].to_numpy(np.float64))
+    blocked = steps["blocked"].to_numpy(np.bool_)
+    turned = np.r_[True, heading[1:] != heading[:-1]]
+    moved = np.r_[True, (position[1:] != position[:-1]).any(axis=1)] | turned
+    rows_at = np.flatnonzero(moved | np.r_[True, blocked[1:] != blocked[:-1]])
+    points = position[rows_at].astype(np.float32)
+    vectors = (0.45 * np.stack([np.cos(heading), np.sin(heading)], axis=1))[rows_at]
+    colors = np.where(blocked[rows_at, None], palette.ARM_BLOCKED, palette.ARM).astype(np.uint8)
+    logged = {
+        ROBOT: send_rows(
+            stream,
+            ROBOT,
+            times[rows_at],
+            lambda rows: [
+                *rr.Points2D.columns(positions=points[rows], colors=colors[rows]),
+                *rr.Arrows2D.columns(
+                    origins=points[rows], vectors=vectors[rows].astype(np.float32)
+                ),
+            ],
+        )
+    }
+    if blocked.any():
+        marks = np.flatnonzero(blocked | np.r_[False, blocked[:-1]])
+        labels = "blocked: " + blocker_texts(steps, marks)
+        logged[BLOCKED] = send_rows(
+            stream,
+            BLOCKED,
+            times[marks],
+            lambda rows: _blocked(position[marks], labels, blocked[marks], rows),
+        )
+    return logged

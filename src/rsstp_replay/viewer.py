@@ -36,7 +36,8 @@ import rerun as rr
 from rsstp_replay import _viewer_model as model_part
 from rsstp_replay import _viewer_plots as plots_part
 from rsstp_replay import _viewer_world as world_part
-from rsstp_replay._viewer_blueprint import default_blueprint, view_reach
+from rsstp_replay._decode import ROVER_COLUMNS
+from rsstp_replay._viewer_blueprint import default_blueprint, view_frame
 from rsstp_replay._viewer_chunks import TIMELINE
 from rsstp_replay._viewer_layout import graph_positions
 from rsstp_replay._viewer_serve import (
@@ -57,7 +58,8 @@ from rsstp_sim.errors import OutputError, RsstpError
 from rsstp_sim.files import side_file, write_whole
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.records import ModelRecord
-from rsstp_sim.scenario import AnyScenario, Scenario
+from rsstp_sim.rover import RoverScenario
+from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth_cache import load_truth
 from rsstp_sim.words import counted
@@ -237,7 +239,6 @@ def view(
     viewer is spawned. Raises :class:`~rsstp_replay.errors.StepOutOfRange` for a bad range and
     :class:`~rsstp_replay.errors.ReplayError` for an unwritable ``save`` or a port in use.
     """
-    _check_drawable(recording)
     first, last = _step_range(recording, start, end)
     if save is not None:
         save = Path(save)
@@ -260,7 +261,7 @@ def view(
     writing = None if target is None else side_file(target)
     loaded = _load(recording)
     stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
-    blueprint = default_blueprint(_check_drawable(recording), first=first, last=last)
+    blueprint = default_blueprint(recording.scenario, first=first, last=last)
     spawned = False
     in_memory: rr.BinaryStream | None = None
     if target is not None and not spawn:
@@ -372,7 +373,6 @@ def log_recording(
     (the caller sets its sinks, and the blueprint if it wants one, and flushes it). The audits
     run over the whole recording; the model version in force at ``start`` is shown from
     ``start`` on."""
-    _check_drawable(recording)
     first, last = _step_range(recording, start, end)
     return _log(recording, _load(recording), stream, first, last)
 
@@ -400,13 +400,16 @@ def _load(recording: ViewSource) -> _Loaded:
     events = recording.events()
     read = time.perf_counter()
     within, determinism = _audits(steps, versions)
-    scenario = _check_drawable(recording)
+    scenario = recording.scenario
+    scale = view_frame(scenario).scale
     places = model_part.state_places(
-        steps, versions, n_joints=scenario.n_joints, reach=scenario.total_length
+        steps,
+        versions,
+        columns=_place_columns(scenario),
+        pose_columns=_pose_columns(scenario),
+        reach=scale,
     )
-    labelled = model_part.labelled_states(
-        places.places, room=model_part.LABEL_ROOM * scenario.total_length
-    )
+    labelled = model_part.labelled_states(places.places, room=model_part.LABEL_ROOM * scale)
     return _Loaded(
         steps,
         versions,
@@ -426,13 +429,17 @@ def _log(
 ) -> LogSummary:
     began = time.perf_counter()
     window = loaded.steps.iloc[first : last + 1]
-    scenario = _check_drawable(recording)
+    scenario = recording.scenario
     stream.send_recording_name(f"{scenario.name} ({getattr(recording, 'path', 'recording')})")
     # The small entities first: a viewer reads the file in order, so the model, its size and
     # the audit log show while the per-step series still load.
-    world_part.log_world_static(stream, scenario)
+    if isinstance(scenario, RoverScenario):
+        world_part.log_rover_static(stream, scenario)
+    else:
+        world_part.log_world_static(stream, scenario)
     if loaded.roles is not None:
-        model_part.log_legend(stream, reach=view_reach(scenario))
+        frame = view_frame(scenario)
+        model_part.log_legend(stream, reach=frame.half, center=frame.center)
     shown, times = _versions_in(loaded.versions, first, last)
     rows = model_part.log_model(
         stream, shown, times, loaded.places, roles=loaded.roles, labelled=loaded.labelled
@@ -459,10 +466,14 @@ def _log(
         sampled["internal_state"].to_numpy(np.int64),
         loaded.places,
     )
-    rows |= world_part.log_world(stream, sampled, scenario, sensor=every == 1)
-    series, thinned = plots_part.log_series(
-        stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
-    )
+    if isinstance(scenario, RoverScenario):
+        rows |= world_part.log_rover(stream, sampled)
+        series, thinned = plots_part.log_series(stream, window, n_joints=0, n_obstacles=0)
+    else:
+        rows |= world_part.log_world(stream, sampled, scenario, sensor=every == 1)
+        series, thinned = plots_part.log_series(
+            stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
+        )
     rows |= series
     return LogSummary(
         first_step=first,
@@ -507,9 +518,13 @@ def render_graph(recording: ViewSource, step: int, path: Path, *, on_world: bool
     model = recording.model_at(step)
     versions = recording.model_versions()
     if on_world:
-        scenario = _check_drawable(recording)
+        scenario = recording.scenario
         places = model_part.state_places(
-            recording.steps(), versions, n_joints=scenario.n_joints, reach=scenario.total_length
+            recording.steps(),
+            versions,
+            columns=_place_columns(scenario),
+            pose_columns=_pose_columns(scenario),
+            reach=view_frame(scenario).scale,
         ).places
         positions = {s: (200.0 * places[s][0], 200.0 * places[s][1]) for s in model.states}
     else:
@@ -521,15 +536,21 @@ def render_graph(recording: ViewSource, step: int, path: Path, *, on_world: bool
 # ------------------------------------------------------------------------------ helpers
 
 
-def _check_drawable(recording: ViewSource) -> Scenario:
-    """The recording's arm scenario; a rover's recording is refused in one line."""
-    scenario = recording.scenario
-    if not isinstance(scenario, Scenario):
-        raise ReplayError(
-            f"{recording.path}: a {scenario.body}'s recording cannot be drawn yet (the viewer "
-            "draws an arm); info, audit, table and check read it"
-        )
-    return scenario
+def _pose_columns(scenario: AnyScenario) -> tuple[str, ...]:
+    """The steps table's integer columns that say a pose: an arm's angles, a rover's cell and
+    heading."""
+    if isinstance(scenario, RoverScenario):
+        return ROVER_COLUMNS
+    return tuple(f"angle_deg_{j}" for j in range(scenario.n_joints))
+
+
+def _place_columns(scenario: AnyScenario) -> tuple[str, str]:
+    """The steps table's columns a state is placed by on the world: an arm's last tip, a
+    rover's position."""
+    if isinstance(scenario, RoverScenario):
+        return ("x", "y")
+    n = scenario.n_joints
+    return (f"joint{n}_x", f"joint{n}_y")
 
 
 def _step_range(recording: ViewSource, start: int | None, end: int | None) -> tuple[int, int]:
@@ -588,7 +609,7 @@ def _audits(
     return within, determinism
 
 
-def _roles(scenario: Scenario, steps: pd.DataFrame) -> model_part.Roles | None:
+def _roles(scenario: AnyScenario, steps: pd.DataFrame) -> model_part.Roles | None:
     """Every visited state's role per version by the truth audit, or None (with a warning)
     when the truth cannot be computed (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
     try:

@@ -432,7 +432,13 @@ def test_arrows_are_coloured_by_action_and_self_loops_are_stubs(
     recording, rrd = refined
     final = recording.model_versions()[-1]
     step = recording.n_steps
-    placed = state_places(recording.steps(), recording.model_versions(), n_joints=3, reach=6.0)
+    placed = state_places(
+        recording.steps(),
+        recording.model_versions(),
+        columns=("joint3_x", "joint3_y"),
+        pose_columns=[f"angle_deg_{j}" for j in range(3)],
+        reach=6.0,
+    )
     places, scale = placed.places, placed.scale
     loops_seen = 0
     for state, outs in _outs(final).items():
@@ -502,7 +508,13 @@ def test_a_learned_model_looks_like_the_world() -> None:
     with open_recording(LEARNER) as recording:
         table = recording.steps(truth=True)
         versions = recording.model_versions()
-        places = state_places(table, versions, n_joints=2, reach=3.0)
+        places = state_places(
+            table,
+            versions,
+            columns=("joint2_x", "joint2_y"),
+            pose_columns=[f"angle_deg_{j}" for j in range(2)],
+            reach=3.0,
+        )
     final = versions[-1]
     last_steps = table.loc[final.step :]
     for state in final.states:
@@ -737,7 +749,13 @@ def test_render_graph_thesis_layout_and_on_the_world(
     assert set(places) == set(model.states)
     for state, place in places.items():
         assert place == pytest.approx(layout[state], abs=0.01)
-    world = state_places(recording.steps(), recording.model_versions(), n_joints=3, reach=6.0)
+    world = state_places(
+        recording.steps(),
+        recording.model_versions(),
+        columns=("joint3_x", "joint3_y"),
+        pose_columns=[f"angle_deg_{j}" for j in range(3)],
+        reach=6.0,
+    )
     on_world = pinned(
         render_graph(recording, step, tmp_path / "world.dot", on_world=True).read_text()
     )
@@ -854,7 +872,13 @@ def test_states_are_coloured_by_what_they_stood_for(learner: tuple[Recording, Rr
 def test_labels_only_where_they_fit(refined: tuple[Recording, Rrd]) -> None:
     """A state is labelled iff no other state is within the label's room of it."""
     recording, rrd = refined
-    places = state_places(recording.steps(), recording.model_versions(), n_joints=3, reach=6.0)
+    places = state_places(
+        recording.steps(),
+        recording.model_versions(),
+        columns=("joint3_x", "joint3_y"),
+        pose_columns=[f"angle_deg_{j}" for j in range(3)],
+        reach=6.0,
+    )
     room = LABEL_ROOM * 6.0
     labelled = 0
     for state, (x, y) in places.places.items():
@@ -887,3 +911,61 @@ def test_without_the_truth_the_states_are_not_coloured(
     assert "world/model/legend" not in rrd.static
     [(_, [color])] = rrd.column("world/model/state/0", "Points2D:colors")
     assert _rgb(color) == palette.STATE
+
+
+# ------------------------------------------------------------------------------ the rover
+
+ROVER = Path(__file__).parents[2] / "recordings" / "rover-one-way-random.mcap"
+
+
+@pytest.fixture(scope="module")
+def rover(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Recording, Rrd]]:
+    """The rover's reference recording (a random walk through its one-way door), viewed."""
+    out = tmp_path_factory.mktemp("viewer") / "rover.rrd"
+    with open_recording(ROVER) as recording:
+        view(recording, save=out, spawn=False, serve_web=False, start=None, end=None)
+        yield recording, Rrd(out)
+
+
+def test_the_rover_is_drawn_where_it_is_facing_where_it_faces(
+    rover: tuple[Recording, Rrd],
+) -> None:
+    recording, rrd = rover
+    table = recording.steps()
+    for step in (0, 777, 2500, recording.n_steps):
+        x, y = float(table.at[step, "cell_x"]) + 0.5, float(table.at[step, "cell_y"]) + 0.5
+        assert rrd.at("world/robot", "Points2D:positions", step) == [[x, y]]
+        heading = np.radians(float(table.at[step, "heading_deg"]))
+        np.testing.assert_allclose(
+            rrd.at("world/robot", "Arrows2D:vectors", step),
+            [[0.45 * np.cos(heading), 0.45 * np.sin(heading)]],
+            atol=1e-6,
+        )
+    blocked = np.flatnonzero(table["blocked"].to_numpy())
+    kinds = set(table["blocked_kind"].iloc[blocked])
+    assert {"room", "wall", "door", "obstacle"} <= kinds
+    for step in blocked[:30].tolist():
+        kind = table.at[step, "blocked_kind"]
+        label = {
+            "room": "room edge {blocked_edge}",
+            "obstacle": "obstacle {blocked_obstacle} link {blocked_link}",
+            "wall": "wall {blocked_wall}",
+            "door": "door {blocked_door}",
+        }[kind].format(**table.loc[step].to_dict())
+        assert rrd.at("world/blocked", "Points2D:labels", step) == [f"blocked: {label}"]
+
+
+def test_the_rovers_room_and_the_model_on_it(rover: tuple[Recording, Rrd]) -> None:
+    recording, rrd = rover
+    scenario = recording.scenario
+    batch = rrd.static["world/room"][0].to_record_batch()
+    strips = batch.column("LineStrips2D:strips").to_pylist()[0]
+    width, height = scenario.room  # type: ignore[union-attr]
+    assert strips[0] == [[0, 0], [width, 0], [width, height], [0, height], [0, 0]]
+    assert len(strips) == 1 + len(scenario.walls)  # type: ignore[union-attr]
+    doors = rrd.static["world/room/doors"][0].to_record_batch()
+    assert len(doors.column("LineStrips2D:strips").to_pylist()[0]) == 1
+    # A random walk's model is one state, placed where the robot was on average.
+    table = recording.steps()
+    place = rrd.at("world/model/state/0", "Points2D:positions", recording.n_steps)
+    np.testing.assert_allclose(place, [[table["x"].mean(), table["y"].mean()]], rtol=1e-5)
