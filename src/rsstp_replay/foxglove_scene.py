@@ -21,6 +21,10 @@ The recording itself is JSON described by this project's schemas: Foxglove plots
 - ``/rsstp/log`` (``foxglove.Log``): one per event, at its step: ``name`` the kind, ``message``
   its text; level WARNING for ``blocked`` and ``contradiction``, INFO for the others.
 
+A rover's recording gives the same topics with the rover's entities and frames
+(:mod:`rsstp_replay._foxglove_rover`): its room on the static topic, the robot on
+``/rsstp/scene``, ``world -> robot`` on the transforms.
+
 A metadata record ``rsstp.scene`` names what the scene was made from (scenario and its
 SHA-256, strategy, seed, steps) and by which ``rsstp``. The world is the plane z = 0, in the
 recording's length unit. The ``log_time`` (and ``publish_time``) and the ``timestamp`` of
@@ -70,6 +74,7 @@ from foxglove.messages import (
 )
 
 from rsstp_replay._decode import pose_numbers
+from rsstp_replay._foxglove_rover import RoverDrawing, RoverPoses
 from rsstp_replay._foxglove_stamps import PoseMessages
 from rsstp_replay.errors import ReplayError
 from rsstp_sim import __version__, palette
@@ -78,6 +83,7 @@ from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.schemas import STEP_NS
+from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.words import counted
 
@@ -128,7 +134,7 @@ class SceneExport:
 
     def to_text(self) -> str:
         return (
-            f"wrote {self.path} ({self.size:,} bytes): the arm at {self.arm_poses:,} of "
+            f"wrote {self.path} ({self.size:,} bytes): the body at {self.arm_poses:,} of "
             f"{counted(self.steps, 'step')} (where it moved), {counted(self.logs, 'event')} as log "
             "messages"
         )
@@ -144,15 +150,17 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
     """
     out = Path(path)
     scenario = recording.scenario
-    if not isinstance(scenario, Scenario):
-        raise ReplayError(
-            f"{recording.path}: a {scenario.body}'s recording has no Foxglove scene yet (the "
-            "scene draws an arm); info, audit, table and check read it"
-        )
     steps = recording.steps(geometry=False)
     n_steps = len(steps)
-    poses = _ArmPoses.from_steps(steps, scenario, source=recording.path)
-    del steps  # the poses where the arm moved are all that is kept of it
+    poses: _ArmPoses | RoverPoses
+    draw: _Drawing | RoverDrawing
+    if isinstance(scenario, RoverScenario):
+        poses = RoverPoses.from_steps(steps, scenario, source=recording.path)
+        draw = RoverDrawing(scenario, poses)
+    else:
+        poses = _ArmPoses.from_steps(steps, scenario, source=recording.path)
+        draw = _Drawing(scenario, poses)
+    del steps  # the poses where the body moved are all that is kept of it
     events = recording.events()
     metadata = {
         "package": "rsstp",
@@ -163,8 +171,6 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
         "seed": str(recording.seed),
         "steps": str(recording.n_steps),
     }
-    draw = _Drawing(scenario)
-
     with written_whole(out) as side:
         output = SideFileWriter(io.FileIO(side, "w"))
         try:
@@ -186,8 +192,8 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
 
 def _write_scene(
     writer: ChunkedWriter,
-    draw: _Drawing,
-    poses: _ArmPoses,
+    draw: _Drawing | RoverDrawing,
+    poses: _ArmPoses | RoverPoses,
     events: pd.DataFrame,
     metadata: dict[str, str],
 ) -> None:
@@ -215,11 +221,7 @@ def _write_scene(
         yield static, 0, draw.static_scene().encode(), b""
         yield transforms, 0, draw.fixed_transforms().encode(), b""
         log_events = _EventLogs(events, logs)
-        poses_at = PoseMessages(
-            lambda row: draw.arm(None, poses.points[row].tolist()),
-            lambda row: draw.links(None, poses.angles_deg[row].tolist()),
-            cached=_CACHED_POSES,
-        ).at
+        poses_at = PoseMessages(draw.body, draw.frames, cached=_CACHED_POSES).at
         next_event = log_events.next_step
         for row, (step, code) in enumerate(poses.rows()):
             if step > next_event:
@@ -332,10 +334,11 @@ def _turn(angle_deg: int) -> Quaternion:
 
 
 class _Drawing:
-    """The scene's messages for one scenario; what never changes is built once."""
+    """The scene's messages for one arm scenario; what never changes is built once."""
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario, poses: _ArmPoses | None = None) -> None:
         self.scenario = scenario
+        self.poses = poses
         self.n_joints = scenario.n_joints
         total = scenario.total_length
         self.thickness = _LINE_THICKNESS * total
@@ -427,6 +430,16 @@ class _Drawing:
                 )
             ]
         )
+
+    def body(self, row: int) -> SceneUpdate:
+        """The arm at row ``row`` of the poses, without a timestamp."""
+        assert self.poses is not None  # (given for an export)
+        return self.arm(None, self.poses.points[row].tolist())
+
+    def frames(self, row: int) -> FrameTransforms:
+        """The links' frames at row ``row`` of the poses, without a timestamp."""
+        assert self.poses is not None  # (given for an export)
+        return self.links(None, self.poses.angles_deg[row].tolist())
 
     def arm(self, stamp: Timestamp | None, points: list[float]) -> SceneUpdate:
         """The arm at one pose (``x0, y0, x1, y1, ...``): a line strip through the joints, a

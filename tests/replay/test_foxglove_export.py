@@ -430,3 +430,44 @@ def test_rerun_imports_the_logs_and_the_frames(
 
     assert set(columns[ARM_TOPIC]) >= {"foxglove.SceneUpdate:message"}
     assert not any(name.startswith(("LineStrips", "Points")) for name in columns[ARM_TOPIC])
+
+
+# ------------------------------------------------------------------------------ the rover
+
+ROVER = Path(__file__).parents[2] / "recordings" / "rover-one-way-random.mcap"
+
+
+def test_the_rover_is_sent_where_it_moved_or_turned_facing_its_heading(tmp_path: Path) -> None:
+    out = tmp_path / "rover.scene.mcap"
+    code, stdout, stderr = export("--foxglove", str(ROVER), "-o", str(out))
+    assert (code, stderr) == (0, "")
+    scene = Scene.read(out)
+    with open_recording(ROVER) as recording:
+        table = recording.steps()
+        scenario = recording.scenario
+        n_events = len(recording.events())
+    pose = table[["cell_x", "cell_y", "heading_deg"]].to_numpy()
+    changed = np.r_[True, (pose[1:] != pose[:-1]).any(axis=1)]
+    updates = scene.messages[ARM_TOPIC]
+    assert [t // 1_000_000 for t, _, _ in updates] == np.flatnonzero(changed).tolist()
+    for t, _, update in updates[:: max(1, len(updates) // 50)]:
+        step = t // 1_000_000
+        (entity,) = update.entities
+        assert (
+            entity.id == "robot" and entity.timestamp.seconds * 10**9 + entity.timestamp.nanos == t
+        )
+        (disk,) = entity.cylinders
+        x, y = table.at[step, "cell_x"] + 0.5, table.at[step, "cell_y"] + 0.5
+        assert (disk.pose.position.x, disk.pose.position.y) == (x, y)
+        (arrow,) = entity.arrows
+        turn = arrow.pose.orientation
+        heading = math.degrees(2 * math.atan2(turn.z, turn.w)) % 360
+        assert heading == pytest.approx(float(table.at[step, "heading_deg"]), abs=1e-9)
+    [(_, _, static)] = scene.messages[STATIC_TOPIC]
+    room = next(e for e in static.entities if e.id == "room")
+    assert len(room.lines) == 1 + len(scenario.walls) + len(scenario.doors)  # type: ignore[union-attr]
+    assert len(room.arrows) == len(scenario.doors)  # type: ignore[union-attr]
+    corners = [(p.x, p.y) for p in room.lines[0].points]
+    width, height = scenario.room  # type: ignore[union-attr]
+    assert corners == [(0, 0), (width, 0), (width, height), (0, height), (0, 0)]
+    assert len(scene.messages[LOG_TOPIC]) == n_events
