@@ -22,7 +22,6 @@ import numpy.typing as npt
 import pandas as pd
 from foxglove.messages import (
     ArrowPrimitive,
-    Color,
     CylinderPrimitive,
     FrameTransform,
     FrameTransforms,
@@ -33,36 +32,18 @@ from foxglove.messages import (
     Quaternion,
     SceneEntity,
     SceneUpdate,
-    Timestamp,
     Vector3,
 )
 
-from rsstp_replay.errors import ReplayError
+from rsstp_replay._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
 from rsstp_sim import palette
-from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.rover import RoverScenario
 
 __all__ = ["RoverDrawing", "RoverPoses"]
 
 WORLD_FRAME = "world"
-_BLOCK = 65_536
 _WALL = (60, 60, 60)
 _DOOR = (150, 150, 150)
-
-
-def _color(rgb: tuple[int, int, int], alpha: float = 1.0) -> Color:
-    r, g, b = rgb
-    return Color(r=r / 255, g=g / 255, b=b / 255, a=alpha)
-
-
-def _stamp(step: int) -> Timestamp:
-    sec, nsec = divmod(step * STEP_NS, 1_000_000_000)
-    return Timestamp(sec, nsec)
-
-
-def _turn(angle_deg: float) -> Quaternion:
-    half = math.radians((angle_deg + 180) % 360 - 180) / 2
-    return Quaternion(x=0.0, y=0.0, z=math.sin(half), w=math.cos(half))
 
 
 @dataclass(frozen=True)
@@ -79,9 +60,7 @@ class RoverPoses:
     def from_steps(
         cls, steps: pd.DataFrame, scenario: RoverScenario, *, source: Path
     ) -> RoverPoses:
-        if steps.index.name != "step":
-            raise ReplayError(f"{source}: the steps table is not indexed by step")
-        numbers = steps.index.to_numpy(np.int64)
+        numbers = step_numbers(steps, source=source)
         values = steps[["cell_x", "cell_y", "heading_deg"]].to_numpy(np.int64)
         moved = np.ones(len(numbers), bool)
         moved[1:] = (values[1:] != values[:-1]).any(axis=1)
@@ -95,9 +74,7 @@ class RoverPoses:
 
     def rows(self) -> Iterator[tuple[int, int]]:
         """``(step, pose code)`` of every row as Python numbers, a block at a time."""
-        for start in range(0, len(self.steps), _BLOCK):
-            block = slice(start, start + _BLOCK)
-            yield from zip(self.steps[block].tolist(), self.codes[block].tolist(), strict=True)
+        return pose_rows(self.steps, self.codes)
 
 
 class RoverDrawing:
@@ -112,22 +89,20 @@ class RoverDrawing:
         self.robot_size = Vector3(x=diameter, y=diameter, z=0.1)
 
     def _pose(self, x: float, y: float, heading_deg: float = 0.0) -> Pose:
-        return Pose(position=Vector3(x=x, y=y, z=0.0), orientation=_turn(heading_deg))
+        return Pose(position=Vector3(x=x, y=y, z=0.0), orientation=turn(heading_deg))
 
-    def _line(
-        self, points: list[tuple[float, float]], color: tuple[int, int, int]
-    ) -> LinePrimitive:
+    def _line(self, points: list[tuple[float, float]], rgb: tuple[int, int, int]) -> LinePrimitive:
         return LinePrimitive(
             type=LinePrimitiveLineType.LineStrip,
             pose=self._pose(0.0, 0.0),
             thickness=0.08,
             points=[Point3(x=x, y=y, z=0.0) for x, y in points],
-            color=_color(color),
+            color=color(rgb),
         )
 
     def static_scene(self) -> SceneUpdate:
         """The room, its walls and doors, the obstacles and the feedback region, forever."""
-        s, stamp = self.scenario, _stamp(0)
+        s, stamp = self.scenario, timestamp(0)
         width, height = s.room
         lines = [self._line([(0, 0), (width, 0), (width, height), (0, height), (0, 0)], _WALL)]
         lines += [self._line([w.start, w.end], _WALL) for w in s.walls]
@@ -143,7 +118,7 @@ class RoverDrawing:
                     shaft_diameter=0.06,
                     head_length=0.2,
                     head_diameter=0.2,
-                    color=_color(_DOOR),
+                    color=color(_DOOR),
                 )
             )
         obstacles = [
@@ -152,7 +127,7 @@ class RoverDrawing:
                 size=Vector3(x=2 * o.radius, y=2 * o.radius, z=0.05),
                 bottom_scale=1.0,
                 top_scale=1.0,
-                color=_color(palette.OBSTACLE, 0.8),
+                color=color(palette.OBSTACLE, 0.8),
             )
             for o in s.obstacles
         ]
@@ -162,7 +137,7 @@ class RoverDrawing:
             size=Vector3(x=region, y=region, z=0.02),
             bottom_scale=1.0,
             top_scale=1.0,
-            color=_color(palette.FEEDBACK, 0.6),
+            color=color(palette.FEEDBACK, 0.6),
         )
         return SceneUpdate(
             entities=[
@@ -183,7 +158,7 @@ class RoverDrawing:
         return FrameTransforms(
             transforms=[
                 FrameTransform(
-                    timestamp=_stamp(0),
+                    timestamp=timestamp(0),
                     parent_frame_id=WORLD_FRAME,
                     child_frame_id="room",
                     translation=self.origin,
@@ -200,7 +175,7 @@ class RoverDrawing:
             size=self.robot_size,
             bottom_scale=1.0,
             top_scale=1.0,
-            color=_color(palette.ARM),
+            color=color(palette.ARM),
         )
         arrow = ArrowPrimitive(
             pose=self._pose(float(x), float(y), heading),
@@ -208,7 +183,7 @@ class RoverDrawing:
             shaft_diameter=0.08,
             head_length=0.2,
             head_diameter=0.2,
-            color=_color(palette.JOINT),
+            color=color(palette.JOINT),
         )
         entity = SceneEntity(frame_id=WORLD_FRAME, id="robot", cylinders=[robot], arrows=[arrow])
         return SceneUpdate(entities=[entity])
@@ -222,7 +197,7 @@ class RoverDrawing:
                     parent_frame_id=WORLD_FRAME,
                     child_frame_id="robot",
                     translation=Vector3(x=float(x), y=float(y), z=0.0),
-                    rotation=_turn(heading),
+                    rotation=turn(heading),
                 )
             ]
         )

@@ -185,17 +185,29 @@ def log_world(
                 np.full(len(segments[rows]), n * m)
             ),
         )
-    if blocked.any():
-        tips = positions[:, -1, :]
-        rows_at = np.flatnonzero(blocked | np.r_[False, blocked[:-1]])
-        labels = "blocked: " + blocker_texts(steps, rows_at)
-        logged[BLOCKED] = send_rows(
+    logged |= _log_blocked(stream, steps, positions[:, -1, :])
+    return logged
+
+
+def _log_blocked(
+    stream: rr.RecordingStream, steps: pd.DataFrame, places: _Floats
+) -> dict[str, int]:
+    """A marker at ``places`` (a row a step: the arm's tip, the robot) at every blocked move,
+    labelled with what blocked it, gone at the next step; rows logged by path."""
+    blocked = steps["blocked"].to_numpy(np.bool_)
+    if not blocked.any():
+        return {}
+    times = steps.index.to_numpy(np.int64)
+    rows_at = np.flatnonzero(blocked | np.r_[False, blocked[:-1]])
+    labels = "blocked: " + blocker_texts(steps, rows_at)
+    return {
+        BLOCKED: send_rows(
             stream,
             BLOCKED,
             times[rows_at],
-            lambda rows: _blocked(tips[rows_at], labels, blocked[rows_at], rows),
+            lambda rows: _blocked(places[rows_at], labels, blocked[rows_at], rows),
         )
-    return logged
+    }
 
 
 def _blocked(
@@ -308,13 +320,5 @@ def log_rover(stream: rr.RecordingStream, steps: pd.DataFrame) -> dict[str, int]
             ],
         )
     }
-    if blocked.any():
-        marks = np.flatnonzero(blocked | np.r_[False, blocked[:-1]])
-        labels = "blocked: " + blocker_texts(steps, marks)
-        logged[BLOCKED] = send_rows(
-            stream,
-            BLOCKED,
-            times[marks],
-            lambda rows: _blocked(position[marks], labels, blocked[marks], rows),
-        )
+    logged |= _log_blocked(stream, steps, position)
     return logged

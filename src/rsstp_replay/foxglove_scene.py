@@ -55,7 +55,6 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd
 from foxglove.messages import (
-    Color,
     CylinderPrimitive,
     FrameTransform,
     FrameTransforms,
@@ -75,8 +74,8 @@ from foxglove.messages import (
 
 from rsstp_replay._decode import pose_numbers
 from rsstp_replay._foxglove_rover import RoverDrawing, RoverPoses
+from rsstp_replay._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
 from rsstp_replay._foxglove_stamps import PoseMessages
-from rsstp_replay.errors import ReplayError
 from rsstp_sim import __version__, palette
 from rsstp_sim.files import written_whole
 from rsstp_sim.geometry import ArmGeometry
@@ -112,8 +111,6 @@ _JOINT_DIAMETER = 0.04
 _FEEDBACK_DIAMETER = 0.03
 _OBSTACLE_HEIGHT = 0.01
 
-_BLOCK = 65_536
-"""Poses turned into Python numbers at a time."""
 _CACHED_POSES = 65_536
 """Poses whose encoded messages are kept (three-joint has 39,232 reachable poses)."""
 _CHUNK_SIZE = 1024 * 1024
@@ -263,7 +260,7 @@ class _EventLogs:
             at, kind = steps[self.written], kinds[self.written]
             level = LogLevel.Warning if kind in _WARNING_KINDS else LogLevel.Info
             message = Log(
-                timestamp=_timestamp(at), level=level, message=texts[self.written], name=kind
+                timestamp=timestamp(at), level=level, message=texts[self.written], name=kind
             )
             self.written += 1
             self.next_step = steps[self.written] if self.written < len(steps) else math.inf
@@ -286,7 +283,7 @@ class _ArmPoses:
 
     @classmethod
     def from_steps(cls, steps: pd.DataFrame, scenario: Scenario, *, source: Path) -> _ArmPoses:
-        numbers = _step_numbers(steps, source=source)
+        numbers = step_numbers(steps, source=source)
         n = scenario.n_joints
         angles = steps[[f"angle_deg_{j}" for j in range(n)]].to_numpy(np.int64)
         moved = np.ones(len(numbers), bool)
@@ -305,32 +302,7 @@ class _ArmPoses:
 
     def rows(self) -> Iterator[tuple[int, int]]:
         """``(step, pose code)`` of every row as Python numbers, a block at a time."""
-        for start in range(0, len(self.steps), _BLOCK):
-            block = slice(start, start + _BLOCK)
-            yield from zip(self.steps[block].tolist(), self.codes[block].tolist(), strict=True)
-
-
-def _step_numbers(steps: pd.DataFrame, *, source: Path) -> npt.NDArray[np.int64]:
-    """The step of every row: the steps table's index, named ``step``."""
-    if steps.index.name != "step":
-        raise ReplayError(f"{source}: the steps table is not indexed by step")
-    return steps.index.to_numpy(np.int64)
-
-
-def _timestamp(step: int) -> Timestamp:
-    sec, nsec = divmod(step * STEP_NS, 1_000_000_000)
-    return Timestamp(sec, nsec)
-
-
-def _color(rgb: palette.Colour, alpha: float = 1.0) -> Color:
-    r, g, b = rgb
-    return Color(r=r / 255, g=g / 255, b=b / 255, a=alpha)
-
-
-def _turn(angle_deg: int) -> Quaternion:
-    """The rotation by ``angle_deg`` about z (counter-clockwise seen from +z), ``w >= 0``."""
-    half = math.radians((angle_deg + 180) % 360 - 180) / 2
-    return Quaternion(x=0.0, y=0.0, z=math.sin(half), w=math.cos(half))
+        return pose_rows(self.steps, self.codes)
 
 
 class _Drawing:
@@ -344,11 +316,11 @@ class _Drawing:
         self.thickness = _LINE_THICKNESS * total
         diameter = _JOINT_DIAMETER * total
         self.joint_size = Vector3(x=diameter, y=diameter, z=diameter)
-        self.arm_color = _color(palette.ARM)
-        self.joint_color = _color(palette.JOINT)
+        self.arm_color = color(palette.ARM)
+        self.joint_color = color(palette.JOINT)
         self.upright = Quaternion(x=0.0, y=0.0, z=0.0, w=1.0)
         self.identity = Pose(position=Vector3(x=0.0, y=0.0, z=0.0), orientation=self.upright)
-        self.turns = [_turn(angle) for angle in range(360)]
+        self.turns = [turn(angle) for angle in range(360)]
         self.link_frames = [f"link{k}" for k in range(self.n_joints)]
         self.parents = ["base", *self.link_frames[:-1]]
         origin = Vector3(x=0.0, y=0.0, z=0.0)
@@ -359,7 +331,7 @@ class _Drawing:
     def static_scene(self) -> SceneUpdate:
         """The obstacles and the feedback points, in ``world``, forever."""
         total = self.scenario.total_length
-        stamp = _timestamp(0)
+        stamp = timestamp(0)
         height = _OBSTACLE_HEIGHT * total
         cylinders = [
             CylinderPrimitive(
@@ -370,7 +342,7 @@ class _Drawing:
                 size=Vector3(x=2 * o.radius, y=2 * o.radius, z=height),
                 bottom_scale=1.0,
                 top_scale=1.0,
-                color=_color(palette.OBSTACLE, 0.8),
+                color=color(palette.OBSTACLE, 0.8),
             )
             for o in self.scenario.obstacles
         ]
@@ -379,7 +351,7 @@ class _Drawing:
             SpherePrimitive(
                 pose=Pose(position=Vector3(x=x, y=y, z=0.0), orientation=self.upright),
                 size=Vector3(x=diameter, y=diameter, z=diameter),
-                color=_color(palette.FEEDBACK),
+                color=color(palette.FEEDBACK),
             )
             for x, y in self.scenario.feedback_points
         ]
@@ -394,7 +366,7 @@ class _Drawing:
 
     def fixed_transforms(self) -> FrameTransforms:
         """``world -> base`` and ``link{n-1} -> tip``, which never change."""
-        stamp = _timestamp(0)
+        stamp = timestamp(0)
         return FrameTransforms(
             transforms=[
                 FrameTransform(

@@ -4,6 +4,7 @@ and what was expected, and the refusal of keys the format does not have."""
 from __future__ import annotations
 
 from collections.abc import Mapping
+from pathlib import Path
 
 from rsstp_sim.errors import ScenarioError
 
@@ -39,3 +40,16 @@ class KeyedValidator:
             raise ScenarioError(
                 f"{self.origin}: {path}: unknown key (allowed: {', '.join(sorted(allowed))})"
             )
+
+    def name_and_description(self, data: Mapping[str, object]) -> tuple[str, str]:
+        """The scenario's ``name`` (default: the file's stem, or the built-in's name) and its
+        one-line ``description`` (default empty)."""
+        name = data.get(
+            "name", Path(self.origin).stem if self.origin.endswith(".toml") else self.origin
+        )
+        if not isinstance(name, str):
+            raise self.fail("name", "a string", name)
+        description = data.get("description", "")
+        if not isinstance(description, str):
+            raise self.fail("description", "a string", description)
+        return name, description

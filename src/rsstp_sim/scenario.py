@@ -314,14 +314,7 @@ class _Validator(KeyedValidator):
         if collision not in ("swept", "endpoint"):
             raise self.fail("motion.collision", '"swept" or "endpoint"', collision)
 
-        name = data.get(
-            "name", Path(self.origin).stem if self.origin.endswith(".toml") else self.origin
-        )
-        if not isinstance(name, str):
-            raise self.fail("name", "a string", name)
-        description = data.get("description", "")
-        if not isinstance(description, str):
-            raise self.fail("description", "a string", description)
+        name, description = self.name_and_description(data)
 
         scenario = Scenario(
             name=name,

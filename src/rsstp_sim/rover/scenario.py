@@ -35,7 +35,6 @@ import hashlib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from pathlib import Path
 from typing import ClassVar, Literal
 
 from rsstp_sim._validation import MISSING, KeyedValidator
@@ -241,14 +240,7 @@ class _Validator(KeyedValidator):
         if mode not in ("bool", "float"):
             raise self.fail("feedback.mode", '"bool" or "float"', mode)
 
-        name = data.get(
-            "name", Path(self.origin).stem if self.origin.endswith(".toml") else self.origin
-        )
-        if not isinstance(name, str):
-            raise self.fail("name", "a string", name)
-        description = data.get("description", "")
-        if not isinstance(description, str):
-            raise self.fail("description", "a string", description)
+        name, description = self.name_and_description(data)
         return RoverScenario(
             name=name,
             room=room,
