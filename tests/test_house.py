@@ -4,6 +4,8 @@ purpose is the package's own (``except RsstpError`` catches them all)."""
 from __future__ import annotations
 
 import ast
+import os
+import subprocess
 import sys
 import warnings
 from collections.abc import Callable
@@ -192,3 +194,35 @@ def test_reading_a_recording_never_calls_back_up(finished: bool, tmp_path: Path)
         ("_contract", "_chunks"),
         ("_chunks", "_container"),
     }
+
+
+READING = """
+import sys
+from rsstp_replay import open_recording
+
+for name in sys.argv[1:]:
+    with open_recording(name) as recording:
+        recording.steps(truth=True)
+        recording.memory()
+        recording.events()
+        recording.model_at(recording.n_steps)
+        recording.model_versions()
+        recording.ground_truth()
+audits = sorted(m for m in sys.modules if m.startswith("rsstp_replay.audits"))
+print(",".join(audits))
+"""
+
+
+def test_reading_a_recording_never_imports_the_audits() -> None:
+    """The reader returns what the file holds: its steps (with their true classes), memory,
+    events and models; judging them is the audits' business, imported only by who asks."""
+    recordings = Path(__file__).parents[1] / "recordings"
+    names = [
+        str(recordings / "two-joint-30-learner.mcap"),
+        str(recordings / "rover-one-way-random.mcap"),
+    ]
+    env = dict(os.environ, PYTHONPATH=str(SRC))
+    done = subprocess.run(
+        [sys.executable, "-c", READING, *names], capture_output=True, text=True, env=env, check=True
+    )
+    assert done.stdout.strip() == ""

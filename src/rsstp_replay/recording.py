@@ -213,9 +213,7 @@ class Recording:
         self._log_times = columns.log_time  # kept: the contract check needs no second pass
         frame = columns.frame(geometry=geometry)
         if truth:
-            from rsstp_replay.audits.truth import step_true_classes
-
-            frame["true_class"] = step_true_classes(frame, self.ground_truth())
+            frame["true_class"] = self.ground_truth().classes_of_table(frame)
         return frame
 
     def step_log_times(self) -> _Ints:

@@ -31,6 +31,7 @@ import time
 from collections import deque
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -208,6 +209,10 @@ class GroundTruth:
         """Classes of many poses at once: ``values`` has shape ``(B, n_values)`` (see
         :meth:`poses_of`)."""
         return np.asarray(self.true_class[self.poses_of(values)], dtype=np.int64)
+
+    def classes_of_table(self, table: Any) -> NDArray[np.int64]:
+        """The class of every row of a steps table (its columns :attr:`value_names`)."""
+        return self.classes_of(table[list(self.value_names)].to_numpy(dtype=np.int64))
 
     def class_of(self, values: Sequence[int]) -> int:
         """Class (minimal machine state) of the pose with these values (see

@@ -67,9 +67,8 @@ class TruthSource(Protocol):
 
 
 def step_true_classes(steps: pd.DataFrame, truth: GroundTruth) -> NDArray[np.int64]:
-    """The true class of every row's pose (columns ``angle_deg_0 .. angle_deg_{n-1}``)."""
-    columns = list(truth.value_names)
-    return truth.classes_of(steps[columns].to_numpy(dtype=np.int64))
+    """The true class of every row's pose (the truth's ``value_names`` columns)."""
+    return truth.classes_of_table(steps)
 
 
 def truth_table(
