@@ -8,12 +8,13 @@ structs check types and ranges while decoding (integers stay integers, angles in
 ``0..359``, feedback in ``[0, 1]``); shapes and the rules between fields are checked on the
 columns.
 
-The joint positions and obstacle distances of a step are a function of its angles and the
-scenario (what the recorder computed them with, :mod:`rsstp_sim.geometry`). Parsing their
-floats is most of the cost of a step, so a batch is decoded without them, they are computed
-from the angles with numpy, and the batch's first message is decoded whole and compared
-with what was computed, bit for bit: a recording whose numbers do not follow from its
-angles is refused (the chunk CRC already guards every byte).
+The joint positions and obstacle distances of an arm's step depend on its pose alone, and
+parsing their floats is most of the cost of a step, so a batch is decoded without them, and
+only the first message of each pose met is decoded whole: the table's numbers of a pose are
+that message's, what the file holds. Whether they are what the scenario's geometry gives, and
+the same at every visit, is the physics check's business (``rsstp-replay check --physics``),
+so a recording written before a geometry fix still opens, and that check names the first
+step that differs.
 """
 
 from __future__ import annotations
@@ -28,7 +29,6 @@ import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_replay.errors import BadStep, ReplayError
-from rsstp_sim.geometry import ArmGeometry, joint_positions, obstacle_distances
 from rsstp_sim.interface import BLOCKER_ARITY, BLOCKER_KINDS, BlockerKind
 from rsstp_sim.recording.records import json_array
 
@@ -39,7 +39,6 @@ __all__ = [
     "StepColumns",
     "blocker_label",
     "blocker_texts",
-    "pose_numbers",
 ]
 
 _Count = Annotated[int, msgspec.Meta(ge=0, le=2**63 - 1)]
@@ -133,6 +132,9 @@ for _body in ("arm", "rover"):
         msgspec.json.Decoder(list[_AgentStep]),
         msgspec.json.Decoder(_AgentStep),
     )
+_WHOLE_STEPS = msgspec.json.Decoder(list[_Step])
+"""Whole arm step messages, many in one call (the first message of each pose met)."""
+
 # BLOCKER_KINDS (rsstp_sim.interface) are the categories of the steps table's ``blocked_kind``
 # column, in that order in every recording (so tables of several recordings concatenate with
 # the categorical kept).
@@ -193,13 +195,11 @@ class StepColumns:
         n_joints: int,
         n_obstacles: int,
         truth: bool = True,
-        geometry: ArmGeometry | None = None,
         body: str = "arm",
+        numbers: bool = True,
     ) -> None:
-        if truth and geometry is None and body == "arm":
-            raise ReplayError("the ground truth columns need the scenario's geometry")
         self.body = body
-        self.geometry = geometry
+        self.numbers = numbers
         self.n_rows = n_rows
         self.n_joints = n_joints
         self.n_obstacles = n_obstacles
@@ -223,6 +223,12 @@ class StepColumns:
             # One row per column, so each DataFrame column is a contiguous array.
             self.angles_deg = np.empty((n_joints, n_rows), np.int64)
             self.rover_values = np.empty((3 if body == "rover" else 0, n_rows), np.int64)
+            # An arm's pose code -> its positions (n + 1, 2) and distances (n, m), as the
+            # first message at that pose holds them.
+            # x0, y0, x1, y1, ... then the distances tip by tip
+            self.pose_numbers: dict[int, list[float]] = {}
+            self._met = np.zeros(0, np.int64)
+            self._places = 360 ** np.arange(n_joints, dtype=np.int64)
 
     # -- filling ----------------------------------------------------------------------------
 
@@ -263,40 +269,57 @@ class StepColumns:
         self.model_version[s] = [a.model_version for a in agents]
         self.no_transition[s] = np.array([a.no_transition for a in agents], np.bool_)
         if self.truth:
-            self._add_truth([x.truth for x in rows], r, parts[0])
+            self._add_truth([x.truth for x in rows], r, parts)
         self.rows = r + k
 
-    def _check_numbers(self, message: memoryview, angles: npt.NDArray[np.int64]) -> None:
-        """The first message of a batch, decoded whole: its joint positions and distances must
-        be, bit for bit, what its angles give (see the module docstring)."""
+    def _read_numbers(self, parts: list[memoryview], angles: npt.NDArray[np.int64]) -> None:
+        """The positions and distances of every pose of this batch not met before, from its
+        first message here (see the module docstring): those messages decoded whole, in one
+        call."""
+        codes = angles @ self._places
+        met = self._met  # the codes of the poses read so far, sorted
+        if len(met):
+            at = np.minimum(np.searchsorted(met, codes), len(met) - 1)
+            unmet = np.flatnonzero(met[at] != codes)
+            if not len(unmet):
+                return
+        else:
+            unmet = np.arange(len(codes))
+        fresh, first = np.unique(codes[unmet], return_index=True)
+        self._met = np.insert(met, np.searchsorted(met, fresh), fresh)
+        indices = unmet[first].tolist()
+        new = fresh.tolist()
         try:
-            truth = _DECODERS["arm", True][1].decode(message).truth
-        except msgspec.DecodeError as exc:
-            raise BadStep(_describe(exc), index=0) from None
-        positions, distances = pose_numbers(self._geometry(), angles[None, :])
+            truths = [
+                step.truth for step in _WHOLE_STEPS.decode(json_array([parts[i] for i in indices]))
+            ]
+        except msgspec.DecodeError:
+            truths = []
+            for index in indices:  # which one, and why
+                try:
+                    truths.append(_DECODERS["arm", True][1].decode(parts[index]).truth)
+                except msgspec.DecodeError as exc:
+                    raise BadStep(_describe(exc), index=index) from None
         n, m = self.n_joints, self.n_obstacles
-        _check_lengths([truth.joint_positions], n + 1, "truth.joint_positions", "points")
-        _check_lengths([truth.distances], n, "truth.distances", "entries (one per tip)")
-        rows = [tip.obstacles for tip in truth.distances]
-        if any(len(row) != m for row in rows):
-            raise BadStep(f"truth.distances: expected {m} obstacles per tip", index=0)
-        points = [(point.x, point.y) for point in truth.joint_positions]
-        found = np.array(points, np.float64).reshape(n + 1, 2)
-        if not np.array_equal(found, positions[0]):
-            raise BadStep(
-                "truth.joint_positions are not the positions of its angles "
-                f"{angles.tolist()}: {found.tolist()}",
-                index=0,
-            )
-        if m and not np.array_equal(np.array(rows, np.float64), distances[0]):
-            raise BadStep(
-                f"truth.distances are not the distances of its angles {angles.tolist()}",
-                index=0,
-            )
-
-    def _geometry(self) -> ArmGeometry:
-        assert self.geometry is not None  # checked in __init__
-        return self.geometry
+        known = self.pose_numbers
+        for code, index, truth in zip(new, indices, truths, strict=True):
+            if len(truth.joint_positions) != n + 1:
+                found = len(truth.joint_positions)
+                raise BadStep(
+                    f"truth.joint_positions: expected {n + 1} points, found {found}", index=index
+                )
+            rows = [tip.obstacles for tip in truth.distances]
+            if len(rows) != n:
+                raise BadStep(
+                    f"truth.distances: expected {n} entries (one per tip), found {len(rows)}",
+                    index=index,
+                )
+            if any(len(row) != m for row in rows):
+                raise BadStep(f"truth.distances: expected {m} obstacles per tip", index=index)
+            numbers = [v for p in truth.joint_positions for v in (p.x, p.y)]
+            for row in rows:
+                numbers += row
+            known[code] = numbers
 
     def _add_rover_truth(self, truths: list[_RoverTruth], s: slice) -> None:
         """A rover's cell and heading; its position must be its cell's centre."""
@@ -314,7 +337,7 @@ class StepColumns:
                 index=index,
             )
 
-    def _add_truth(self, truths: list[Any], r: int, first: memoryview) -> None:
+    def _add_truth(self, truths: list[Any], r: int, parts: list[memoryview]) -> None:
         k = len(truths)
         n = self.n_joints
         s = slice(r, r + k)
@@ -325,7 +348,8 @@ class StepColumns:
             _check_lengths(angles, n, "truth.angles_deg", "angles")
             flat = np.fromiter(chain.from_iterable(angles), np.int64, k * n)
             self.angles_deg[:, s] = flat.reshape(k, n).T
-            self._check_numbers(first, flat[:n])
+            if self.numbers:
+                self._read_numbers(parts, flat.reshape(k, n))
         self.blocked[s] = np.array([t.blocked for t in truths], np.bool_)
         labels = self.blocker_labels
         bys = [t.blocked_by for t in truths]
@@ -421,23 +445,28 @@ class StepColumns:
             columns["x"] = self.rover_values[0, part] + 0.5
             columns["y"] = self.rover_values[1, part] + 0.5
         elif self.truth and geometry:
+            if not self.numbers:
+                raise ReplayError("the joint positions were not read (numbers=False)")
             columns |= self._geometry_columns(part)
         return pd.DataFrame(columns, index=pd.RangeIndex(start, stop, name="step"), copy=copy)
 
     def _geometry_columns(self, part: slice) -> dict[str, npt.NDArray[np.float64]]:
         """``joint{k}_x``, ``joint{k}_y`` and ``dist_{k}_{j}`` of the rows ``part``: each
-        distinct pose computed once (a long run revisits its poses; found by hashing its
-        code, ``sum_j angle_j * 360**j``), each column taken whole from those."""
-        places = 360 ** np.arange(self.n_joints, dtype=np.int64)
-        index, codes = pd.factorize(places @ self.angles_deg[:, part])
-        poses = codes[:, None] // places % 360
-        positions, distances = pose_numbers(self._geometry(), poses)
+        distinct pose's numbers as the file holds them (found by its code,
+        ``sum_j angle_j * 360**j``), each column taken whole from those."""
+        index, codes = pd.factorize(self._places @ self.angles_deg[:, part])
+        n, m = self.n_joints, self.n_obstacles
+        known = self.pose_numbers
+        numbers = np.array([known[code] for code in np.asarray(codes).tolist()], np.float64)
+        numbers = numbers.reshape(len(codes), 2 * (n + 1) + n * m)
+        positions = numbers[:, : 2 * (n + 1)].reshape(len(codes), n + 1, 2)
+        distances = numbers[:, 2 * (n + 1) :].reshape(len(codes), n, m)
         columns = {}
-        for k in range(self.n_joints + 1):
+        for k in range(n + 1):
             columns[f"joint{k}_x"] = positions[:, k, 0].take(index)
             columns[f"joint{k}_y"] = positions[:, k, 1].take(index)
-        for k in range(self.n_joints):
-            for j in range(self.n_obstacles):
+        for k in range(n):
+            for j in range(m):
                 columns[f"dist_{k}_{j}"] = distances[:, k, j].take(index)
         return columns
 
@@ -485,15 +514,6 @@ def blocker_texts(steps: pd.DataFrame, rows: npt.NDArray[np.int64]) -> npt.NDArr
         )  # (its body's)
         texts.append(blocker_label(kind, indices))
     return np.array(texts, object)[inverse.reshape(-1)]
-
-
-def pose_numbers(
-    geometry: ArmGeometry, angles_deg: npt.NDArray[np.int64]
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Joint positions ``(B, n + 1, 2)`` and obstacle distances ``(B, n, m)`` of poses
-    ``(B, n)``, computed as the recorder computes them."""
-    positions = joint_positions(angles_deg, geometry.lengths)
-    return positions, obstacle_distances(positions[:, 1:], geometry.centers, geometry.radii)
 
 
 def _nullable(values: list[int | None], first: int, nulls: list[int]) -> list[int] | Any:

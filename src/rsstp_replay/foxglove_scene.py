@@ -72,13 +72,11 @@ from foxglove.messages import (
     Vector3,
 )
 
-from rsstp_replay._decode import pose_numbers
 from rsstp_replay._foxglove_rover import RoverDrawing, RoverPoses
 from rsstp_replay._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
 from rsstp_replay._foxglove_stamps import PoseMessages
 from rsstp_sim import __version__, palette
 from rsstp_sim.files import written_whole
-from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.schemas import STEP_NS
@@ -147,7 +145,7 @@ def export_foxglove(recording: Recording, path: str | os.PathLike[str]) -> Scene
     """
     out = Path(path)
     scenario = recording.scenario
-    steps = recording.steps(geometry=False)
+    steps = recording.steps(geometry=not isinstance(scenario, RoverScenario))
     n_steps = len(steps)
     poses: _ArmPoses | RoverPoses
     draw: _Drawing | RoverDrawing
@@ -272,8 +270,7 @@ class _ArmPoses:
     """The arm at step 0 and at every step where it moved: ``steps`` (m), ``codes`` (m pose
     codes, ``sum_j angle_j * 360**j``), ``points`` (m rows of the ``n + 1`` joint positions,
     base first, as x0, y0, x1, y1, ...) and ``angles_deg`` (m rows of the ``n`` relative
-    joint angles). The points are computed from the angles as the recorder computes them
-    (the reader checks that the recording's are those, bit for bit), once per distinct pose.
+    joint angles). The points are the recording's (its steps table's joint positions).
     """
 
     steps: npt.NDArray[np.int64]
@@ -283,18 +280,16 @@ class _ArmPoses:
 
     @classmethod
     def from_steps(cls, steps: pd.DataFrame, scenario: Scenario, *, source: Path) -> _ArmPoses:
+        """From a steps table with its joint positions (as the recording holds them)."""
         numbers = step_numbers(steps, source=source)
         n = scenario.n_joints
         angles = steps[[f"angle_deg_{j}" for j in range(n)]].to_numpy(np.int64)
         moved = np.ones(len(numbers), bool)
         moved[1:] = (angles[1:] != angles[:-1]).any(axis=1)
+        names = [f"joint{k}_{axis}" for k in range(n + 1) for axis in ("x", "y")]
+        points = steps[names].to_numpy(np.float64)[moved]
         angles = angles[moved]
-        places = 360 ** np.arange(n, dtype=np.int64)
-        codes = angles @ places
-        index, distinct = pd.factorize(codes)
-        distinct_angles = np.asarray(distinct)[:, None] // places % 360
-        positions, _ = pose_numbers(ArmGeometry.from_scenario(scenario), distinct_angles)
-        points = positions.reshape(len(distinct), 2 * (n + 1)).take(index, axis=0)
+        codes = angles @ 360 ** np.arange(n, dtype=np.int64)
         return cls(numbers[moved], codes, points, angles)
 
     def __len__(self) -> int:

@@ -45,7 +45,6 @@ from rsstp_replay.errors import (
     UnfinishedRecordingWarning,
 )
 from rsstp_sim.errors import MemoryRangeError
-from rsstp_sim.geometry import ArmGeometry
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
 from rsstp_sim.recording.records import EventKind, EventRecord, ModelRecord, json_array
@@ -185,7 +184,7 @@ class Recording:
           ``internal_state`` (int64); ``sensation`` (bool); ``feedback`` (float64, closeness in
           ``[0, 1]``); ``model_version`` (int64); ``no_transition`` (bool): the agent's view;
         - ``blocked`` (bool) and what blocked the move: ``blocked_kind`` (categorical, always
-          the categories ``fold``, ``obstacle``, ``links``; missing when not blocked) and
+          every body's kinds as categories; missing when not blocked) and
           nullable Int64 indices, each present exactly at the steps of its kind:
           ``blocked_joint`` (``fold``: the joint whose relative angle would reach 180),
           ``blocked_link`` and ``blocked_obstacle`` (``obstacle``: the link that meets the
@@ -195,7 +194,11 @@ class Recording:
         - ``joint{k}_x``, ``joint{k}_y`` (float64, length units, world frame): point ``k`` of
           the arm, ``k = 0`` the base, ``k = n`` the tip of the last link;
         - ``dist_{k}_{j}`` (float64, length units): from the tip of link ``k`` (point ``k + 1``)
-          to obstacle ``j``'s surface;
+          to obstacle ``j``'s surface (a pose's numbers are its first message's, as the file
+          holds them; ``check --physics`` compares every message with the geometry);
+        - a rover's ``cell_x``, ``cell_y``, ``heading_deg`` (int64) and ``x``, ``y`` (float64,
+          its position) instead of an arm's pose columns, and its own blocked index columns
+          (``docs/tables.md``);
         - with ``truth=True``, also ``true_class`` (int64): the state of the minimal correct
           model (the ground truth of :mod:`rsstp_sim.truth`) that the step's pose belongs to.
 
@@ -209,7 +212,7 @@ class Recording:
         such an int64 column becomes float64 there); the other columns keep their dtypes.
         """
         self._check_open()
-        columns = self._step_columns(truth=True)
+        columns = self._step_columns(truth=True, numbers=geometry)
         self._log_times = columns.log_time  # kept: the contract check needs no second pass
         frame = columns.frame(geometry=geometry)
         if truth:
@@ -260,7 +263,7 @@ class Recording:
         they are a third of the table's memory without the geometry."""
         self._check_open()
         events: list[Any] | None = [] if self._events is None else None
-        columns = self._step_columns(truth=True, events=events)
+        columns = self._step_columns(truth=True, events=events, numbers=geometry)
         self._log_times = columns.log_time
         if events is not None:
             self._events = self._event_table(events)
@@ -453,10 +456,13 @@ class Recording:
                 f"{exc.text}"
             ) from None
 
-    def _step_columns(self, *, truth: bool, events: list[Any] | None = None) -> StepColumns:
+    def _step_columns(
+        self, *, truth: bool, events: list[Any] | None = None, numbers: bool = True
+    ) -> StepColumns:
         """Decode and check every step message; with ``events``, add every event's record
-        to it, read in the same pass over the chunks."""
-        columns = self._new_step_columns(truth=truth)
+        to it, read in the same pass over the chunks; ``numbers``: an arm's joint positions
+        and distances too (the table's geometry)."""
+        columns = self._new_step_columns(truth=truth, numbers=numbers)
         for _ in self._decoding(columns, events):
             pass
         self._check_steps(columns)
@@ -485,7 +491,7 @@ class Recording:
         if done < columns.n_rows:
             yield columns.frame(rows=slice(done, columns.n_rows))
 
-    def _new_step_columns(self, *, truth: bool) -> StepColumns:
+    def _new_step_columns(self, *, truth: bool, numbers: bool = True) -> StepColumns:
         scenario = self.scenario
         if isinstance(scenario, RoverScenario):
             return StepColumns(
@@ -496,7 +502,7 @@ class Recording:
             n_joints=scenario.n_joints,
             n_obstacles=len(scenario.obstacles),
             truth=truth,
-            geometry=ArmGeometry.from_scenario(scenario) if truth else None,
+            numbers=numbers,
         )
 
     def _decoding(
