@@ -11,7 +11,10 @@ For each built-in, cold (a fresh process each, as a user runs them):
 
 - ``rsstp-sim truth NAME``: the reachable poses, the true classes N, the seconds it prints
   and the process's wall time;
-- ``rsstp-sim run NAME --strategy random --steps 1000000``: its printed steps per second.
+- ``rsstp-sim run NAME --strategy random --steps 1000000``: its printed steps per second;
+- ``rsstp-sim record NAME --strategy random --steps 100000``, then ``rsstp-replay audit
+  --truth`` and ``rsstp-replay view --save`` of that recording: each one's wall time, and the
+  file's size.
 
 Then the learner, in this process (seed 0): on each small room with a budget of 4 N^2 steps,
 on each built-in with ``--budget`` steps; the steps it took, its model's states, and whether
@@ -39,6 +42,7 @@ from rsstp_sim.truth import check_equivalence, compute_truth
 
 BUILT_INS = ("rover-room", "rover-two-rooms", "rover-one-way")
 RSSTP_SIM = str(Path(sys.executable).with_name("rsstp-sim"))
+RSSTP_REPLAY = str(Path(sys.executable).with_name("rsstp-replay"))
 
 
 def small_room(side: int) -> str:
@@ -52,6 +56,12 @@ def cold(*args: str) -> tuple[str, float]:
     started = time.perf_counter()
     done = subprocess.run([RSSTP_SIM, *args], capture_output=True, text=True, check=True)
     return done.stdout, time.perf_counter() - started
+
+
+def cold_replay(*args: str) -> float:
+    started = time.perf_counter()
+    subprocess.run([RSSTP_REPLAY, *args], capture_output=True, text=True, check=True)
+    return time.perf_counter() - started
 
 
 def learn(text_or_name: str, budget: int | None) -> str:
@@ -102,6 +112,18 @@ def main() -> None:
             f"{name}: {poses} poses, N = {classes}; truth {seconds} s computing, "
             f"{wall:.2f} s cold end to end; random run {rate} steps/s cold"
         )
+        with tempfile.TemporaryDirectory() as folder:
+            path = Path(folder) / f"{name}.mcap"
+            _, recorded = cold(
+                "record", name, "--strategy", "random", "--steps", "100000", "-o", str(path),
+                "--quiet",
+            )  # fmt: skip
+            audited = cold_replay("audit", "--truth", str(path))
+            viewed = cold_replay("view", str(path), "--save", str(path.with_suffix(".rrd")))
+            print(
+                f"  100,000 random steps: record {recorded:.2f} s ({path.stat().st_size:,} "
+                f"bytes), audit --truth {audited:.2f} s, view --save {viewed:.2f} s, cold"
+            )
     with tempfile.TemporaryDirectory():
         for side in args.sides:
             print(learn(small_room(side), None))
