@@ -110,13 +110,7 @@ def log_world_static(stream: rr.RecordingStream, scenario: Scenario) -> None:
         ),
         static=True,
     )
-    stream.log(
-        BLOCKED,
-        rr.Points2D.from_fields(
-            radii=rr.Radius.ui_points(8.0), colors=palette.ARM_BLOCKED, draw_order=7.0
-        ),
-        static=True,
-    )
+    _log_blocked_style(stream)
 
 
 def joint_positions(steps: pd.DataFrame, n_joints: int) -> _Floats:
@@ -187,6 +181,17 @@ def log_world(
         )
     logged |= _log_blocked(stream, steps, positions[:, -1, :])
     return logged
+
+
+def _log_blocked_style(stream: rr.RecordingStream) -> None:
+    """The blocked-move marker's style, static: every body's."""
+    stream.log(
+        BLOCKED,
+        rr.Points2D.from_fields(
+            radii=rr.Radius.ui_points(8.0), colors=palette.ARM_BLOCKED, draw_order=7.0
+        ),
+        static=True,
+    )
 
 
 def _log_blocked(
@@ -285,13 +290,7 @@ def log_rover_static(stream: rr.RecordingStream, scenario: RoverScenario) -> Non
         rr.Arrows2D.from_fields(colors=palette.JOINT, draw_order=6.0),
         static=True,
     )
-    stream.log(
-        BLOCKED,
-        rr.Points2D.from_fields(
-            radii=rr.Radius.ui_points(8.0), colors=palette.ARM_BLOCKED, draw_order=7.0
-        ),
-        static=True,
-    )
+    _log_blocked_style(stream)
 
 
 def log_rover(stream: rr.RecordingStream, steps: pd.DataFrame) -> dict[str, int]:

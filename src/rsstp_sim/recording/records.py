@@ -456,6 +456,11 @@ class TruthRecord(_Record, frozen=True, kw_only=True):
     ]
 
 
+_StepIndex = Annotated[int, _schema("step index t (steps; 0 = the reset)", minimum=0)]
+_Agent = Annotated[AgentRecord, _schema("what the agent knows after this step")]
+"""The fields every body's step message starts with (``rsstp.Step``, ``rsstp.RoverStep``)."""
+
+
 class StepRecord(_Record, frozen=True, kw_only=True):
     """``rsstp.Step`` on ``/rsstp/step``: one step (0 = the reset), agent view and truth."""
 
@@ -466,8 +471,8 @@ class StepRecord(_Record, frozen=True, kw_only=True):
         "`truth` is the world's ground truth, which the agent never sees."
     )
 
-    step: Annotated[int, _schema("step index t (steps; 0 = the reset)", minimum=0)]
-    agent: Annotated[AgentRecord, _schema("what the agent knows after this step")]
+    step: _StepIndex
+    agent: _Agent
     truth: Annotated[TruthRecord, _schema("ground truth after the step (for analysis only)")]
 
 
@@ -635,8 +640,8 @@ class RoverStepRecord(_Record, frozen=True, kw_only=True):
         "knows; `truth` is the world's ground truth, which the agent never sees."
     )
 
-    step: Annotated[int, _schema("step index t (steps; 0 = the reset)", minimum=0)]
-    agent: Annotated[AgentRecord, _schema("what the agent knows after this step")]
+    step: _StepIndex
+    agent: _Agent
     truth: Annotated[RoverTruthRecord, _schema("ground truth after the step (for analysis only)")]
 
 
