@@ -12,6 +12,7 @@ or door, so a room of a few hundred thousand poses takes well under a second.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,6 +78,12 @@ class RoverTable:
 
     @classmethod
     def of(cls, scenario: RoverScenario) -> RoverTable:
+        """The table of ``scenario``: computed once, then shared (it is read-only), so the
+        command's warnings, its world and the ground truth tabulate the room once."""
+        return _table(scenario)
+
+    @classmethod
+    def _compute(cls, scenario: RoverScenario) -> RoverTable:
         width, height = scenario.room
         n_headings = scenario.headings
         codes = np.arange(width * height * n_headings, dtype=np.int64)
@@ -132,6 +139,11 @@ class RoverTable:
         width, height = self.scenario.room
         codes = np.asarray(codes, np.int64)
         return np.stack([codes % width, codes // width % height, codes // (width * height)], 1)
+
+
+@functools.lru_cache(maxsize=4)
+def _table(scenario: RoverScenario) -> RoverTable:
+    return RoverTable._compute(scenario)
 
 
 def cell_clearance(scenario: RoverScenario, centers: FloatArray) -> BoolArray:
