@@ -198,6 +198,15 @@ _SMALL = "[rover]\nroom = [3, 3]\nstart = [0, 0]\n"
     ("text", "message"),
     [
         (
+            "[rover]\nroom = [9223372036854775807, 3]\nstart = [0, 0]\n",
+            r"rover\.room\[0\]: expected an integer in 1\.\.1000, found 9223372036854775807$",
+        ),
+        (
+            _SMALL + "[[walls]]\nfrom = [1e308, 0]\nto = [0, 1]\n",
+            r"walls\[0\]\.from\[0\]: expected a number in \[-1e\+06, 1e\+06\], found 1e\+308$",
+        ),
+        (_SMALL + "radius = 1e308\n", r"rover\.radius: expected a number in \[0, 0\.4999\]"),
+        (
             "[rover]\nroom = [0, 3]\nstart = [0, 0]\n",
             r"rover\.room\[0\]: expected an integer in 1\.\.1000, found 0$",
         ),
