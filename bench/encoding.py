@@ -3,7 +3,7 @@
     PYTHONPATH=src python bench/encoding.py [STEPS]   (default: 20000)
 
 The records are real: a random walk of STEPS steps in the ``three-joint`` scenario (three
-links, two obstacles), one :class:`~rsstp_sim.recording.records.StepRecord` per step (about
+links, two obstacles), one :class:`~rsstp_format.records.StepRecord` per step (about
 510 bytes of JSON), built as a recorder would. Every figure is the best of five passes over
 all records, in microseconds per record:
 
@@ -44,9 +44,9 @@ from typing import Any
 import msgspec
 import orjson
 
+from rsstp_format.records import StepRecord, decode, encode
 from rsstp_sim.coupling import Runner, StepOutcome
 from rsstp_sim.recording.builders import step_record
-from rsstp_sim.recording.records import StepRecord, decode, encode
 from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import RandomStrategy
 from rsstp_sim.world import Pose

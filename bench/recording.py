@@ -65,6 +65,7 @@ from typing import Any
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
+from rsstp_format.schemas import STEP_NS
 from rsstp_sim import (
     Pose,
     RandomStrategy,
@@ -76,7 +77,6 @@ from rsstp_sim import (
 from rsstp_sim.recording.chunks import ChunkedWriter
 from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.recorder import DEFAULT_CHUNK_SIZE, Recorder
-from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.recording.step_messages import StepMessages
 from rsstp_sim.scenario import Scenario
 from step_rate import float_mode  # bench/ is the script folder

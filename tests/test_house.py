@@ -58,8 +58,9 @@ def test_no_built_in_exception_is_raised_on_purpose() -> None:
 
 # ------------------------------------------------------------------- one direction of import
 
-PACKAGES = ("rsstp_sim", "rsstp_replay", "rsstp_sweep", "rsstp_cli")
-"""Bottom to top: each package may import those before it, never one after it."""
+PACKAGES = ("rsstp_format", "rsstp_sim", "rsstp_replay", "rsstp_sweep", "rsstp_cli")
+"""Bottom to top: each package may import those before it, never one after it (the file
+format imports neither the simulator nor the replay side)."""
 READER_LAYERS = ("_container", "_chunks", "_contract", "recording")
 """The replay side's reader, bottom to top: the MCAP file's records, the messages inside its
 chunks, the recording contract, the recording."""
@@ -108,7 +109,7 @@ def test_no_package_imports_another_packages_private_module() -> None:
     assert reaching == []
 
 
-def test_the_four_packages_are_all_there_is() -> None:
+def test_the_five_packages_are_all_there_is() -> None:
     """No top-level module beside the packages in every user's site-packages, and the
     console scripts start in the command-line package."""
     import tomllib

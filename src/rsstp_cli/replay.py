@@ -299,7 +299,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
 def _metadata_text(recording: Recording) -> str:
     if recording.metadata_verified:
         return "metadata: verified by its checksum"
-    from rsstp_sim.recording.schemas import parse_version
+    from rsstp_format.schemas import parse_version
 
     version = max(recording.schema_versions.values(), key=parse_version)
     return (

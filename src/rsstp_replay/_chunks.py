@@ -22,9 +22,9 @@ import numpy as np
 import numpy.typing as npt
 from mcap.opcode import Opcode
 
+from rsstp_format.schemas import STEP_NS
 from rsstp_replay._container import MESSAGE_TIME, ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording
-from rsstp_sim.recording.schemas import STEP_NS
 
 __all__ = [
     "count_messages",

@@ -30,18 +30,14 @@ import msgspec
 import numpy as np
 import numpy.typing as npt
 
-from rsstp_replay._chunks import Messages, count_messages, topic_chunks, topics_chunks
-from rsstp_replay._container import ChunkRef, Container
-from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
-from rsstp_sim.errors import ScenarioError
-from rsstp_sim.recording.records import (
+from rsstp_format.records import (
     RecordFormatError,
     RoverScenarioRecord,
     ScenarioRecord,
     decode,
     decode_many,
 )
-from rsstp_sim.recording.schemas import (
+from rsstp_format.schemas import (
     ATTACHMENT_NAME,
     BODY_TOPICS,
     MESSAGE_ENCODING,
@@ -58,6 +54,10 @@ from rsstp_sim.recording.schemas import (
     parse_version,
     version_refusal,
 )
+from rsstp_replay._chunks import Messages, count_messages, topic_chunks, topics_chunks
+from rsstp_replay._container import ChunkRef, Container
+from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
+from rsstp_sim.errors import ScenarioError
 from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import AnyScenario, Scenario, parse_scenario
 

@@ -28,9 +28,9 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
+from rsstp_format.records import json_array
+from rsstp_format.vocabulary import BLOCKER_ARITY, BLOCKER_KINDS, BlockerKind
 from rsstp_replay.errors import BadStep, ReplayError
-from rsstp_sim.interface import BLOCKER_ARITY, BLOCKER_KINDS, BlockerKind
-from rsstp_sim.recording.records import json_array
 
 __all__ = [
     "BLOCKED_COLUMNS",

@@ -12,9 +12,9 @@ import numpy.typing as npt
 import pandas as pd
 from foxglove.messages import Color, Quaternion, Timestamp
 
+from rsstp_format.schemas import STEP_NS
 from rsstp_replay.errors import ReplayError
 from rsstp_sim import palette
-from rsstp_sim.recording.schemas import STEP_NS
 
 __all__ = ["BLOCK", "color", "pose_rows", "step_numbers", "timestamp", "turn"]
 

@@ -17,8 +17,8 @@ from collections.abc import Callable
 
 from foxglove.messages import FrameTransforms, SceneUpdate
 
+from rsstp_format.schemas import STEP_NS
 from rsstp_replay.errors import ReplayError
-from rsstp_sim.recording.schemas import STEP_NS
 
 __all__ = ["PoseMessages", "timestamp_field"]
 

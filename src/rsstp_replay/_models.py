@@ -16,9 +16,9 @@ from typing import Any, cast
 
 import msgspec
 
+from rsstp_format.records import ModelRecord, TransitionsRecord, encode
 from rsstp_replay.errors import CorruptRecording
 from rsstp_sim.errors import ModelError
-from rsstp_sim.recording.records import ModelRecord, TransitionsRecord, encode
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["HEADS", "ChainCheck", "ModelHead", "build_model"]
@@ -31,7 +31,7 @@ ModelHead: Any = msgspec.defstruct(
     gc=False,
 )
 """A ``/rsstp/model`` message read without its transitions (the parser skips them): the
-fields of :class:`~rsstp_sim.recording.records.ModelRecord` but those. What
+fields of :class:`~rsstp_format.records.ModelRecord` but those. What
 :meth:`ChainCheck.head` needs to rebuild the version and write its bytes again."""
 
 

@@ -23,8 +23,8 @@ from itertools import chain
 
 import numpy as np
 
+from rsstp_format.records import ModelRecord
 from rsstp_sim.graph import plain_positions, run_graphviz
-from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem, snapshot_form
 
 __all__ = [

@@ -49,6 +49,7 @@ import numpy.typing as npt
 import pandas as pd
 import rerun as rr
 
+from rsstp_format.records import ModelRecord
 from rsstp_replay._viewer_chunks import TIMELINE, send_rows
 from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.state_roles import (
@@ -60,7 +61,6 @@ from rsstp_replay.audits.state_roles import (
     state_roles,
 )
 from rsstp_sim import palette
-from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = [

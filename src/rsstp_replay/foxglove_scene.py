@@ -72,6 +72,7 @@ from foxglove.messages import (
     Vector3,
 )
 
+from rsstp_format.schemas import STEP_NS
 from rsstp_replay._foxglove_rover import RoverDrawing, RoverPoses
 from rsstp_replay._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
 from rsstp_replay._foxglove_stamps import PoseMessages
@@ -79,7 +80,6 @@ from rsstp_sim import __version__, palette
 from rsstp_sim.files import written_whole
 from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter
-from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.words import counted

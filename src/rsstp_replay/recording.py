@@ -31,6 +31,8 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
+from rsstp_format.records import EventKind, EventRecord, ModelRecord, json_array
+from rsstp_format.schemas import STEP_NS
 from rsstp_replay._chunks import Messages, gc_paused, message_times
 from rsstp_replay._container import ChunkRef, open_container
 from rsstp_replay._contract import CheckedFile, check_file
@@ -47,8 +49,6 @@ from rsstp_replay.errors import (
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
-from rsstp_sim.recording.records import EventKind, EventRecord, ModelRecord, json_array
-from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.rover import RoverScenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
@@ -61,7 +61,7 @@ _Stepped = TypeVar("_Stepped", EventRecord, ModelRecord, ModelHead)
 
 EVENT_KINDS: tuple[EventKind, ...] = get_args(EventKind)
 """The categories of :meth:`Recording.events`' ``kind`` column: the event kinds of the record
-(:data:`rsstp_sim.recording.records.EventKind`), in its order."""
+(:data:`rsstp_format.records.EventKind`), in its order."""
 
 _CACHED_CHUNKS = 4
 

@@ -22,9 +22,9 @@ from typing import Any, Protocol
 import numpy as np
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
+from rsstp_format.records import ModelRecord, RoverScenarioRecord, ScenarioRecord
 from rsstp_replay.errors import TableError
 from rsstp_replay.recording import Recording
-from rsstp_sim.recording.records import ModelRecord, RoverScenarioRecord, ScenarioRecord
 
 __all__ = ["TABLES", "model_table", "recording_table", "scenario_table"]
 

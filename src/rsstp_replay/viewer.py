@@ -33,6 +33,7 @@ import numpy as np
 import pandas as pd
 import rerun as rr
 
+from rsstp_format.records import ModelRecord
 from rsstp_replay import _viewer_model as model_part
 from rsstp_replay import _viewer_plots as plots_part
 from rsstp_replay import _viewer_world as world_part
@@ -57,7 +58,6 @@ from rsstp_sim import graph
 from rsstp_sim.errors import OutputError, RsstpError
 from rsstp_sim.files import side_file, write_whole
 from rsstp_sim.memory import Memory
-from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.transition_system import TransitionSystem

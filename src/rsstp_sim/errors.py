@@ -1,6 +1,12 @@
-"""The simulator's exception hierarchy: one root, one subclass per condition."""
+"""The simulator's exception hierarchy: one root, one subclass per condition.
+
+The root (:class:`RsstpError`) and the recording format's error (:class:`RecordFormatError`)
+are the file format's (:mod:`rsstp_format.errors`), the floor both packages stand on.
+"""
 
 from __future__ import annotations
+
+from rsstp_format.errors import RecordFormatError, RsstpError
 
 __all__ = [
     "RsstpError",
@@ -20,10 +26,6 @@ __all__ = [
     "UnknownPose",
     "UsageError",
 ]
-
-
-class RsstpError(Exception):
-    """Root of every error this project raises on purpose."""
 
 
 class ScenarioError(RsstpError):
@@ -70,10 +72,6 @@ class ChunkProcessFailed(RecordingError):
 
 class ActionError(RsstpError):
     """An action is not one of the scenario's actions."""
-
-
-class RecordFormatError(RsstpError):
-    """A message does not have the shape of its record: the message names the field path."""
 
 
 class UsageError(RsstpError):

@@ -32,8 +32,8 @@ from typing import Protocol
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from rsstp_format.vocabulary import BlockerKind
 from rsstp_sim._arrays import FloatArray, IntArray
-from rsstp_sim.interface import BlockerKind
 
 __all__ = [
     "ARM_BLOCKER_KINDS",

@@ -13,45 +13,18 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any, Literal, Protocol, get_args
+from typing import Any, Protocol
 
 from rsstp_sim._arrays import BoolArray, IntArray
 
 __all__ = [
-    "BLOCKER_ARITY",
-    "BLOCKER_KINDS",
     "Blocker",
-    "BlockerKind",
     "Body",
     "Pose",
     "PoseMachine",
     "World",
     "WorldScenario",
 ]
-
-BlockerKind = Literal["fold", "obstacle", "links", "room", "wall", "door"]
-"""Why a move was blocked, for every body: the one definition of the blocker kinds, which the
-records, the schemas generated from them and the replay side's tables take from here.
-
-- the arm: ``fold`` (joint ``j`` would fold back onto its link: ``(j,)``), ``obstacle``
-  (link ``i`` meets obstacle ``j``: ``(i, j)``), ``links`` (links ``i`` and ``j`` meet);
-- the rover: ``room`` (it would leave the room by edge ``e``: ``(e,)``, 0 east, 1 north,
-  2 west, 3 south), ``obstacle`` (``(0, j)``: the robot, part 0 of its body, meets obstacle
-  ``j``), ``wall`` (``(w,)``), ``door`` (a one-way door ``d`` the other way: ``(d,)``)."""
-
-BLOCKER_KINDS: tuple[BlockerKind, ...] = get_args(BlockerKind)
-"""The blocker kinds in their order (the order of a steps table's ``blocked_kind``
-categories)."""
-
-BLOCKER_ARITY: dict[BlockerKind, int] = {
-    "fold": 1,
-    "obstacle": 2,
-    "links": 2,
-    "room": 1,
-    "wall": 1,
-    "door": 1,
-}
-"""How many indices a blocker of each kind has."""
 
 
 class WorldScenario(Protocol):

@@ -31,8 +31,9 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, ClassVar, Literal, TypeAlias
+from typing import TYPE_CHECKING, ClassVar, TypeAlias
 
+from rsstp_format.vocabulary import CollisionMode, FeedbackMode
 from rsstp_sim import geometry
 from rsstp_sim._validation import MISSING, KeyedValidator
 from rsstp_sim.bodies import BODIES, body_named
@@ -52,8 +53,6 @@ __all__ = [
     "parse_scenario",
 ]
 
-FeedbackMode = Literal["bool", "float"]
-CollisionMode = Literal["swept", "endpoint"]
 
 _SECTIONS: dict[str, frozenset[str]] = {
     "arm": frozenset({"lengths", "initial_deg", "step_deg", "actions"}),

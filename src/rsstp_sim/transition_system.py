@@ -40,33 +40,15 @@ import bisect
 import operator
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
-from typing import Literal
 
 import numpy as np
 
+from rsstp_format.vocabulary import Operation, snapshot_form
 from rsstp_sim.errors import ModelError, RsstpError
 
 __all__ = ["DeterminismReport", "Operation", "TransitionSystem", "snapshot_form"]
 
-OperationKind = Literal["split", "merge", "add", "delete"]
 _ARITY: dict[str, int] = {"split": 1, "merge": 2, "add": 3, "delete": 3}
-
-
-@dataclass(frozen=True, slots=True)
-class Operation:
-    """One change applied to a transition system, as logged and replayed.
-
-    ``args`` is ``(s,)`` for split, ``(s, t)`` for merge and ``(s, t, a)`` for
-    add and delete. ``result`` is the new state's id for split, the surviving
-    ``s`` for merge and ``None`` for add and delete. ``changed`` is ``False``
-    only for an add of an existing or a delete of a missing transition; such
-    no-ops are never logged by :class:`TransitionSystem`.
-    """
-
-    kind: OperationKind
-    args: tuple[int, ...]
-    result: int | None
-    changed: bool = True
 
 
 @dataclass(frozen=True, slots=True)
@@ -616,21 +598,3 @@ def _as_list(value: object, what: str) -> list[object]:
     if isinstance(value, str | bytes | Mapping) or not isinstance(value, Iterable):
         raise ModelError(f"snapshot: {what} must be a list, got {value!r}")
     return list(value)
-
-
-def snapshot_form(
-    states: Iterable[int],
-    next_id: int,
-    current: int,
-    actions: Iterable[int],
-    transitions: Iterable[Iterable[int]],
-) -> dict[str, object]:
-    """The sparse form of a model that :meth:`TransitionSystem.from_snapshot` reads: its
-    states, the next id, the current state, the actions and ``[s, a, t]`` transitions."""
-    return {
-        "states": list(states),
-        "next_id": next_id,
-        "current": current,
-        "actions": list(actions),
-        "transitions": [list(t) for t in transitions],
-    }

@@ -16,6 +16,7 @@ from fakes import FakeRecording, RandomRefiner, StaticRecording
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rsstp_format import records
 from rsstp_replay.audits import (
     AuditReport,
     CompareFindings,
@@ -30,7 +31,7 @@ from rsstp_replay.recording import open_recording
 from rsstp_sim import Memory, RandomStrategy, load_scenario
 from rsstp_sim.errors import MemoryRangeError, ModelError
 from rsstp_sim.memory import CompareKind
-from rsstp_sim.recording import builders, records
+from rsstp_sim.recording import builders
 from rsstp_sim.recording.recorder import record as record_run
 from rsstp_sim.transition_system import TransitionSystem
 

@@ -25,11 +25,11 @@ import pytest
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
+from rsstp_format.schemas import SCHEMA_VERSION
 from rsstp_replay import Recording, errors, open_recording
 from rsstp_replay.table_files import write_table_parts
 from rsstp_sim import AgentView, StrategyBase, load_scenario
 from rsstp_sim.recording.recorder import record
-from rsstp_sim.recording.schemas import SCHEMA_VERSION
 from waiting import HANG_S
 
 SRC = Path(__file__).resolve().parents[2] / "src"

@@ -3,7 +3,7 @@
 ``rsstp_replay._decode`` reads step messages with structs of its own, for speed: they skip
 what a batch does not need (the joint positions and distances that follow from the angles)
 and are not tracked by the garbage collector, and decoding a chunk's steps with them takes
-about a third of the time :class:`~rsstp_sim.recording.records.StepRecord` takes (2026-11-28,
+about a third of the time :class:`~rsstp_format.records.StepRecord` takes (2026-11-28,
 the 10,001 steps of ``recordings/three-joint-random.mcap``: 1.1 us a step against 3.0 us).
 So they are kept, and checked here against the records, which the schemas are generated
 from: the same fields in the same order, the same optional fields, the same types, and the
@@ -20,8 +20,8 @@ from typing import Any
 import msgspec
 import pytest
 
+from rsstp_format import records
 from rsstp_replay import _decode
-from rsstp_sim.recording import records
 
 WHOLE = [
     (_decode._Step, records.StepRecord),

@@ -24,6 +24,7 @@ import pandas as pd
 import pytest
 from mcap.reader import make_reader
 
+from rsstp_format import records
 from rsstp_replay import EVENT_KINDS, open_recording
 from rsstp_replay._container import Container
 from rsstp_replay.errors import (
@@ -33,7 +34,6 @@ from rsstp_replay.errors import (
     UnfinishedRecordingWarning,
 )
 from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, make_strategy
-from rsstp_sim.recording import records
 from rsstp_sim.recording.recorder import record
 from rsstp_sim.transition_system import TransitionSystem
 from waiting import wait_until

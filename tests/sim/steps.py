@@ -3,8 +3,9 @@ step messages are compared with (``test_records.py``, ``test_step_messages.py``)
 
 from __future__ import annotations
 
+from rsstp_format import records
 from rsstp_sim import Pose, StepOutcome
-from rsstp_sim.recording import builders, records
+from rsstp_sim.recording import builders
 from rsstp_sim.transition_system import TransitionSystem
 
 

@@ -25,8 +25,8 @@ from mcap.reader import make_reader
 from mcap.records import Channel, Chunk, DataEnd, Footer, Message
 from mcap.stream_reader import StreamReader, breakup_chunk
 
+from rsstp_format import records, schemas
 from rsstp_sim import RandomStrategy, load_scenario
-from rsstp_sim.recording import records, schemas
 from rsstp_sim.recording.recorder import record
 from waiting import HANG_S, wait_until
 

@@ -29,6 +29,8 @@ from mcap.stream_reader import StreamReader, breakup_chunk
 from mcap.summary import Summary
 
 from builtin_worlds import builtins_of
+from rsstp_format import records, schemas
+from rsstp_format.records import EventRecord, ModelRecord, StepRecord
 from rsstp_sim import (
     AgentView,
     Pose,
@@ -41,10 +43,9 @@ from rsstp_sim import (
     load_scenario,
     make_strategy,
 )
-from rsstp_sim.recording import builders, records, schemas
+from rsstp_sim.recording import builders
 from rsstp_sim.recording import recorder as recorder_module
 from rsstp_sim.recording.recorder import Recorder, record
-from rsstp_sim.recording.records import EventRecord, ModelRecord, StepRecord
 from rsstp_sim.recording.step_messages import Block
 from rsstp_sim.scenario import Scenario
 from rsstp_sim.strategies import Strategy

@@ -30,8 +30,9 @@ from jsonschema import Draft202012Validator
 from steps import step_record_after
 
 import rsstp_sim
+from rsstp_format import records, schemas
 from rsstp_sim.coupling import Event, Runner, StepOutcome
-from rsstp_sim.recording import builders, records, schemas
+from rsstp_sim.recording import builders
 from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import Scenario, builtin_scenarios, load_scenario
 from rsstp_sim.strategies import RandomStrategy, strategy_origin
@@ -60,7 +61,7 @@ def test_schema_is_a_valid_draft_2020_12_schema(name: str) -> None:
 def test_packaged_schema_bytes_are_the_repository_files(name: str) -> None:
     on_disk = (SCHEMA_DIR / f"{name}.json").read_bytes()
     assert schemas.schema_bytes(name) == on_disk
-    packaged = resources.files("rsstp_sim").joinpath(f"schemas/{name}.json").read_bytes()
+    packaged = resources.files("rsstp_format").joinpath(f"schemas/{name}.json").read_bytes()
     assert packaged == on_disk
 
 

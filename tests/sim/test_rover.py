@@ -18,13 +18,13 @@ import pytest
 import shapely
 
 from builtin_worlds import builtins_of
+from rsstp_format.schemas import SCHEMA_VERSION, STEP_NS
 from rsstp_replay import errors, open_recording
 from rsstp_sim import Runner, make_strategy, palette
 from rsstp_sim.bodies import body_of, make_world
 from rsstp_sim.errors import ActionError, ScenarioError
 from rsstp_sim.recording.env_wrapper import RecordMcap
 from rsstp_sim.recording.recorder import record
-from rsstp_sim.recording.schemas import SCHEMA_VERSION, STEP_NS
 from rsstp_sim.rover import RoverScenario, RoverWorld
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.truth import compute_truth

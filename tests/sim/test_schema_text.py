@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from rsstp_sim.recording import schema_text, schemas
+from rsstp_format import schema_text, schemas
 
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "schemas"
 
@@ -19,7 +19,7 @@ def test_the_checked_in_schema_is_the_generated_one(name: str) -> None:
     generated = schema_text.schema_text(name).encode("utf-8")
     assert generated == (SCHEMA_DIR / f"{name}.json").read_bytes(), (
         f"schemas/{name}.json differs from the record classes: run "
-        "python -m rsstp_sim.recording.schema_text (and see schemas/README.md, Versions)"
+        "python -m rsstp_format.schema_text (and see schemas/README.md, Versions)"
     )
     assert generated == schemas.schema_bytes(name)
 

@@ -19,6 +19,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from steps import step_record_after
 
+from rsstp_format import records
+from rsstp_format.vocabulary import BLOCKER_ARITY
 from rsstp_sim import (
     AgentView,
     RandomStrategy,
@@ -28,8 +30,7 @@ from rsstp_sim import (
     load_scenario,
 )
 from rsstp_sim.geometry import ARM_BLOCKER_KINDS, Blocker
-from rsstp_sim.interface import BLOCKER_ARITY
-from rsstp_sim.recording import builders, records
+from rsstp_sim.recording import builders
 from rsstp_sim.recording.chunks import Message
 from rsstp_sim.recording.step_messages import BlockMessages, StepMessages, Steps
 from rsstp_sim.scenario import Scenario, parse_scenario

@@ -37,8 +37,8 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd
 
-from rsstp_sim.recording.records import ModelRecord
-from rsstp_sim.recording.schemas import STEP_NS
+from rsstp_format.records import ModelRecord
+from rsstp_format.schemas import STEP_NS
 from rsstp_sim.words import counted
 
 __all__ = ["ContractFindings", "ContractSource", "Violation", "check_contract", "version_index"]

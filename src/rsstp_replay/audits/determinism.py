@@ -36,8 +36,8 @@ from typing import Any, Protocol
 
 import pandas as pd
 
+from rsstp_format.records import ModelRecord
 from rsstp_sim.errors import ModelError
-from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import DeterminismReport, TransitionSystem
 from rsstp_sim.words import counted
 

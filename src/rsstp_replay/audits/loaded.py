@@ -21,9 +21,9 @@ import numpy as np
 import numpy.typing as npt
 import pandas as pd
 
+from rsstp_format.records import ModelRecord
 from rsstp_replay._decode import BLOCKED_COLUMNS
 from rsstp_sim.memory import Memory
-from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import Scenario
 
 __all__ = ["LoadedRecording", "load"]

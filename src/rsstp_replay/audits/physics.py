@@ -26,10 +26,11 @@ import msgspec
 import numpy as np
 from numpy.typing import NDArray
 
+from rsstp_format import records
 from rsstp_replay._chunks import gc_paused
 from rsstp_replay.errors import PhysicsDifference
 from rsstp_sim.errors import ActionError
-from rsstp_sim.recording import builders, records
+from rsstp_sim.recording import builders
 from rsstp_sim.rover import RoverScenario, RoverWorld
 from rsstp_sim.strategies import StrategyOrigin
 from rsstp_sim.world import World

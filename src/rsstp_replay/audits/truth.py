@@ -38,12 +38,12 @@ import numpy as np
 import pandas as pd
 from numpy.typing import NDArray
 
+from rsstp_format.records import ModelRecord
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
 from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
 from rsstp_sim.memory import Memory
-from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.truth import GroundTruth
 from rsstp_sim.truth_cache import load_truth

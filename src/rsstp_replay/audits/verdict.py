@@ -35,13 +35,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from rsstp_format.records import ModelRecord
 from rsstp_replay.audits._equivalence import (
     ModelTable,
     TrackedTable,
     closure,
     equivalent_classes,
 )
-from rsstp_sim.recording.records import ModelRecord
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence
 from rsstp_sim.words import counted

@@ -1,6 +1,6 @@
 """Building records from the simulator's live objects: the scenario, a step's outcome and
 pose, a model version, and the events (blocked moves, missing transitions, refinements,
-contradictions, notes). :mod:`rsstp_sim.recording.records` says what the records are.
+contradictions, notes). :mod:`rsstp_format.records` says what the records are.
 
 >>> note_event(3, "exploring joint 1")
 EventRecord(step=3, kind='note', text='exploring joint 1', data={})
@@ -15,9 +15,7 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 
-from rsstp_sim.coupling import stop_text
-from rsstp_sim.errors import RecordFormatError
-from rsstp_sim.recording.records import (
+from rsstp_format.records import (
     AgentRecord,
     BlockedByRecord,
     DistancesRecord,
@@ -43,6 +41,8 @@ from rsstp_sim.recording.records import (
     TruthRecord,
     encode_json,
 )
+from rsstp_sim.coupling import stop_text
+from rsstp_sim.errors import RecordFormatError
 from rsstp_sim.rover import RoverBlocker, RoverPose, RoverScenario
 from rsstp_sim.transition_system import Operation
 

@@ -22,9 +22,9 @@ from collections.abc import Callable
 from contextlib import ExitStack
 from pathlib import Path
 
+from rsstp_format.schemas import STEP_NS
 from rsstp_sim.errors import RecordingError
 from rsstp_sim.files import irregular, side_file
-from rsstp_sim.recording.schemas import STEP_NS
 from rsstp_sim.switching import sooner_switches
 
 __all__ = ["SideFileWriter", "open_side_file"]

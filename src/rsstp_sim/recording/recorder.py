@@ -40,19 +40,8 @@ from importlib import metadata
 from itertools import islice
 from pathlib import Path
 
-from rsstp_sim.coupling import Event, Runner, StepOutcome
-from rsstp_sim.errors import (
-    ChunkProcessFailed,
-    RecordingError,
-    RecordingWriteError,
-    RsstpError,
-)
-from rsstp_sim.files import side_file
-from rsstp_sim.recording import builders, records
-from rsstp_sim.recording.chunk_process import ChunkProcess
-from rsstp_sim.recording.chunks import ChunkedWriter, Message
-from rsstp_sim.recording.output import SideFileWriter, open_side_file
-from rsstp_sim.recording.schemas import (
+from rsstp_format import records
+from rsstp_format.schemas import (
     ATTACHMENT_MEDIA_TYPE,
     ATTACHMENT_NAME,
     BODY_TOPICS,
@@ -64,6 +53,18 @@ from rsstp_sim.recording.schemas import (
     metadata_checksum,
     schema_bytes,
 )
+from rsstp_sim.coupling import Event, Runner, StepOutcome
+from rsstp_sim.errors import (
+    ChunkProcessFailed,
+    RecordingError,
+    RecordingWriteError,
+    RsstpError,
+)
+from rsstp_sim.files import side_file
+from rsstp_sim.recording import builders
+from rsstp_sim.recording.chunk_process import ChunkProcess
+from rsstp_sim.recording.chunks import ChunkedWriter, Message
+from rsstp_sim.recording.output import SideFileWriter, open_side_file
 from rsstp_sim.recording.step_messages import Block, BlockMessages, StepMessages
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.strategies import Strategy, strategy_origin

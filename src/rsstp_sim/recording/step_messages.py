@@ -16,8 +16,8 @@ the blocks go as a few integers a step.
 A blocked event's JSON after its step number depends on the action and the blocker alone,
 and is encoded once per pair.
 
-Floats are msgspec's (the encoder of :func:`~rsstp_sim.recording.records.encode`), and the
-bytes are those of :func:`~rsstp_sim.recording.records.encode` on
+Floats are msgspec's (the encoder of :func:`~rsstp_format.records.encode`), and the
+bytes are those of :func:`~rsstp_format.records.encode` on
 :func:`~rsstp_sim.recording.builders.step_record` and
 :func:`~rsstp_sim.recording.builders.blocked_event`: ``tests/sim/test_step_messages.py``
 compares them over live runs (obstacles or none, blocked moves, steps with no transition,
@@ -30,10 +30,10 @@ from __future__ import annotations
 from collections.abc import Callable, Generator, Iterable, Sized
 from typing import TYPE_CHECKING, NamedTuple
 
+from rsstp_format.records import encode, encode_json
+from rsstp_format.schemas import STEP_NS
 from rsstp_sim.recording import builders
 from rsstp_sim.recording.chunks import Message
-from rsstp_sim.recording.records import encode, encode_json
-from rsstp_sim.recording.schemas import STEP_NS
 
 if TYPE_CHECKING:
     from rsstp_sim.coupling import StepOutcome

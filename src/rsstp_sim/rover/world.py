@@ -8,9 +8,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rsstp_format.vocabulary import BlockerKind
 from rsstp_sim._arrays import IntArray
 from rsstp_sim.errors import ActionError
-from rsstp_sim.interface import BlockerKind
 from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario
 from rsstp_sim.rover.table import ROOM_EDGES, RoverTable
 

@@ -1,8 +1,8 @@
-"""The JSON Schemas of a recording, as shipped in the package (``rsstp_sim/schemas/*.json``).
+"""The JSON Schemas of a recording, as shipped in the package (``rsstp_format/schemas/*.json``).
 
 A recording registers each schema's file byte for byte (:func:`schema_bytes`), so the
 files are part of the contract (they are written from the record classes by
-:mod:`~rsstp_sim.recording.schema_text`); ``schemas/README.md`` documents every field, the
+:mod:`~rsstp_format.schema_text`); ``schemas/README.md`` documents every field, the
 topics, the metadata record, the attachment and the version policy: a reader accepts any
 ``2.x`` (ignoring fields it does not know) and refuses another major version
 (:func:`check_schema_version`).
@@ -25,7 +25,7 @@ from collections.abc import Mapping
 from importlib import resources
 from typing import TYPE_CHECKING, Any
 
-from rsstp_sim.recording.records import RecordFormatError
+from rsstp_format.records import RecordFormatError
 
 if TYPE_CHECKING:
     from jsonschema import Draft202012Validator
@@ -221,7 +221,7 @@ def _known(name: str) -> str:
 
 @functools.cache
 def _schema_bytes(name: str) -> bytes:
-    return resources.files("rsstp_sim").joinpath(f"schemas/{name}.json").read_bytes()
+    return resources.files("rsstp_format").joinpath(f"schemas/{name}.json").read_bytes()
 
 
 @functools.cache

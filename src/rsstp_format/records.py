@@ -2,7 +2,7 @@
 
 Each message schema (``rsstp.Scenario``, ``rsstp.Step``, ``rsstp.Model``, ``rsstp.Event``)
 has a record class, and each nested object of a schema has one too. The schema files are
-written from these classes (:mod:`~rsstp_sim.recording.schema_text`): field names, order and
+written from these classes (:mod:`~rsstp_format.schema_text`): field names, order and
 types, and in each field's ``Annotated`` metadata its description and bounds. JSON arrays are
 tuples, points are :class:`PointRecord` ``{x, y}``, a model's transitions a
 :class:`TransitionsRecord` of three parallel arrays. A field the schema makes optional is
@@ -13,12 +13,12 @@ tuples, points are :class:`PointRecord` ``{x, y}``, a model's transitions a
 - ``Record.from_json(data)`` reads one back, ignoring keys it does not know (a later 2.x may
   add fields) and refusing missing or mistyped ones with a :class:`RecordFormatError` that
   names the field path; value ranges are the schema's business
-  (:func:`rsstp_sim.recording.schemas.validate`);
+  (:func:`rsstp_format.schemas.validate`);
 - :func:`encode` and :func:`decode` turn records into the bytes of an MCAP message and back
   (msgspec, the fastest: see ``bench/encoding.py``); floats are written as their shortest
   round-trip representation, so ground truth survives exactly.
 
-:mod:`rsstp_sim.recording.builders` makes records from the simulator's live objects.
+:mod:`rsstp_sim.recording.builders` (the simulator) makes records from the simulator's live objects.
 
 >>> record = EventRecord(step=3, kind="note", text="exploring joint 1", data={})
 >>> encode(record)
@@ -38,10 +38,15 @@ from typing import Annotated, Any, ClassVar, Literal, Self, TypeVar
 
 import msgspec
 
-from rsstp_sim.errors import RecordFormatError
-from rsstp_sim.interface import BlockerKind
-from rsstp_sim.scenario import CollisionMode, FeedbackMode
-from rsstp_sim.transition_system import Operation, OperationKind, snapshot_form
+from rsstp_format.errors import RecordFormatError
+from rsstp_format.vocabulary import (
+    BlockerKind,
+    CollisionMode,
+    FeedbackMode,
+    Operation,
+    OperationKind,
+    snapshot_form,
+)
 
 __all__ = [
     "AgentRecord",
@@ -109,10 +114,10 @@ class _Record(msgspec.Struct, frozen=True, omit_defaults=True, kw_only=True):
 def _schema(description: str | None = None, **keywords: Any) -> msgspec.Meta:
     """A field's JSON Schema beyond its type: its ``description`` and the ``keywords`` that
     bound its value (``minimum``, ``minItems``, ``pattern``...), in the order the schema file
-    has them. :mod:`~rsstp_sim.recording.schema_text` writes ``schemas/*.json`` from these;
+    has them. :mod:`~rsstp_format.schema_text` writes ``schemas/*.json`` from these;
     msgspec keeps the keywords for its own JSON Schema and does not check them when it
     decodes: value ranges are the schema's business
-    (:func:`~rsstp_sim.recording.schemas.validate`)."""
+    (:func:`~rsstp_format.schemas.validate`)."""
     return msgspec.Meta(description=description, extra_json_schema=keywords or None)
 
 
@@ -983,7 +988,7 @@ def decode(schema_name: str, data: bytes) -> MessageRecord:
     """Read a message's bytes as the record of ``schema_name`` (``rsstp.Step``, ...).
 
     Unknown keys are ignored; a missing or mistyped field raises :class:`RecordFormatError`
-    naming its path. Value ranges are checked by :func:`~rsstp_sim.recording.schemas.validate`.
+    naming its path. Value ranges are checked by :func:`~rsstp_format.schemas.validate`.
     """
     decoder = _DECODERS.get(schema_name)
     if decoder is None:

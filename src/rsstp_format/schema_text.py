@@ -1,14 +1,14 @@
 """The JSON Schemas of a recording, written from the record classes.
 
-Each message's fields are declared once, in :mod:`~rsstp_sim.recording.records`: their
+Each message's fields are declared once, in :mod:`~rsstp_format.records`: their
 names, order and types, and (in each field's ``Annotated`` metadata) their description and
 the keywords that bound their values. This module writes ``schemas/*.json`` from them, byte
 for byte (2-space indent, UTF-8, a final newline): a recording registers the files' bytes,
 so the text is part of the contract, and ``tests/sim/test_schema_text.py`` fails when a
 checked-in file differs from what this gives. After changing a record class::
 
-    python -m rsstp_sim.recording.schema_text            # rewrites schemas/*.json
-    python -m rsstp_sim.recording.schema_text --check    # exit 1 if a file differs
+    python -m rsstp_format.schema_text            # rewrites schemas/*.json
+    python -m rsstp_format.schema_text --check    # exit 1 if a file differs
 
 How a field's type reads: ``int`` ``integer``, ``float`` ``number``, ``bool`` ``boolean``,
 ``str`` ``string``, a ``Literal`` a string with its ``enum``, a tuple an ``array`` of its
@@ -17,7 +17,7 @@ the same field left out of ``required``. An event's ``data`` (a dict in the reco
 properties from ``records._EventData`` and gives the schema's ``allOf``, one branch per
 struct of ``records._EVENT_DATA`` that requires a field.
 
->>> from rsstp_sim.recording.schemas import schema_bytes
+>>> from rsstp_format.schemas import schema_bytes
 >>> schema_text("rsstp.Step") == schema_bytes("rsstp.Step").decode("utf-8")
 True
 """
@@ -35,9 +35,9 @@ from typing import Annotated, Any, Literal, Union
 
 import msgspec
 
-from rsstp_sim.errors import RecordFormatError
-from rsstp_sim.recording.records import RECORD_TYPES
-from rsstp_sim.recording.schemas import SCHEMA_NAMES, SCHEMA_VERSION
+from rsstp_format.errors import RecordFormatError
+from rsstp_format.records import RECORD_TYPES
+from rsstp_format.schemas import SCHEMA_NAMES, SCHEMA_VERSION
 
 __all__ = ["SCHEMA_DIALECT", "main", "schema_document", "schema_text", "write_schemas"]
 
@@ -87,16 +87,16 @@ def write_schemas(directory: Path, *, check: bool = False) -> list[Path]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m rsstp_sim.recording.schema_text [--check] [DIRECTORY]``."""
+    """``python -m rsstp_format.schema_text [--check] [DIRECTORY]``."""
     parser = argparse.ArgumentParser(
-        prog="python -m rsstp_sim.recording.schema_text",
+        prog="python -m rsstp_format.schema_text",
         description="Write the recording's JSON Schemas from the record classes.",
     )
     parser.add_argument(
         "directory",
         nargs="?",
         type=Path,
-        default=Path(__file__).resolve().parents[1] / "schemas",
+        default=Path(__file__).resolve().parent / "schemas",
         help="where the schema files are (default: the package's schemas, the repository's "
         "schemas/ folder)",
     )
