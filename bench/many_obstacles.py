@@ -6,7 +6,7 @@ arm (5-degree steps), run and recorded end to end, as a user runs it.
 
 The whole world table of this arm would cost 6.7 billion link-obstacle checks (issue 22: grown
 in blocks toward it, ``run`` and ``record --steps 2000`` took 114 s of CPU and 6.7 GB), so the
-world computes only the moves the arm makes (``rsstp_sim.world_table.MAX_TABULATION_CHECKS``)
+world computes only the moves the arm makes (``rsstp_sim.arm.table.MAX_TABULATION_CHECKS``)
 and ``truth`` refuses it in one line. Each command runs in a fresh process (``rsstp-sim``
 beside this interpreter, see ``bench/_cold.py``); the CPU seconds are the figure on a loaded
 machine, the wall seconds stretch with the load.

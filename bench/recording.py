@@ -74,11 +74,11 @@ from rsstp_sim import (
     builtin_scenarios,
     load_scenario,
 )
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.recording.chunks import ChunkedWriter
 from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.recording.recorder import DEFAULT_CHUNK_SIZE, Recorder
 from rsstp_sim.recording.step_messages import StepMessages
-from rsstp_sim.scenario import Scenario
 from step_rate import float_mode  # bench/ is the script folder
 
 SEED = 1

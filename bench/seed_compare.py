@@ -74,7 +74,7 @@ def build():
 """,
     "ours-world": """
 from rsstp_sim.scenario import parse_scenario
-from rsstp_sim.world import World
+from rsstp_sim.arm.world import World
 scenario = parse_scenario(TOML)
 def build():
     return World(scenario).move  # builds the world's table

@@ -16,7 +16,7 @@ import time
 import numpy as np
 
 from rsstp_sim import RandomStrategy, Runner, World, load_scenario, parse_scenario
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.arm.scenario import Scenario
 
 
 def float_mode(name: str) -> Scenario:

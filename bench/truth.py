@@ -17,7 +17,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 
-from rsstp_sim.scenario import Scenario, parse_scenario  # noqa: E402
+from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.scenario import parse_scenario  # noqa: E402
 from rsstp_sim.truth import compute_truth  # noqa: E402
 from scenarios import arm_toml  # noqa: E402 (the test suite's folder goes on the path first)
 

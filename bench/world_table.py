@@ -51,7 +51,7 @@ _TABLE = """
 import json, resource, time
 began = time.perf_counter()
 from rsstp_sim.scenario import load_scenario, parse_scenario
-from rsstp_sim.world_table import WorldTable
+from rsstp_sim.arm.table import WorldTable
 imported = time.perf_counter() - began
 scenario = load_scenario(NAME) if TOML is None else parse_scenario(TOML, origin=NAME)
 began = time.perf_counter()
@@ -66,7 +66,7 @@ _WALK = """
 import json, resource, time
 import numpy as np
 from rsstp_sim.scenario import parse_scenario
-from rsstp_sim.world import World
+from rsstp_sim.arm.world import World
 scenario = parse_scenario(TOML, origin=NAME)
 actions = np.random.default_rng(1).choice(scenario.actions, size=STEPS).tolist()
 began, cpu = time.perf_counter(), time.process_time()

@@ -22,9 +22,9 @@ import pytest
 from rsstp_cli.replay import main as replay_main
 from rsstp_cli.sim import main as sim_main
 from rsstp_sim import load_scenario, make_strategy
+from rsstp_sim.arm.table import WorldTable
 from rsstp_sim.recording import record
 from rsstp_sim.scenario import MAX_MAGNITUDE
-from rsstp_sim.world_table import WorldTable
 from waiting import HANG_S
 
 sys.path.insert(0, str(Path(__file__).parent / "replay"))

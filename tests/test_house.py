@@ -109,6 +109,29 @@ def test_no_package_imports_another_packages_private_module() -> None:
     assert reaching == []
 
 
+BODY_INSIDES = {
+    "rsstp_sim/arm": ("rsstp_sim.arm.geometry", "rsstp_sim.arm.table"),
+    "rsstp_sim/rover": ("rsstp_sim.rover.table",),
+}
+"""A body's package -> the modules of its insides: its geometry and its table, which no
+module outside the package imports (everything else goes through the world interface)."""
+
+
+def test_only_a_body_imports_its_own_geometry() -> None:
+    reaching = []
+    for path, tree in _modules():
+        where = path.relative_to(SRC).as_posix()
+        for package, insides in BODY_INSIDES.items():
+            if where.startswith(package + "/"):
+                continue
+            reaching += [
+                f"{where} imports {name}"
+                for name in sorted(_imports(tree))
+                if any(name == inside or name.startswith(inside + ".") for inside in insides)
+            ]
+    assert reaching == []
+
+
 def test_the_five_packages_are_all_there_is() -> None:
     """No top-level module beside the packages in every user's site-packages, and the
     console scripts start in the command-line package."""

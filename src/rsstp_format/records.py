@@ -62,6 +62,7 @@ __all__ = [
     "ParamRecord",
     "PointRecord",
     "RECORD_TYPES",
+    "STEP_RECORDS",
     "RecordFormatError",
     "RegionRecord",
     "RoverRecord",
@@ -139,6 +140,11 @@ class PointRecord(_Record, frozen=True, kw_only=True):
 
     x: Annotated[float, _schema("x (length units, world frame)")]
     y: Annotated[float, _schema("y (length units, world frame)")]
+
+    @classmethod
+    def of(cls, xy: Sequence[float]) -> PointRecord:
+        """The point of an ``(x, y)`` pair."""
+        return cls(x=float(xy[0]), y=float(xy[1]))
 
 
 _Point = Annotated[PointRecord, _schema("a point {x, y} (length units, world frame)")]
@@ -406,6 +412,13 @@ class BlockedByRecord(_Record, frozen=True, kw_only=True):
             maxItems=2,
         ),
     ]
+
+    @classmethod
+    def of(cls, blocker: Any) -> BlockedByRecord | None:
+        """The record of a body's blocker (its ``kind`` and ``indices``); None stays None."""
+        if blocker is None:
+            return None
+        return cls(kind=blocker.kind, indices=tuple(int(i) for i in blocker.indices))
 
 
 class DistancesRecord(_Record, frozen=True, kw_only=True):
@@ -967,6 +980,12 @@ RECORD_TYPES: dict[str, type[MessageRecord]] = {
     )
 }
 """Schema name -> record class."""
+
+STEP_RECORDS: dict[type, type[StepRecord | RoverStepRecord]] = {
+    TruthRecord: StepRecord,
+    RoverTruthRecord: RoverStepRecord,
+}
+"""A body's truth record -> its step message's record (one line a body)."""
 
 _DECODERS = {name: msgspec.json.Decoder(cls) for name, cls in RECORD_TYPES.items()}
 _MANY = {name: msgspec.json.Decoder(list[cls]) for name, cls in RECORD_TYPES.items()}  # type: ignore[valid-type]

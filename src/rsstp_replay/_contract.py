@@ -57,9 +57,10 @@ from rsstp_format.schemas import (
 from rsstp_replay._chunks import Messages, count_messages, topic_chunks, topics_chunks
 from rsstp_replay._container import ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.rover import RoverScenario
-from rsstp_sim.scenario import AnyScenario, Scenario, parse_scenario
+from rsstp_sim.scenario import AnyScenario, parse_scenario
 
 __all__ = ["CheckedFile", "check_file"]
 

@@ -18,8 +18,8 @@ import rerun as rr
 from rsstp_replay._decode import blocker_texts
 from rsstp_replay._viewer_chunks import send_rows
 from rsstp_sim import palette
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.rover import RoverScenario
-from rsstp_sim.scenario import Scenario
 
 __all__ = [
     "ARM",

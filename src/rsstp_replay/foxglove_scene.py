@@ -77,11 +77,11 @@ from rsstp_replay._foxglove_rover import RoverDrawing, RoverPoses
 from rsstp_replay._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
 from rsstp_replay._foxglove_stamps import PoseMessages
 from rsstp_sim import __version__, palette
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.files import written_whole
 from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter
 from rsstp_sim.rover import RoverScenario
-from rsstp_sim.scenario import Scenario
 from rsstp_sim.words import counted
 
 if TYPE_CHECKING:

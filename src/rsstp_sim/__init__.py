@@ -6,6 +6,8 @@ keeps a :class:`Memory` and an internal :class:`TransitionSystem`; a
 them one step at a time with one seeded generator per run.
 """
 
+from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.arm.world import Blocker, Pose, World
 from rsstp_sim.coupling import Event, Runner, RunSummary, StepOutcome
 from rsstp_sim.env import ArmEnv, RoverEnv, register_envs
 from rsstp_sim.errors import (
@@ -18,9 +20,8 @@ from rsstp_sim.errors import (
     ScenarioError,
     StrategyError,
 )
-from rsstp_sim.geometry import Blocker
 from rsstp_sim.memory import CompareKind, CompareResult, Memory, MemoryEntry
-from rsstp_sim.scenario import Obstacle, Scenario, builtin_scenarios, load_scenario, parse_scenario
+from rsstp_sim.scenario import Obstacle, builtin_scenarios, load_scenario, parse_scenario
 from rsstp_sim.strategies import (
     AgentView,
     RandomStrategy,
@@ -31,7 +32,6 @@ from rsstp_sim.strategies import (
     make_strategy,
 )
 from rsstp_sim.transition_system import DeterminismReport, Operation, TransitionSystem
-from rsstp_sim.world import Pose, World
 
 register_envs()
 

@@ -19,7 +19,7 @@ from rsstp_sim.interface import Body
 __all__ = ["BODIES", "body_named", "body_of", "make_world"]
 
 BODIES: dict[str, str] = {
-    "arm": "rsstp_sim.world:ARM",
+    "arm": "rsstp_sim.arm.world:ARM",
     "rover": "rsstp_sim.rover:ROVER",
 }
 """Body name (its scenario table) -> ``module:attribute`` of its :class:`Body`."""

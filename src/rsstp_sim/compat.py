@@ -67,12 +67,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rsstp_sim import graph
+from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.arm.world import Blocker, World
 from rsstp_sim.errors import MemoryRangeError, ModelError, RsstpError, ScenarioError
-from rsstp_sim.geometry import Blocker
 from rsstp_sim.memory import CompareKind, Memory
-from rsstp_sim.scenario import Scenario, parse_scenario
+from rsstp_sim.scenario import parse_scenario
 from rsstp_sim.transition_system import TransitionSystem, as_int
-from rsstp_sim.world import World
 
 __all__ = ["THESIS_GOAL_TOLERANCE", "robot_arm"]
 

@@ -25,7 +25,7 @@ import numpy as np
 
 from rsstp_sim.bodies import make_world
 from rsstp_sim.errors import ActionError, StrategyError
-from rsstp_sim.geometry import Blocker
+from rsstp_sim.interface import Blocker
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.strategies import AgentView, Strategy, StrategyBase

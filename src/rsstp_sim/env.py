@@ -1,6 +1,6 @@
 """A Gymnasium environment for the world alone: the arm among its obstacles.
 
-:class:`ArmEnv` exposes the :class:`~rsstp_sim.world.World` through the
+:class:`ArmEnv` exposes the :class:`~rsstp_sim.arm.world.World` through the
 standard ``reset``/``step`` interface, with no internal model, memory or
 strategy: those are what a Gymnasium agent brings itself. :func:`register_envs`
 makes it available as ``gymnasium.make("rsstp/Arm-v0")``.
@@ -27,11 +27,12 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec
 from numpy.typing import NDArray
 
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.bodies import body_of
 from rsstp_sim.errors import ActionError, EnvError
 from rsstp_sim.interface import Blocker
 from rsstp_sim.rover import RoverScenario
-from rsstp_sim.scenario import Scenario, load_scenario
+from rsstp_sim.scenario import load_scenario
 
 __all__ = ["ENV_ID", "MAX_EPISODE_STEPS", "ROVER_ENV_ID", "ArmEnv", "RoverEnv", "register_envs"]
 
@@ -125,7 +126,7 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
 
     ## Arguments
 
-    - ``scenario``: a :class:`~rsstp_sim.scenario.Scenario`, the name of a built-in
+    - ``scenario``: a :class:`~rsstp_sim.arm.scenario.Scenario`, the name of a built-in
       scenario, or the path of a scenario file (default ``"three-joint"``).
     - ``render_mode``: ``None`` or ``"rgb_array"`` (a ``(400, 400, 3)`` uint8 picture
       drawn with numpy: obstacles grey, feedback points green, the arm blue, or

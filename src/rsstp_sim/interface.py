@@ -57,6 +57,14 @@ class Pose(Protocol):
     def sensation(self) -> bool: ...
     @property
     def feedback(self) -> float: ...
+    def truth_json(self) -> tuple[bytes, bytes]:
+        """The pose's members of its step message's ``truth`` (JSON, keys in schema order),
+        before its ``blocked`` field and after it: what a step's message repeats at every
+        visit (the recorder's byte templates)."""
+
+    def truth_record(self, blocker: Any) -> Any:
+        """The truth record (:mod:`rsstp_format.records`) of a step ending here after a move
+        that ``blocker`` blocked (None: it moved)."""
 
 
 class Blocker(Protocol):
@@ -84,6 +92,19 @@ class World(Protocol):
     def sensation(self) -> bool: ...
     @property
     def feedback(self) -> float: ...
+    def follow(self, actions: IntArray, recorded: Any = None) -> tuple[IntArray, IntArray]:
+        """From the start pose, walking ``actions[1:]`` (``actions[0]``, step 0's, is the
+        reset): the row of every step's pose in the world's own numbering (step 0's the
+        start) and each move's blocker code (0: it moved, and at step 0). ``recorded``, the
+        recording's steps table, is a hint a world may use to go faster. Raises
+        :class:`~rsstp_sim.errors.ActionError` at an action the scenario does not have."""
+
+    def senses(self) -> tuple[BoolArray, Any]:
+        """The sensation and the float feedback of every row :meth:`follow` gives."""
+
+    def truth_at(self, row: int, blocker_code: int) -> Any:
+        """The truth record of a step ending at ``row`` after a move blocked by
+        ``blocker_code``: what the recorder writes there."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -117,6 +138,11 @@ class Body(Protocol):
     def world(self, scenario: Any) -> Any:
         """A :class:`World` at the scenario's start pose."""
 
+    def scenario_record(self, scenario: Any, common: dict[str, Any]) -> Any:
+        """The run's scenario message (:mod:`rsstp_format.records`), from the body's scenario
+        and the fields every body's message has (``common``: name, actions, obstacles,
+        seed, strategy, ...)."""
+
     def describe(self, scenario: Any) -> list[str]:
         """The body in its world, a few indented lines (``rsstp-replay info``)."""
 
@@ -131,9 +157,10 @@ class Body(Protocol):
         """What a user should hear before a run of ``scenario`` (one line each): a feedback
         region nothing can sense, a world whose steps are slow."""
 
-    def check_size(self, scenario: Any, *, max_poses: int, max_checks: int) -> None:
+    def check_size(self, scenario: Any, *, max_poses: int, max_checks: int | None) -> None:
         """Refuse (:class:`~rsstp_sim.errors.TruthError`), before any work, a world whose
-        enumeration would pass ``max_poses`` poses or ``max_checks`` collision checks."""
+        enumeration would pass ``max_poses`` poses or ``max_checks`` collision checks (None:
+        the body's own bound)."""
 
     def machine(self, scenario: Any) -> PoseMachine:
         """Every pose reachable from the start."""

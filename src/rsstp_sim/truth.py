@@ -8,8 +8,8 @@ the smallest internal model that predicts every sensation correctly, the
 reference against which a learned model is judged (:func:`check_equivalence`).
 
 Poses are identified by their code ``sum_i angle_i * 360**i`` (as in
-:class:`~rsstp_sim.world.World`). The reachable poses, their moves and their
-sensations come from the scenario's :class:`~rsstp_sim.world_table.WorldTable`
+:class:`~rsstp_sim.arm.world.World`). The reachable poses, their moves and their
+sensations come from the scenario's :class:`~rsstp_sim.arm.table.WorldTable`
 completed (breadth first, whole frontiers per vectorised batch); nothing
 here loops over poses in Python.
 
@@ -42,17 +42,14 @@ from rsstp_sim.errors import ModelError, TruthError
 from rsstp_sim.interface import PoseMachine, WorldScenario
 from rsstp_sim.moore import moore_classes, reached
 from rsstp_sim.transition_system import TransitionSystem
-from rsstp_sim.world_table import MAX_TABULATION_CHECKS, pose_space_size
 
 __all__ = [
-    "MAX_TRUTH_CHECKS",
     "GroundTruth",
     "TruthError",
     "check_truth_size",
     "check_equivalence",
     "compute_truth",
     "format_truth",
-    "pose_space_size",
 ]
 
 
@@ -61,7 +58,7 @@ class GroundTruth:
     """The reachable poses of a scenario as a Moore machine, and its minimisation.
 
     Pose index ``p`` (``0 .. P-1``) follows the sorted pose codes. For action
-    ``actions[k]`` (see :class:`~rsstp_sim.world.World`), ``next_pose[p, k]``
+    ``actions[k]`` (see :class:`~rsstp_sim.arm.world.World`), ``next_pose[p, k]``
     is the pose reached from ``p`` (``p`` itself when ``blocked[p, k]``).
     ``true_class[p]`` is the pose's class in the minimal machine; classes are
     numbered breadth-first from the start pose's class (0) over the actions in
@@ -271,30 +268,24 @@ def format_truth(truth: GroundTruth) -> str:
 # --------------------------------------------------------------- enumeration
 
 
-MAX_TRUTH_CHECKS = MAX_TABULATION_CHECKS
-"""The most link-against-obstacle move checks :func:`compute_truth` takes on, counted over the
-pose lattice (:func:`~rsstp_sim.world_table.tabulation_checks`): about 20 s on this project's
-machine. Three joints at 5 degrees among 1,000 obstacles count 6.7 billion; they took 130 s and
-8.6 GB before this bound."""
-
-
 def check_truth_size(
-    scenario: WorldScenario, *, max_poses: int = 2_000_000, max_checks: int = MAX_TRUTH_CHECKS
+    scenario: WorldScenario, *, max_poses: int = 2_000_000, max_checks: int | None = None
 ) -> None:
     """Refuse (:class:`TruthError`), before any work, a world too large to enumerate: more
     than ``max_poses`` poses, or (an arm among obstacles) more than ``max_checks``
-    link-obstacle checks; the same whether the truth is computed or read from the cache."""
+    link-obstacle checks (None: the body's own bound, the arm's about 20 s of checks); the
+    same whether the truth is computed or read from the cache."""
     body_of(scenario).check_size(scenario, max_poses=max_poses, max_checks=max_checks)
 
 
 def compute_truth(
-    scenario: WorldScenario, *, max_poses: int = 2_000_000, max_checks: int = MAX_TRUTH_CHECKS
+    scenario: WorldScenario, *, max_poses: int = 2_000_000, max_checks: int | None = None
 ) -> GroundTruth:
     """Enumerate the reachable poses of ``scenario`` and minimise their Moore machine.
 
-    Refuses (:class:`TruthError`, before any work) when :func:`pose_space_size` exceeds
+    Refuses (:class:`TruthError`, before any work) when the body's pose space exceeds
     ``max_poses``, or when checking every move of every pose against every obstacle would
-    take more than ``max_checks`` link-obstacle checks (:data:`MAX_TRUTH_CHECKS`).
+    take more than ``max_checks`` link-obstacle checks (:func:`check_truth_size`).
     """
     started = time.perf_counter()
     check_truth_size(scenario, max_poses=max_poses, max_checks=max_checks)

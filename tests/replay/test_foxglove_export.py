@@ -28,8 +28,9 @@ from rsstp_cli.replay import main
 from rsstp_replay import foxglove_scene, open_recording
 from rsstp_replay.foxglove_scene import ARM_TOPIC, LOG_TOPIC, STATIC_TOPIC, TRANSFORMS_TOPIC
 from rsstp_sim import __version__, palette
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.recording import record
-from rsstp_sim.scenario import Scenario, load_scenario
+from rsstp_sim.scenario import load_scenario
 from waiting import HANG_S
 
 STEPS = 400

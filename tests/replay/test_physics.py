@@ -14,9 +14,9 @@ from test_corrupt import rewrite
 
 from rsstp_cli.replay import main
 from rsstp_replay import open_recording
-from rsstp_replay.audits import physics
 from rsstp_replay.audits.physics import check_physics
 from rsstp_sim import load_scenario, make_strategy
+from rsstp_sim.arm import world as arm_world
 from rsstp_sim.recording import record
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -31,8 +31,8 @@ def world_walk(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) 
     recorded poses followed in numpy, block by block (what a replay longer than its world's
     pose space does)."""
     if request.param == "whole table":
-        monkeypatch.setattr(physics, "pose_space_size", lambda scenario: 0)
-        monkeypatch.setattr(physics, "_BLOCK_STEPS", 97)  # many blocks, a step's at each edge
+        monkeypatch.setattr(arm_world, "pose_space_size", lambda scenario: 0)
+        monkeypatch.setattr(arm_world, "_BLOCK_STEPS", 97)  # many blocks, a step's at each edge
 
 
 @pytest.fixture(scope="module")

@@ -11,9 +11,10 @@ from gymnasium.utils.env_checker import check_env
 
 from rsstp_sim import env as env_module
 from rsstp_sim import palette
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.env import ENV_ID, MAX_EPISODE_STEPS, ArmEnv, register_envs
 from rsstp_sim.errors import ActionError, ScenarioError
-from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
+from rsstp_sim.scenario import load_scenario, parse_scenario
 from scenarios import arm_toml
 from waiting import HANG_S
 

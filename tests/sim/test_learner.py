@@ -11,16 +11,17 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.arm.world import World
 from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import StrategyError
 from rsstp_sim.memory import Memory
-from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
+from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies import AgentView
 from rsstp_sim.strategies._learner_hypothesis import Hypothesis
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
-from rsstp_sim.world import World
 from scenarios import arm_toml
 
 LEARNER_SOURCES = sorted(
@@ -508,8 +509,8 @@ def test_the_learner_modules_import_nothing_of_the_world() -> None:
                     assert module in allowed or module.startswith(
                         "rsstp_sim.strategies._learner_"
                     ), f"{path.name} imports {module}"
-                assert not module.startswith(("rsstp_sim.world", "rsstp_sim.truth"))
-                assert not module.startswith("rsstp_sim.geometry")
+                assert not module.startswith(("rsstp_sim.arm.world", "rsstp_sim.truth"))
+                assert not module.startswith("rsstp_sim.arm.geometry")
 
 
 class _Ring:

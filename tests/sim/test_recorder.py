@@ -43,11 +43,11 @@ from rsstp_sim import (
     load_scenario,
     make_strategy,
 )
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.recording import builders
 from rsstp_sim.recording import recorder as recorder_module
 from rsstp_sim.recording.recorder import Recorder, record
 from rsstp_sim.recording.step_messages import Block
-from rsstp_sim.scenario import Scenario
 from rsstp_sim.strategies import Strategy
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -323,7 +323,7 @@ def test_truth_part_is_the_worlds_poses(messages: list[Message], live: LiveRun) 
         assert [[p.x, p.y] for p in truth.joint_positions] == pose.joint_positions.tolist()
         assert [list(tip.obstacles) for tip in truth.distances] == pose.distances.tolist()
         assert truth.blocked == (blocker is not None)
-        assert truth.blocked_by == builders.blocked_by_record(blocker)
+        assert truth.blocked_by == records.BlockedByRecord.of(blocker)
 
 
 def test_blocked_events_are_the_blocked_moves(messages: list[Message], live: LiveRun) -> None:

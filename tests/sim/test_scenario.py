@@ -13,11 +13,11 @@ from pathlib import Path
 import pytest
 
 from builtin_worlds import builtins_of
-from rsstp_sim import geometry
 from rsstp_sim import scenario as scenario_module
+from rsstp_sim.arm import geometry
+from rsstp_sim.arm.world import World
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.scenario import Obstacle, builtin_scenarios, load_scenario, parse_scenario
-from rsstp_sim.world import World
 from waiting import HANG_S
 
 BUILTINS = tuple(builtin_scenarios())

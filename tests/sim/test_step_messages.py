@@ -29,11 +29,13 @@ from rsstp_sim import (
     StrategyBase,
     load_scenario,
 )
-from rsstp_sim.geometry import ARM_BLOCKER_KINDS, Blocker
+from rsstp_sim.arm.geometry import ARM_BLOCKER_KINDS, Blocker
+from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.arm.world import Pose as ArmPose
 from rsstp_sim.recording import builders
 from rsstp_sim.recording.chunks import Message
 from rsstp_sim.recording.step_messages import BlockMessages, StepMessages, Steps
-from rsstp_sim.scenario import Scenario, parse_scenario
+from rsstp_sim.scenario import parse_scenario
 from rsstp_sim.strategies import Strategy, make_strategy
 from rsstp_sim.transition_system import TransitionSystem
 from scenarios import arm_toml
@@ -263,6 +265,9 @@ class FakePose:
 
     def truth_values(self) -> tuple[list[int], list[float], list[float]]:
         return self.angles, self.positions, self.distances
+
+    # The arm's byte templates, under test: they read the numbers through truth_values.
+    truth_json = ArmPose.truth_json
 
     def truth_record(self, blocker: Blocker | None) -> records.TruthRecord:
         """The record of this pose's truth, built field by field (not by the builders)."""

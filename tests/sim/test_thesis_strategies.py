@@ -480,7 +480,7 @@ def test_strategies_see_only_the_agent_view(module: object) -> None:
     path = Path(str(getattr(module, "__file__", "")))
     imports = project_imports(path)
     assert imports <= ALLOWED_IMPORTS, imports - ALLOWED_IMPORTS
-    assert not any(name.startswith("rsstp_sim.world") for name in imports)
+    assert not any(name.startswith("rsstp_sim.arm.world") for name in imports)
     # And the helpers they import do not reach the world either.
     for name in imports & {"rsstp_sim.strategies._base", "rsstp_sim.strategies.random_walk"}:
         helper = path.parent / f"{name.rsplit('.', 1)[1]}.py"

@@ -15,8 +15,11 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rsstp_sim import truth as truth_module
+from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.arm.table import pose_space_size
+from rsstp_sim.arm.world import World
 from rsstp_sim.errors import ModelError, RsstpError
-from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
+from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import (
     GroundTruth,
@@ -24,9 +27,7 @@ from rsstp_sim.truth import (
     check_equivalence,
     compute_truth,
     format_truth,
-    pose_space_size,
 )
-from rsstp_sim.world import World
 
 
 def one_joint(step: int, *, actions: Sequence[int] = (0, 1), feedback: str = "") -> Scenario:

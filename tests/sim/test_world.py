@@ -12,12 +12,13 @@ from hypothesis import assume, event, example, given, settings
 from hypothesis import strategies as st
 
 from conftest import THIN_OBSTACLE_TOML
-from rsstp_sim import geometry
+from rsstp_sim.arm import geometry
+from rsstp_sim.arm.geometry import Blocker
+from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.arm.table import WorldTable
+from rsstp_sim.arm.world import World
 from rsstp_sim.errors import ActionError
-from rsstp_sim.geometry import Blocker
-from rsstp_sim.scenario import Scenario, load_scenario, parse_scenario
-from rsstp_sim.world import World
-from rsstp_sim.world_table import WorldTable
+from rsstp_sim.scenario import load_scenario, parse_scenario
 from scenarios import arm_toml
 
 SAMPLE_DEG = 0.25

@@ -15,10 +15,10 @@ import numpy as np
 import pytest
 
 from builtin_worlds import builtins_of
+from rsstp_sim.arm.table import MAX_TABULATION_CHECKS, tabulation_checks, unsensable
+from rsstp_sim.arm.world import World
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.truth import compute_truth
-from rsstp_sim.world import World
-from rsstp_sim.world_table import MAX_TABULATION_CHECKS, tabulation_checks, unsensable
 from scenarios import arm_toml
 from waiting import HANG_S
 

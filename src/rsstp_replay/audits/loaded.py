@@ -23,8 +23,8 @@ import pandas as pd
 
 from rsstp_format.records import ModelRecord
 from rsstp_replay._decode import BLOCKED_COLUMNS
+from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.memory import Memory
-from rsstp_sim.scenario import Scenario
 
 __all__ = ["LoadedRecording", "load"]
 

@@ -5,7 +5,7 @@ and, at every step, the action taken and the world's answer: the pose, the joint
 the sensation and feedback, the obstacle distances, whether the move was blocked and by what
 (and a ``blocked`` event for it). The world is deterministic, so all of that follows from the
 scenario and the actions alone. :func:`check_physics` re-simulates it with
-:class:`~rsstp_sim.world.World`, never importing the strategy (no code of the recording's
+:class:`~rsstp_sim.arm.world.World`, never importing the strategy (no code of the recording's
 runs), and compares every recorded ground-truth field at every step, naming the first
 difference by step and field.
 
@@ -29,15 +29,12 @@ from numpy.typing import NDArray
 from rsstp_format import records
 from rsstp_replay._chunks import gc_paused
 from rsstp_replay.errors import PhysicsDifference
+from rsstp_sim.bodies import make_world
 from rsstp_sim.errors import ActionError
 from rsstp_sim.recording import builders
-from rsstp_sim.rover import RoverScenario, RoverWorld
 from rsstp_sim.strategies import StrategyOrigin
-from rsstp_sim.world import World
-from rsstp_sim.world_table import pose_space_size
 
 IntArray = NDArray[np.int64]  # (rsstp_sim._arrays is the simulator's own)
-AnyWorld = World | RoverWorld
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -132,29 +129,15 @@ def _plain(value: object) -> str:
 
 def _simulate(
     recording: Recording, actions: IntArray, steps: pd.DataFrame
-) -> tuple[AnyWorld, IntArray, IntArray]:
-    """The world after the recorded actions, the table row of every step's pose and the
+) -> tuple[Any, IntArray, IntArray]:
+    """The world after the recorded actions, and the table row of every step's pose and the
     blocker code of every move (step 0 is the start pose, not blocked)."""
-    scenario = recording.scenario
-    if isinstance(scenario, RoverScenario):
-        rover = RoverWorld(scenario)
-        try:
-            codes, blocked = rover.walk(actions[1:].tolist())
-        except ActionError:
-            raise _unknown_action(actions, scenario.actions) from None
-        start = np.array([rover.table.start_code], np.int64)
-        return rover, np.concatenate([start, codes]), np.concatenate([[0], blocked])
-    world = World(scenario)
-    if not world.per_move and recording.n_steps >= pose_space_size(scenario):
-        world.table.complete()  # a long walk meets most poses: all at once costs less
-        followed = _followed(world, actions, steps)
-        if followed is not None:
-            return world, *followed
+    world = make_world(recording.scenario)
     try:
-        rows, blockers = world.walk(actions[1:].tolist())
+        rows, blockers = world.follow(actions, steps)
     except ActionError:
-        raise _unknown_action(actions, world.table.actions) from None
-    return world, np.concatenate([[0], rows]), np.concatenate([[0], blockers])
+        raise _unknown_action(actions, recording.scenario.actions) from None
+    return world, rows, blockers
 
 
 def _unknown_action(actions: IntArray, known: tuple[int, ...]) -> PhysicsDifference:
@@ -166,75 +149,9 @@ def _unknown_action(actions: IntArray, known: tuple[int, ...]) -> PhysicsDiffere
     )
 
 
-def _pose_arrays(world: AnyWorld) -> tuple[NDArray[np.bool_], NDArray[np.float64]]:
-    """The sensation and the feedback of every pose, indexed as :func:`_simulate`'s rows."""
-    table = world.table
-    if isinstance(world, RoverWorld):
-        return world.table.sensation, world.table.feedback
-    sensation = np.frombuffer(table.sensation, np.int8).astype(bool)
-    return sensation, np.frombuffer(table.feedback, np.float64)
-
-
-def _truth_of(world: AnyWorld, row: int, code: int) -> Any:
-    """The truth record of a step ending at ``row`` after a move blocked by ``code``."""
-    if isinstance(world, RoverWorld):
-        return builders.rover_truth_record(world.pose(row), world.blocker_of(code))
-    return builders.truth_record(world.pose_at(row), world.blocker_of(code))
-
-
-_BLOCK_STEPS = 1 << 20
-"""Steps :func:`_followed` takes at once (its temporary arrays stay a few tens of MB)."""
-
-
-def _followed(
-    world: World, actions: IntArray, steps: pd.DataFrame
-) -> tuple[IntArray, IntArray] | None:
-    """The rows and blockers of :func:`_simulate`, from a whole world table and the recorded
-    poses, when each step's pose is where the world's table moves the one before by the
-    step's action (checked in numpy, a block of steps at a time, not move by move); None at
-    the first step where it is not, which the walk then finds."""
-    table = world.table
-    names = [f"angle_deg_{j}" for j in range(len(table.radix))]
-    if not set(names) <= set(steps.columns) or len(steps) != len(actions):
-        return None
-    index = np.full(max(table.actions) + 1, -1, np.int64)
-    index[list(table.actions)] = np.arange(len(table.actions))
-    table_codes = np.frombuffer(table.codes, np.int64)
-    next_rows, blocker_codes = table.next_array(), table.blocker_array()
-    columns = [steps[name].to_numpy() for name in names]
-    rows = np.empty(len(steps), np.int64)
-    blockers = np.zeros(len(steps), np.int64)
-    before = 0  # the row of the step before the block (the start pose's: row 0)
-    for first in range(0, len(steps), _BLOCK_STEPS):
-        block = slice(first, first + _BLOCK_STEPS)
-        angles = np.stack([column[block] for column in columns], axis=1).astype(np.int64)
-        found = table.rows_at(angles)
-        if (found < 0).any() or not np.array_equal(table_codes[found], angles @ table.radix):
-            return None
-        moves = actions[block]
-        if first == 0:  # step 0 is the reset, to the start pose
-            if found[0] != 0:
-                return None
-            found, moves = found[1:], moves[1:]
-            if not len(found):  # the reset alone
-                break
-        if ((moves < 0) | (moves >= len(index))).any() or (index[moves] < 0).any():
-            return None
-        k = index[moves]
-        came_from = np.concatenate([[before], found[:-1]])
-        if not np.array_equal(next_rows[came_from, k], found):
-            return None
-        where = slice(max(first, 1), block.stop)
-        rows[where] = found
-        blockers[where] = blocker_codes[came_from, k]
-        before = int(found[-1])
-    rows[0] = 0
-    return rows, blockers
-
-
-def _check_agent_view(steps: pd.DataFrame, world: AnyWorld, rows: IntArray) -> None:
+def _check_agent_view(steps: pd.DataFrame, world: Any, rows: IntArray) -> None:
     """The sensation and the feedback the agent was given are the world's at its pose."""
-    all_sensations, all_feedback = _pose_arrays(world)
+    all_sensations, all_feedback = world.senses()
     sensation, feedback = all_sensations[rows], all_feedback[rows]
     for name, want, got in (
         ("agent.sensation", sensation, steps["sensation"].to_numpy(bool)),
@@ -248,7 +165,7 @@ def _check_agent_view(steps: pd.DataFrame, world: AnyWorld, rows: IntArray) -> N
             )
 
 
-def _check_truth(recording: Recording, world: AnyWorld, rows: IntArray, blockers: IntArray) -> None:
+def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: IntArray) -> None:
     """Every step message's truth, against the bytes the recorder writes for its pose and
     blocker (each pair encoded once)."""
     width = int(blockers.max(initial=0)) + 1
@@ -257,7 +174,7 @@ def _check_truth(recording: Recording, world: AnyWorld, rows: IntArray, blockers
     expected = []
     for key in distinct.tolist():
         row, code = divmod(key, width)
-        truth = _truth_of(world, row, code)
+        truth = world.truth_at(row, code)
         expected.append(_TRUTH_KEY + records.encode_json(truth) + b"}")
     step = 0
     with gc_paused():
@@ -331,7 +248,7 @@ def _scalar(value: object) -> str:
 
 
 def _check_blocked_events(
-    recording: Recording, world: AnyWorld, actions: IntArray, blockers: IntArray
+    recording: Recording, world: Any, actions: IntArray, blockers: IntArray
 ) -> None:
     """A ``blocked`` event at exactly the blocked steps, with the action and the blocker.
 

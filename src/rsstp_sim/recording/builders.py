@@ -8,7 +8,6 @@ EventRecord(step=3, kind='note', text='exploring joint 1', data={})
 
 from __future__ import annotations
 
-import functools
 import re
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
@@ -16,46 +15,36 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 
 from rsstp_format.records import (
+    STEP_RECORDS,
     AgentRecord,
-    BlockedByRecord,
-    DistancesRecord,
-    DoorRecord,
     EventKind,
     EventRecord,
-    FeedbackRecord,
     ModelRecord,
     ObstacleRecord,
     OperationRecord,
     ParamRecord,
     PointRecord,
-    RegionRecord,
-    RoverRecord,
     RoverScenarioRecord,
     RoverStepRecord,
-    RoverTruthRecord,
     ScenarioRecord,
-    SegmentRecord,
     StepRecord,
     StrategyRecord,
     TransitionsRecord,
-    TruthRecord,
     encode_json,
 )
+from rsstp_sim.bodies import body_of
 from rsstp_sim.coupling import stop_text
 from rsstp_sim.errors import RecordFormatError
-from rsstp_sim.rover import RoverBlocker, RoverPose, RoverScenario
 from rsstp_sim.transition_system import Operation
 
 if TYPE_CHECKING:
     from rsstp_sim.coupling import Event
-    from rsstp_sim.geometry import Blocker
+    from rsstp_sim.interface import Blocker, Pose
     from rsstp_sim.scenario import AnyScenario
     from rsstp_sim.strategies import StrategyOrigin
     from rsstp_sim.transition_system import TransitionSystem
-    from rsstp_sim.world import Pose
 
 __all__ = [
-    "blocked_by_record",
     "blocked_event",
     "contradiction_event",
     "event_record",
@@ -66,7 +55,6 @@ __all__ = [
     "operation_record",
     "scenario_record",
     "step_record",
-    "truth_record",
 ]
 
 
@@ -107,73 +95,28 @@ def scenario_record(
         "sha256": scenario.sha256,
         "actions": tuple(int(v) for v in scenario.actions),
         "obstacles": tuple(
-            ObstacleRecord(center=_point(o.center), radius=float(o.radius))
+            ObstacleRecord(center=PointRecord.of(o.center), radius=float(o.radius))
             for o in scenario.obstacles
         ),
         "seed": int(seed),
         "strategy": strategy,
     }
-    if isinstance(scenario, RoverScenario):
-        return _rover_scenario_record(scenario, common)
-    target = scenario.feedback_target_deg
-    return ScenarioRecord(
-        n_joints=scenario.n_joints,
-        lengths=tuple(float(v) for v in scenario.lengths),
-        initial_deg=tuple(int(v) for v in scenario.initial_deg),
-        step_deg=int(scenario.step_deg),
-        feedback=FeedbackRecord(
-            mode=scenario.feedback_mode,
-            tolerance=float(scenario.tolerance),
-            tolerance_abs=float(scenario.tolerance * scenario.total_length),
-            points=tuple(_point(xy) for xy in scenario.feedback_points),
-            target_deg=None if target is None else tuple(int(v) for v in target),
-        ),
-        collision=scenario.collision,
-        **common,
+    record: ScenarioRecord | RoverScenarioRecord = body_of(scenario).scenario_record(
+        scenario, common
     )
-
-
-def _rover_scenario_record(scenario: RoverScenario, common: dict[str, Any]) -> RoverScenarioRecord:
-    heading = scenario.feedback_heading
-    return RoverScenarioRecord(
-        rover=RoverRecord(
-            room=scenario.room,
-            start=scenario.start,
-            heading_deg=scenario.start_heading * scenario.turn_deg,
-            turn_deg=scenario.turn_deg,
-            radius=float(scenario.robot_radius),
-            walls=tuple(
-                SegmentRecord(start=_point(w.start), end=_point(w.end)) for w in scenario.walls
-            ),
-            doors=tuple(
-                DoorRecord(start=_point(d.start), end=_point(d.end), toward=_point(d.toward))
-                for d in scenario.doors
-            ),
-        ),
-        feedback=RegionRecord(
-            mode=scenario.feedback_mode,
-            center=_point(scenario.feedback_center),
-            radius=float(scenario.feedback_radius),
-            heading_deg=None if heading is None else heading * scenario.turn_deg,
-        ),
-        **common,
-    )
-
-
-def _point(xy: Any) -> PointRecord:
-    return PointRecord(x=float(xy[0]), y=float(xy[1]))
+    return record
 
 
 def step_record(
     step: int,
-    pose: Pose | RoverPose,
+    pose: Pose,
     *,
     action: int | None,
     state_before: int | None,
     internal_state: int,
     model_version: int,
     no_transition: bool,
-    blocker: Blocker | RoverBlocker | None,
+    blocker: Blocker | None,
 ) -> StepRecord | RoverStepRecord:
     """The step message of step ``step`` ending in the world pose ``pose`` (``rsstp.Step``;
     a rover's ``rsstp.RoverStep``).
@@ -190,54 +133,10 @@ def step_record(
         model_version=int(model_version),
         no_transition=bool(no_transition),
     )
-    if isinstance(pose, RoverPose):
-        assert blocker is None or isinstance(blocker, RoverBlocker)
-        truth = rover_truth_record(pose, blocker)
-        return RoverStepRecord(step=int(step), agent=agent, truth=truth)
-    assert not isinstance(blocker, RoverBlocker)  # (an arm's pose: an arm's blocker)
-    return StepRecord(step=int(step), agent=agent, truth=truth_record(pose, blocker))
-
-
-@functools.lru_cache(maxsize=1 << 12)
-def truth_record(pose: Pose, blocker: Blocker | None) -> TruthRecord:
-    """The truth record of a step ending in ``pose`` after a move that ``blocker`` blocked
-    (None: it moved). Poses are cached read-only objects, so a random walk revisiting them
-    gets the same immutable record."""
-    angles, points, distances = pose.truth_values()
-    m = len(distances) // len(angles)
-    return TruthRecord(
-        angles_deg=tuple(angles),
-        joint_positions=tuple(
-            [PointRecord(x=x, y=y) for x, y in zip(points[0::2], points[1::2], strict=True)]
-        ),
-        blocked=blocker is not None,
-        blocked_by=blocked_by_record(blocker),
-        distances=tuple(
-            [
-                DistancesRecord(obstacles=tuple(distances[k * m : (k + 1) * m]))
-                for k in range(len(angles))
-            ]
-        ),
-    )
-
-
-def rover_truth_record(pose: RoverPose, blocker: RoverBlocker | None) -> RoverTruthRecord:
-    """The truth record of a rover's step ending in ``pose`` (``blocker``: None when it
-    moved)."""
-    return RoverTruthRecord(
-        cell=pose.cell,
-        heading_deg=pose.heading_deg,
-        position=_point(pose.position),
-        blocked=blocker is not None,
-        blocked_by=blocked_by_record(blocker),
-    )
-
-
-def blocked_by_record(blocker: Blocker | RoverBlocker | None) -> BlockedByRecord | None:
-    """The record of a :class:`~rsstp_sim.geometry.Blocker` (None stays None)."""
-    if blocker is None:
-        return None
-    return BlockedByRecord(kind=blocker.kind, indices=tuple(int(i) for i in blocker.indices))
+    truth = pose.truth_record(blocker)
+    step_type: Any = STEP_RECORDS[type(truth)]
+    record: StepRecord | RoverStepRecord = step_type(step=int(step), agent=agent, truth=truth)
+    return record
 
 
 def operation_record(op: Operation) -> OperationRecord:
@@ -272,7 +171,7 @@ def model_record(
     )
 
 
-def blocked_event(step: int, *, action: int, blocker: Blocker | RoverBlocker) -> EventRecord:
+def blocked_event(step: int, *, action: int, blocker: Blocker) -> EventRecord:
     """A ``blocked`` event: ``action`` did not move the arm, because of ``blocker``."""
     by = {"kind": blocker.kind, "indices": [int(i) for i in blocker.indices]}
     return _event(

@@ -30,16 +30,15 @@ from __future__ import annotations
 from collections.abc import Callable, Generator, Iterable, Sized
 from typing import TYPE_CHECKING, NamedTuple
 
-from rsstp_format.records import encode, encode_json
+from rsstp_format.records import BlockedByRecord, encode, encode_json
 from rsstp_format.schemas import STEP_NS
 from rsstp_sim.recording import builders
 from rsstp_sim.recording.chunks import Message
 
 if TYPE_CHECKING:
     from rsstp_sim.coupling import StepOutcome
-    from rsstp_sim.geometry import Blocker
+    from rsstp_sim.interface import Blocker, Pose, World
     from rsstp_sim.transition_system import TransitionSystem
-    from rsstp_sim.world import Pose, World
 
 __all__ = ["POSE_CACHE_BYTES", "Block", "BlockMessages", "StepMessages", "Steps"]
 
@@ -124,7 +123,6 @@ class StepMessages:
         # a transition, where its truth's "blocked" field starts in that tail)
         self._poses: dict[Pose, tuple[bytes, bytes, int]] = {}
         self._room = cache_bytes  # bytes the kept parts and tails may still take
-        self._truth: tuple[bytes, bytes] | None = None  # templates around "blocked"
         self._blocked_truth: dict[Blocker, bytes] = {}
         self._blocked_events: dict[tuple[int, Blocker], bytes] = {}
         # pose -> the number of a plain step's tail at model version ``_version`` (see
@@ -142,19 +140,8 @@ class StepMessages:
         """Blocked events given as a blocked step's tail in :class:`Steps` (not by ``then``)."""
 
     def _parts(self, pose: Pose) -> tuple[bytes, bytes, int]:
-        own = getattr(pose, "truth_json", None)  # a body whose pose writes its own truth
-        if own is not None:
-            before, after = own()
-            feedback = encode_json(pose.feedback)
-        else:  # the arm: numbers into templates, one encoder call a pose
-            angles, positions, distances = pose.truth_values()
-            if self._truth is None:
-                self._truth = _truth_templates(len(angles), len(distances) // len(angles))
-            texts = encode_json([pose.feedback, *positions, *distances])[1:-1].split(b",")
-            points = 1 + len(positions)
-            before = self._truth[0] % (*angles, *texts[1:points])
-            after = self._truth[1] % tuple(texts[points:])
-            feedback = texts[0]
+        before, after = pose.truth_json()
+        feedback = encode_json(pose.feedback)
         head = _AGENT % (b"true" if pose.sensation else b"false", feedback)
         moved = b"".join((_MOVED, before, _UNBLOCKED, after, b"}}"))
         parts = (head, moved, len(_MOVED) + len(before))
@@ -341,7 +328,7 @@ class StepMessages:
     def _blocked(self, blocker: Blocker) -> bytes:
         truth = self._blocked_truth.get(blocker)
         if truth is None:
-            by = encode_json(builders.blocked_by_record(blocker))
+            by = encode_json(BlockedByRecord.of(blocker))
             truth = self._blocked_truth[blocker] = b'"blocked":true,"blocked_by":' + by
         return truth
 
@@ -357,15 +344,3 @@ class StepMessages:
             whole = encode(builders.blocked_event(0, action=action, blocker=blocker))
             tail = self._blocked_events[key] = whole.removeprefix(_EVENT % 0)
         return tail
-
-
-def _truth_templates(n: int, m: int) -> tuple[bytes, bytes]:
-    """The truth record of an arm of ``n`` links among ``m`` obstacles, before its
-    ``blocked`` field (angles, then the points' float texts) and after it (the distances')."""
-    angles = b",".join([b"%d"] * n)
-    points = b",".join([b'{"x":%b,"y":%b}'] * (n + 1))
-    tips = b",".join([b'{"obstacles":[' + b",".join([b"%b"] * m) + b"]}"] * n)
-    return (
-        b'"angles_deg":[' + angles + b'],"joint_positions":[' + points + b"],",
-        b',"distances":[' + tips + b"]",
-    )

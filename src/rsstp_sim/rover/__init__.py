@@ -12,6 +12,14 @@ from typing import Any
 
 import numpy as np
 
+from rsstp_format.records import (
+    DoorRecord,
+    PointRecord,
+    RegionRecord,
+    RoverRecord,
+    RoverScenarioRecord,
+    SegmentRecord,
+)
 from rsstp_sim.errors import ScenarioError, TruthError
 from rsstp_sim.interface import PoseMachine
 from rsstp_sim.moore import reached
@@ -37,6 +45,39 @@ class _Rover:
                 "or an obstacle"
             )
         return scenario
+
+    def scenario_record(
+        self, scenario: RoverScenario, common: dict[str, Any]
+    ) -> RoverScenarioRecord:
+        heading, point = scenario.feedback_heading, PointRecord.of
+        return RoverScenarioRecord(
+            rover=RoverRecord(
+                room=scenario.room,
+                start=scenario.start,
+                heading_deg=scenario.start_heading * scenario.turn_deg,
+                turn_deg=scenario.turn_deg,
+                radius=float(scenario.robot_radius),
+                walls=tuple(
+                    SegmentRecord(start=PointRecord.of(w.start), end=PointRecord.of(w.end))
+                    for w in scenario.walls
+                ),
+                doors=tuple(
+                    DoorRecord(
+                        start=PointRecord.of(d.start),
+                        end=PointRecord.of(d.end),
+                        toward=PointRecord.of(d.toward),
+                    )
+                    for d in scenario.doors
+                ),
+            ),
+            feedback=RegionRecord(
+                mode=scenario.feedback_mode,
+                center=point(scenario.feedback_center),
+                radius=float(scenario.feedback_radius),
+                heading_deg=None if heading is None else heading * scenario.turn_deg,
+            ),
+            **common,
+        )
 
     def world(self, scenario: RoverScenario) -> RoverWorld:
         return RoverWorld(scenario)
@@ -77,7 +118,9 @@ class _Rover:
             f"(centre {list(scenario.feedback_center)}, radius {scenario.feedback_radius:g})"
         ]
 
-    def check_size(self, scenario: RoverScenario, *, max_poses: int, max_checks: int) -> None:
+    def check_size(
+        self, scenario: RoverScenario, *, max_poses: int, max_checks: int | None
+    ) -> None:
         width, height = scenario.room
         poses = width * height * scenario.headings
         if poses > max_poses:

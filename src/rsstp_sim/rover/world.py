@@ -5,11 +5,13 @@ from __future__ import annotations
 import json
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
+from rsstp_format.records import BlockedByRecord, PointRecord, RoverTruthRecord
 from rsstp_format.vocabulary import BlockerKind
-from rsstp_sim._arrays import IntArray
+from rsstp_sim._arrays import BoolArray, FloatArray, IntArray
 from rsstp_sim.errors import ActionError
 from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario
 from rsstp_sim.rover.table import ROOM_EDGES, RoverTable
@@ -60,6 +62,16 @@ class RoverPose:
             self.cell[0], self.cell[1], self.heading_deg, x, y,
         )  # fmt: skip
         return before, b""
+
+    def truth_record(self, blocker: RoverBlocker | None) -> RoverTruthRecord:
+        """The truth record of a step ending here (``blocker``: None when it moved)."""
+        return RoverTruthRecord(
+            cell=self.cell,
+            heading_deg=self.heading_deg,
+            position=PointRecord.of(self.position),
+            blocked=blocker is not None,
+            blocked_by=BlockedByRecord.of(blocker),
+        )
 
 
 class RoverWorld:
@@ -151,6 +163,24 @@ class RoverWorld:
         index -= len(s.walls)
         assert index < len(s.doors), f"no blocker has code {blocker_code}"  # (the table's own)
         return RoverBlocker("door", (index,))
+
+    def follow(self, actions: IntArray, recorded: Any = None) -> tuple[IntArray, IntArray]:
+        """From the start pose, the pose code of every step (step 0's: the start) and each
+        move's blocker code (0 at step 0) of ``actions[1:]``; ``recorded`` is not needed (a
+        rover's walk is one array lookup a move)."""
+        self.reset()
+        codes, blocked = self.walk(actions[1:].tolist())
+        start = np.array([self.table.start_code], np.int64)
+        return np.concatenate([start, codes]), np.concatenate([[0], blocked])
+
+    def senses(self) -> tuple[BoolArray, FloatArray]:
+        """The sensation and the feedback of every pose code."""
+        return self.table.sensation, self.table.feedback
+
+    def truth_at(self, code: int, blocker_code: int) -> RoverTruthRecord:
+        """The truth record of a step ending at pose ``code`` after a move blocked by
+        ``blocker_code`` (0: it moved)."""
+        return self.pose(code).truth_record(self.blocker_of(blocker_code))
 
     @property
     def current(self) -> RoverPose:

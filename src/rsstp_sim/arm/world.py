@@ -3,7 +3,7 @@
 The world knows nothing about the agent, its model or any recording. Its answer
 for a move depends only on the pose and the action, and the pose space is
 finite (integer angles), so every answer comes from the scenario's
-:class:`~rsstp_sim.world_table.WorldTable`, computed once and read back with a
+:class:`~rsstp_sim.arm.table.WorldTable`, computed once and read back with a
 couple of array lookups per move: a small pose space's in vectorised blocks
 around the arm, a large one's (many links, small steps) or a costly one's (many
 obstacles) move by move, each new move checked alone.
@@ -11,20 +11,37 @@ obstacles) move by move, each new move checked alone.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from rsstp_sim._arrays import FloatArray, IntArray
+from rsstp_format.records import (
+    BlockedByRecord,
+    DistancesRecord,
+    FeedbackRecord,
+    PointRecord,
+    ScenarioRecord,
+    TruthRecord,
+    encode_json,
+)
+from rsstp_sim._arrays import BoolArray, FloatArray, IntArray
+from rsstp_sim.arm.geometry import Blocker
+from rsstp_sim.arm.scenario import Scenario, parse_arm
+from rsstp_sim.arm.table import (
+    MAX_TABULATION_CHECKS,
+    WorldTable,
+    pose_space_size,
+    tabulation_checks,
+    unsensable,
+)
 from rsstp_sim.errors import ActionError, TruthError, UnknownPose
-from rsstp_sim.geometry import Blocker
 from rsstp_sim.interface import PoseMachine
-from rsstp_sim.scenario import MANY_OBSTACLES, Scenario, parse_arm
-from rsstp_sim.world_table import WorldTable, pose_space_size, tabulation_checks, unsensable
+from rsstp_sim.scenario import MANY_OBSTACLES
 
-__all__ = ["ARM", "Pose", "World"]
+__all__ = ["ARM", "Blocker", "Pose", "World"]
 
 _FIRST_BLOCK = 256
 """The poses a table grown in blocks grows by at its first miss (doubling at each)."""
@@ -84,6 +101,22 @@ class Pose:
         values, without numpy arrays."""
         return self._table.truth_values(self._row)
 
+    def truth_json(self) -> tuple[bytes, bytes]:
+        """The pose's members of its ``rsstp.Step`` truth (JSON, keys in schema order) before
+        its ``blocked`` field (angles, joint positions) and after it (distances): numbers into
+        templates, one encoder call a pose."""
+        angles, positions, distances = self.truth_values()
+        n = len(angles)
+        before, after = _truth_templates(n, len(distances) // n)
+        texts = encode_json([*positions, *distances])[1:-1].split(b",")
+        points = len(positions)
+        return before % (*angles, *texts[:points]), after % tuple(texts[points:])
+
+    def truth_record(self, blocker: Blocker | None) -> TruthRecord:
+        """The truth record of a step ending here after a move that ``blocker`` blocked
+        (None: it moved)."""
+        return _truth_record(self, blocker)
+
 
 class World:
     """A 2D arm of ``n`` links, moved one joint at a time by ``step_deg``.
@@ -91,7 +124,7 @@ class World:
     Actions are integers ``0 .. 2n-1`` (restricted to ``scenario.actions``):
     joint ``a // 2`` turns by ``+step_deg`` (counter-clockwise) for even ``a`` and
     by ``-step_deg`` for odd ``a``. A blocked move leaves the arm where it is
-    and :meth:`move` returns its :class:`~rsstp_sim.geometry.Blocker`.
+    and :meth:`move` returns its :class:`~rsstp_sim.arm.geometry.Blocker`.
 
     Observation available to an agent: :attr:`sensation` (bool) and
     :attr:`feedback` (float in [0, 1]). Everything else (angles, positions,
@@ -102,8 +135,8 @@ class World:
         """``per_move``: grow the world table move by move (True) or in blocks of poses
         (False); by default per move exactly when the pose space is too large for a dense
         table, or the whole table would cost more than
-        :data:`~rsstp_sim.world_table.MAX_TABULATION_CHECKS` (many obstacles), since the
-        blocks double until they hold it (see :mod:`rsstp_sim.world_table`). Both give the
+        :data:`~rsstp_sim.arm.table.MAX_TABULATION_CHECKS` (many obstacles), since the
+        blocks double until they hold it (see :mod:`rsstp_sim.arm.table`). Both give the
         same answers."""
         self.scenario = scenario
         self.table = WorldTable(scenario)
@@ -228,7 +261,7 @@ class World:
         return np.array(rows, np.int64), np.array(codes, np.int64)
 
     def blocker_of(self, blocker_code: int) -> Blocker | None:
-        """The :class:`~rsstp_sim.geometry.Blocker` of a blocker code (None for 0: it moved)."""
+        """The :class:`~rsstp_sim.arm.geometry.Blocker` of a blocker code (None for 0: it moved)."""
         return self._blocker(blocker_code) if blocker_code else None
 
     def peek(self, action: int) -> tuple[Pose, Blocker | None]:
@@ -264,9 +297,123 @@ class World:
     def distances(self) -> FloatArray:
         return self._pose.distances
 
+    # -- following a recorded run (the physics check) ------------------------------------
+
+    def follow(self, actions: IntArray, recorded: Any = None) -> tuple[IntArray, IntArray]:
+        """From the start pose, the table row of every step's pose (step 0's: the start,
+        row 0) and each move's blocker code (0 at step 0) of ``actions[1:]``; raises
+        :class:`~rsstp_sim.errors.ActionError` at an action the scenario does not have.
+        ``recorded`` (a steps table with the recorded angles, or None) lets a long run be
+        followed in numpy, a block of steps at a time, on the whole table: where the
+        recorded poses are where the table moves each one before, the answer is theirs;
+        else (or at the first step where they are not) the arm walks move by move."""
+        if (
+            recorded is not None
+            and not self.per_move
+            and len(actions) > pose_space_size(self.scenario)
+        ):
+            self.table.complete()  # a long walk meets most poses: all at once costs less
+            followed = _followed(self.table, actions, recorded)
+            if followed is not None:
+                return followed
+        rows, blockers = self.walk(actions[1:].tolist())
+        return np.concatenate([[0], rows]), np.concatenate([[0], blockers])
+
+    def senses(self) -> tuple[BoolArray, FloatArray]:
+        """The sensation and the feedback of every row of the world's table."""
+        sensation = np.frombuffer(self.table.sensation, np.int8).astype(bool)
+        return sensation, np.frombuffer(self.table.feedback, np.float64)
+
+    def truth_at(self, row: int, blocker_code: int) -> TruthRecord:
+        """The truth record of a step ending at ``row`` after a move blocked by
+        ``blocker_code`` (0: it moved)."""
+        return self.pose_at(row).truth_record(self.blocker_of(blocker_code))
+
     def cache_info(self) -> tuple[int, int]:
         """(poses in the world's table, poses with at least one move computed)."""
         return len(self.table), self.table.moves_computed()
+
+
+_BLOCK_STEPS = 1 << 20
+"""Steps :func:`_followed` takes at once (its temporary arrays stay a few tens of MB)."""
+
+
+def _followed(table: WorldTable, actions: IntArray, steps: Any) -> tuple[IntArray, IntArray] | None:
+    """The rows and blockers of :meth:`World.follow`, from a whole world table and the recorded
+    poses, when each step's pose is where the world's table moves the one before by the
+    step's action (checked in numpy, a block of steps at a time, not move by move); None at
+    the first step where it is not, which the walk then finds."""
+    names = [f"angle_deg_{j}" for j in range(len(table.radix))]
+    if not set(names) <= set(steps.columns) or len(steps) != len(actions):
+        return None
+    index = np.full(max(table.actions) + 1, -1, np.int64)
+    index[list(table.actions)] = np.arange(len(table.actions))
+    table_codes = np.frombuffer(table.codes, np.int64)
+    next_rows, blocker_codes = table.next_array(), table.blocker_array()
+    columns = [steps[name].to_numpy() for name in names]
+    rows = np.empty(len(steps), np.int64)
+    blockers = np.zeros(len(steps), np.int64)
+    before = 0  # the row of the step before the block (the start pose's: row 0)
+    for first in range(0, len(steps), _BLOCK_STEPS):
+        block = slice(first, first + _BLOCK_STEPS)
+        angles = np.stack([column[block] for column in columns], axis=1).astype(np.int64)
+        found = table.rows_at(angles)
+        if (found < 0).any() or not np.array_equal(table_codes[found], angles @ table.radix):
+            return None
+        moves = actions[block]
+        if first == 0:  # step 0 is the reset, to the start pose
+            if found[0] != 0:
+                return None
+            found, moves = found[1:], moves[1:]
+            if not len(found):  # the reset alone
+                break
+        if ((moves < 0) | (moves >= len(index))).any() or (index[moves] < 0).any():
+            return None
+        k = index[moves]
+        came_from = np.concatenate([[before], found[:-1]])
+        if not np.array_equal(next_rows[came_from, k], found):
+            return None
+        where = slice(max(first, 1), block.stop)
+        rows[where] = found
+        blockers[where] = blocker_codes[came_from, k]
+        before = int(found[-1])
+    rows[0] = 0
+    return rows, blockers
+
+
+@functools.lru_cache(maxsize=1 << 12)
+def _truth_record(pose: Pose, blocker: Blocker | None) -> TruthRecord:
+    """Poses are cached read-only objects, so a random walk revisiting them gets the same
+    immutable record."""
+    angles, points, distances = pose.truth_values()
+    m = len(distances) // len(angles)
+    return TruthRecord(
+        angles_deg=tuple(angles),
+        joint_positions=tuple(
+            [PointRecord(x=x, y=y) for x, y in zip(points[0::2], points[1::2], strict=True)]
+        ),
+        blocked=blocker is not None,
+        blocked_by=BlockedByRecord.of(blocker),
+        distances=tuple(
+            [
+                DistancesRecord(obstacles=tuple(distances[k * m : (k + 1) * m]))
+                for k in range(len(angles))
+            ]
+        ),
+    )
+
+
+@functools.lru_cache(maxsize=64)
+def _truth_templates(n: int, m: int) -> tuple[bytes, bytes]:
+    """The truth record of an arm of ``n`` links among ``m`` obstacles, before its
+    ``blocked`` field (angles, then the points' float texts) and after it (the distances')."""
+    angles = b",".join([b"%d"] * n)
+    points = b",".join([b'{"x":%b,"y":%b}'] * (n + 1))
+    tips = b",".join([b'{"obstacles":[' + b",".join([b"%b"] * m) + b"]}"] * n)
+    return (
+        b'"angles_deg":[' + angles + b'],"joint_positions":[' + points + b"],",
+        b',"distances":[' + tips + b"]",
+    )
 
 
 class _Arm:
@@ -279,6 +426,24 @@ class _Arm:
 
     def world(self, scenario: Scenario) -> World:
         return World(scenario)
+
+    def scenario_record(self, scenario: Scenario, common: dict[str, Any]) -> ScenarioRecord:
+        target = scenario.feedback_target_deg
+        return ScenarioRecord(
+            n_joints=scenario.n_joints,
+            lengths=tuple(float(v) for v in scenario.lengths),
+            initial_deg=tuple(int(v) for v in scenario.initial_deg),
+            step_deg=int(scenario.step_deg),
+            feedback=FeedbackRecord(
+                mode=scenario.feedback_mode,
+                tolerance=float(scenario.tolerance),
+                tolerance_abs=float(scenario.tolerance * scenario.total_length),
+                points=tuple(PointRecord.of(xy) for xy in scenario.feedback_points),
+                target_deg=None if target is None else tuple(int(v) for v in target),
+            ),
+            collision=scenario.collision,
+            **common,
+        )
 
     def describe(self, scenario: Scenario) -> list[str]:
         lengths = ", ".join(f"{length:g}" for length in scenario.lengths)
@@ -304,7 +469,7 @@ class _Arm:
         }
 
     def picture(self, scenario: Scenario) -> Any:
-        from rsstp_sim.arm_picture import ArmPicture  # (drawing imports the world)
+        from rsstp_sim.arm.picture import ArmPicture  # (drawing imports the world)
 
         return ArmPicture(scenario)
 
@@ -324,7 +489,9 @@ class _Arm:
             )
         return found
 
-    def check_size(self, scenario: Scenario, *, max_poses: int, max_checks: int) -> None:
+    def check_size(self, scenario: Scenario, *, max_poses: int, max_checks: int | None) -> None:
+        if max_checks is None:
+            max_checks = MAX_TABULATION_CHECKS
         bound = pose_space_size(scenario)
         if bound > max_poses:
             raise TruthError(

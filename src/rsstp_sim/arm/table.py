@@ -2,7 +2,7 @@
 
 This is the one home of the geometry's answers. The world (one move at a time), the
 ground truth (every reachable pose at once) and the Gymnasium env (through the world)
-all read the same table, and the table asks :mod:`rsstp_sim.geometry` for whole batches
+all read the same table, and the table asks :mod:`rsstp_sim.arm.geometry` for whole batches
 of poses and moves at once.
 
 - A *pose code* is ``sum(angle_k * 360**k)`` (integer degrees), a *row* the pose's place
@@ -10,7 +10,7 @@ of poses and moves at once.
 - ``next_row[row * A + k]`` is the row reached by the scenario's ``k``-th action (the row
   itself when the move is blocked), or -1 while that pose's moves are not computed;
   ``blocker[row * A + k]`` is the move's blocker code (0 = free, see
-  :class:`~rsstp_sim.geometry.ArmGeometry`). Both are ``array.array`` of C ints: compact,
+  :class:`~rsstp_sim.arm.geometry.ArmGeometry`). Both are ``array.array`` of C ints: compact,
   growable, and read by Python without numpy's per-call cost.
 - Only poses the arm can reach are ever stored: a pose enters the table as the target of
   a free move, never as a neighbour on a lattice, so invalid and unreachable poses cost
@@ -21,7 +21,7 @@ computes the moves of a block of poses around the one the arm stands on, breadth
 vectorised batch per frontier, as many poses as the caller's budget allows, and
 :meth:`WorldTable.complete` computes every reachable pose the same way (the ground truth's
 enumeration). Or move by move: :meth:`WorldTable.step` computes just the move the arm makes
-(one swept check of the joint that turns, see :func:`~rsstp_sim.geometry.move_blocker`) and
+(one swept check of the joint that turns, see :func:`~rsstp_sim.arm.geometry.move_blocker`) and
 the one pose it reaches, in plain floats: the way of a pose space too large to be
 tabulated, where nearly every move reaches a new pose, or of a world whose whole table
 would cost more than :data:`MAX_TABULATION_CHECKS` link-obstacle checks (many obstacles),
@@ -29,7 +29,7 @@ where the blocks would grow to that cost over a long run. A pose space of at mos
 :data:`DENSE_LIMIT` lattice poses finds rows by pose code in a dense array, a larger one in
 a dict of the poses reached.
 
-Every row keeps its pose's :func:`~rsstp_sim.geometry.pose_points` (the base and the link
+Every row keeps its pose's :func:`~rsstp_sim.arm.geometry.pose_points` (the base and the link
 tips, flat), its sensation and its float feedback, and, when a pose has at most
 :data:`KEPT_DISTANCES` tip-obstacle distances, those distances, in growable arrays: a few
 hundred bytes a pose, whichever way it was computed. A pose of more distances (three links
@@ -44,10 +44,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rsstp_sim import geometry
 from rsstp_sim._arrays import BoolArray, FloatArray, Int32Array, IntArray
-from rsstp_sim.geometry import ArmGeometry
-from rsstp_sim.scenario import Scenario
+from rsstp_sim.arm import geometry
+from rsstp_sim.arm.geometry import ArmGeometry
+from rsstp_sim.arm.scenario import Scenario
 
 __all__ = [
     "DENSE_LIMIT",
@@ -179,12 +179,12 @@ class WorldTable:
         self.sensation = array.array("b")
         self.feedback = array.array("d")
         self.positions = array.array("d")
-        """Every row's :func:`~rsstp_sim.geometry.pose_points`, :attr:`width` floats a row."""
+        """Every row's :func:`~rsstp_sim.arm.geometry.pose_points`, :attr:`width` floats a row."""
         self.keeps_distances = n * self.geometry.m <= KEPT_DISTANCES
         """Whether rows keep their distances (else :meth:`distances_of` computes them)."""
         self.distances = array.array("d")
         """When :attr:`keeps_distances`, every row's
-        :func:`~rsstp_sim.geometry.obstacle_distances` (``n * m`` floats a row) when its pose
+        :func:`~rsstp_sim.arm.geometry.obstacle_distances` (``n * m`` floats a row) when its pose
         came in a block; NaN for a pose added alone (see :meth:`step`), whose distances its
         reader computes (:meth:`distances_of`). Empty otherwise."""
         self._unknown_distances = array.array(
@@ -193,7 +193,7 @@ class WorldTable:
         self.dense = pose_space_size(scenario) <= DENSE_LIMIT
         self.heavy = tabulation_checks(scenario) > MAX_TABULATION_CHECKS
         """The whole table would cost more than :data:`MAX_TABULATION_CHECKS`: grow it move by
-        move (see :class:`~rsstp_sim.world.World`)."""
+        move (see :class:`~rsstp_sim.arm.world.World`)."""
         # Rows by pose code: a dense array over a small lattice, else a dict of the poses
         # reached.
         sizes = np.asarray(lattice_sizes(scenario), dtype=np.int64)
@@ -255,7 +255,7 @@ class WorldTable:
 
         The move's reverse, when already computed from the pose the move reaches, gives its
         blocker (they sweep the same poses); else one check of the joint that turns
-        (:func:`~rsstp_sim.geometry.move_blocker`). A free move to a pose not in the table
+        (:func:`~rsstp_sim.arm.geometry.move_blocker`). A free move to a pose not in the table
         adds that one pose.
         """
         n_actions = len(self.actions)

@@ -6,9 +6,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rsstp_sim import palette
+from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.arm.world import World
 from rsstp_sim.canvas import Canvas
-from rsstp_sim.scenario import Scenario
-from rsstp_sim.world import World
 
 __all__ = ["ArmPicture"]
 
