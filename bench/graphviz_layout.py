@@ -21,9 +21,9 @@ Three drawings of each, the ones the command lines make:
 - ``labelled``: the model laid out by ``dot`` with its action labels (``rsstp-sim graph``,
   :func:`rsstp_sim.graph.layout`).
 
-And ``dot400``: unions of 400 state pairs (:data:`~rsstp_replay._viewer_layout.DOT_MAX_PAIRS`,
+And ``dot400``: unions of 400 state pairs (:data:`~rsstp_replay.viewer._layout.DOT_MAX_PAIRS`,
 the most ``dot`` lays out) laid out by ``dot`` within
-:data:`~rsstp_replay._viewer_layout.DOT_LIMITS` (``limits``, both sides) and without them
+:data:`~rsstp_replay.viewer._layout.DOT_LIMITS` (``limits``, both sides) and without them
 (``none``: the program as it ran before issue 30, with a 10 s timeout): the union of the first
 versions of the ``119`` run, and random pairs over 150 states (seed 0).
 
@@ -54,7 +54,7 @@ from pathlib import Path
 
 from _recordings import recorded
 from rsstp_replay import open_recording
-from rsstp_replay._viewer_layout import (
+from rsstp_replay.viewer._layout import (
     DOT_LIMITS,
     DOT_MAX_PAIRS,
     SFDP_SETTINGS,

@@ -42,9 +42,9 @@ from pathlib import Path
 from typing import Any
 
 from _recordings import recorded
-from rsstp_replay._viewer_serve import WebServer
-from rsstp_replay.recording import open_recording
+from rsstp_replay.reader.recording import open_recording
 from rsstp_replay.viewer import view
+from rsstp_replay.viewer._serve import WebServer
 
 ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent

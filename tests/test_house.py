@@ -151,8 +151,10 @@ def test_the_five_packages_are_all_there_is() -> None:
 def test_the_reader_layers_import_only_downwards() -> None:
     upward = []
     for rank, layer in enumerate(READER_LAYERS):
-        tree = ast.parse((SRC / "rsstp_replay" / f"{layer}.py").read_text(encoding="utf-8"))
-        above = {f"rsstp_replay.{name}" for name in READER_LAYERS[rank + 1 :]}
+        tree = ast.parse(
+            (SRC / "rsstp_replay" / "reader" / f"{layer}.py").read_text(encoding="utf-8")
+        )
+        above = {f"rsstp_replay.reader.{name}" for name in READER_LAYERS[rank + 1 :]}
         upward += [f"{layer} imports {name}" for name in sorted(_imports(tree) & above)]
     assert upward == []
 
@@ -160,7 +162,7 @@ def test_the_reader_layers_import_only_downwards() -> None:
 def _calls_between_layers(action: Callable[[], object]) -> list[tuple[str, str]]:
     """(caller layer, called layer) for every call from one reader layer into another while
     ``action`` runs (a generator resumed counts as a call from its resumer)."""
-    files = {str(SRC / "rsstp_replay" / f"{layer}.py"): layer for layer in READER_LAYERS}
+    files = {str(SRC / "rsstp_replay" / "reader" / f"{layer}.py"): layer for layer in READER_LAYERS}
     calls: list[tuple[str, str]] = []
 
     def profile(frame: FrameType, event: str, arg: object) -> None:

@@ -29,14 +29,14 @@ from rsstp_cli._commandline import (
     warning_line,
 )
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
-from rsstp_replay.recording import Recording, open_recording
-from rsstp_replay.table_files import (
+from rsstp_replay.export.table_files import (
     TABLE_FORMATS,
     sidecar_path,
     write_table,
     write_table_parts,
 )
-from rsstp_replay.tables import TABLES, recording_table
+from rsstp_replay.export.tables import TABLES, recording_table
+from rsstp_replay.reader.recording import Recording, open_recording
 from rsstp_sim.bodies import body_of
 from rsstp_sim.files import check_output
 from rsstp_sim.words import counted
@@ -135,8 +135,8 @@ def _check_table_output(out: Path, *, force: bool) -> None:
 
 
 def _write_table(table: pd.DataFrame, out: Path) -> None:
-    """Write ``table`` whole (:func:`rsstp_replay.table_files.write_table`): a failed write leaves
-    no partial table and the old one untouched."""
+    """Write ``table`` whole (:func:`rsstp_replay.export.table_files.write_table`): a failed
+    write leaves no partial table and the old one untouched."""
     _wrote(len(table), table, out, write_table(table, out))
 
 
@@ -165,7 +165,7 @@ def _cmd_table(args: argparse.Namespace) -> int:
 
 
 def _cmd_events(args: argparse.Namespace) -> int:
-    from rsstp_replay.recording import EVENT_KINDS
+    from rsstp_replay.reader.recording import EVENT_KINDS
 
     out = Path(args.output)
     _check_table_output(out, force=args.force)
@@ -406,7 +406,7 @@ def _cmd_graph(args: argparse.Namespace) -> int:
 
 
 def _cmd_export(args: argparse.Namespace) -> int:
-    from rsstp_replay.foxglove_scene import export_foxglove
+    from rsstp_replay.export.foxglove import export_foxglove
 
     out = Path(args.output)
     if out.suffix.lower() != ".mcap":

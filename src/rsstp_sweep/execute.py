@@ -157,7 +157,7 @@ def _record(run: Run, path: Path) -> float:
 def _audit(path: Path) -> dict[str, Any]:
     from rsstp_replay.audits import audit_truth, run_audits
     from rsstp_replay.audits.loaded import load
-    from rsstp_replay.recording import open_recording
+    from rsstp_replay.reader.recording import open_recording
 
     with open_recording(path) as recording:
         loaded = load(recording)
@@ -234,7 +234,7 @@ def _local_copy(fs: Any, path: str) -> Iterator[Path]:
 def _check(path: Path, run: Run) -> str:
     """``valid``: a finished recording of exactly this run whose every chunk passes its CRC;
     ``other``: such a recording, of another run; ``broken``: anything else."""
-    from rsstp_replay.recording import open_recording
+    from rsstp_replay.reader.recording import open_recording
     from rsstp_sim.errors import RsstpError
 
     try:

@@ -2,7 +2,7 @@
 strategy that refines its model at random (and counts what it did).
 
 :class:`FakeRecording` has what the audits read of a
-:class:`rsstp_replay.recording.Recording` (``memory()``, ``model_versions()``, ``steps()``,
+:class:`rsstp_replay.reader.recording.Recording` (``memory()``, ``model_versions()``, ``steps()``,
 ``events()``, ``model_at(step)``, ``n_steps``), observed through the runner's callbacks the way
 the recorder observes a run, so the audits can be tested without an MCAP file.
 """

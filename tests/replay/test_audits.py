@@ -27,7 +27,7 @@ from rsstp_replay.audits import (
     compare,
     run_audits,
 )
-from rsstp_replay.recording import open_recording
+from rsstp_replay.reader.recording import open_recording
 from rsstp_sim import Memory, RandomStrategy, load_scenario
 from rsstp_sim.errors import MemoryRangeError, ModelError
 from rsstp_sim.memory import CompareKind

@@ -27,7 +27,7 @@ from mcap.writer import CompressionType, Writer
 
 from rsstp_format.schemas import SCHEMA_VERSION
 from rsstp_replay import Recording, errors, open_recording
-from rsstp_replay.table_files import write_table_parts
+from rsstp_replay.export.table_files import write_table_parts
 from rsstp_sim import AgentView, StrategyBase, load_scenario
 from rsstp_sim.recording.recorder import record
 from waiting import HANG_S
@@ -432,7 +432,7 @@ def test_a_table_streamed_from_a_recording_broken_at_its_end_is_not_kept(
 def test_a_message_index_that_points_elsewhere_is_refused(original: Path, tmp_path: Path) -> None:
     """A finished file's steps are found through each chunk's message index; an index entry
     that does not point at a step message (here: moved by one byte) is one clear error."""
-    from rsstp_replay._container import open_container
+    from rsstp_replay.reader._container import open_container
 
     container = open_container(original)
     ref = container.chunks[1]

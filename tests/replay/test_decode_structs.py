@@ -1,6 +1,6 @@
 """The replay side's decode-only step structs agree with the records, field for field.
 
-``rsstp_replay._decode`` reads step messages with structs of its own, for speed: they skip
+``rsstp_replay.reader._decode`` reads step messages with structs of its own, for speed: they skip
 what a batch does not need (the joint positions and distances that follow from the angles)
 and are not tracked by the garbage collector, and decoding a chunk's steps with them takes
 about a third of the time :class:`~rsstp_format.records.StepRecord` takes (2026-11-28,
@@ -21,7 +21,7 @@ import msgspec
 import pytest
 
 from rsstp_format import records
-from rsstp_replay import _decode
+from rsstp_replay.reader import _decode
 
 WHOLE = [
     (_decode._Step, records.StepRecord),

@@ -25,8 +25,9 @@ from mcap_protobuf.decoder import DecoderFactory
 from rerun.chunk import RrdReader
 
 from rsstp_cli.replay import main
-from rsstp_replay import foxglove_scene, open_recording
-from rsstp_replay.foxglove_scene import ARM_TOPIC, LOG_TOPIC, STATIC_TOPIC, TRANSFORMS_TOPIC
+from rsstp_replay import open_recording
+from rsstp_replay.export import foxglove as foxglove_scene
+from rsstp_replay.export.foxglove import ARM_TOPIC, LOG_TOPIC, STATIC_TOPIC, TRANSFORMS_TOPIC
 from rsstp_sim import __version__, palette
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.recording import record

@@ -10,9 +10,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rsstp_format.records import TransitionsRecord
-from rsstp_replay._models import _patched
 from rsstp_replay.audits._equivalence import ModelTable, TrackedTable
 from rsstp_replay.audits.determinism import audit_determinism
+from rsstp_replay.reader._models import _patched
 from rsstp_sim import load_scenario
 from rsstp_sim.transition_system import TransitionSystem
 

@@ -26,13 +26,13 @@ from mcap.reader import make_reader
 
 from rsstp_format import records
 from rsstp_replay import EVENT_KINDS, open_recording
-from rsstp_replay._container import Container
 from rsstp_replay.errors import (
     ReplayError,
     StepOutOfRange,
     TableError,
     UnfinishedRecordingWarning,
 )
+from rsstp_replay.reader._container import Container
 from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording.recorder import record
 from rsstp_sim.transition_system import TransitionSystem

@@ -13,7 +13,7 @@ import pytest
 
 from rsstp_replay import TableError, read_table, write_table
 from rsstp_replay.errors import CorruptRecording
-from rsstp_replay.table_files import write_table_parts
+from rsstp_replay.export.table_files import write_table_parts
 from rsstp_sim.errors import OutputError
 
 

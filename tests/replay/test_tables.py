@@ -13,7 +13,7 @@ import pytest
 
 from rsstp_cli.replay import main
 from rsstp_replay import Recording, open_recording, read_table
-from rsstp_replay.tables import TABLES, model_table, recording_table, scenario_table
+from rsstp_replay.export.tables import TABLES, model_table, recording_table, scenario_table
 from rsstp_sim import Runner, make_strategy, parse_scenario
 from rsstp_sim.arm.geometry import Blocker
 from rsstp_sim.recording.recorder import record

@@ -20,20 +20,21 @@ import rerun as rr
 from fakes import RandomRefiner
 from rerun.chunk import Chunk, RrdReader
 
-from rsstp_replay import _viewer_layout, viewer
-from rsstp_replay._viewer_model import (
+from rsstp_replay import viewer
+from rsstp_replay.audits.consistency import audit_consistency, audit_consistency_by_version
+from rsstp_replay.audits.contract import version_index
+from rsstp_replay.audits.truth import audit_truth
+from rsstp_replay.errors import ReplayError, StepOutOfRange
+from rsstp_replay.reader.recording import Recording, open_recording
+from rsstp_replay.viewer import ViewerWarning, graph_positions, render_graph, view
+from rsstp_replay.viewer import _layout as _viewer_layout
+from rsstp_replay.viewer._model import (
     ACTION_COLORS,
     LABEL_ROOM,
     LOOP_LENGTH,
     POSE_LINES,
     state_places,
 )
-from rsstp_replay.audits.consistency import audit_consistency, audit_consistency_by_version
-from rsstp_replay.audits.contract import version_index
-from rsstp_replay.audits.truth import audit_truth
-from rsstp_replay.errors import ReplayError, StepOutOfRange
-from rsstp_replay.recording import Recording, open_recording
-from rsstp_replay.viewer import ViewerWarning, graph_positions, render_graph, view
 from rsstp_sim import palette
 from rsstp_sim.recording import record
 from rsstp_sim.scenario import load_scenario

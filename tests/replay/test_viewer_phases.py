@@ -8,7 +8,7 @@ from typing import ClassVar
 
 from test_viewer import Rrd
 
-from rsstp_replay.recording import open_recording
+from rsstp_replay.reader.recording import open_recording
 from rsstp_replay.viewer import view
 from rsstp_sim import AgentView, StrategyBase, load_scenario
 from rsstp_sim.recording import record

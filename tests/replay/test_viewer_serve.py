@@ -11,9 +11,9 @@ from pathlib import Path
 
 import pytest
 
-from rsstp_replay._viewer_serve import WebServer, ctrl_c_remembered
-from rsstp_replay.recording import open_recording
+from rsstp_replay.reader.recording import open_recording
 from rsstp_replay.viewer import view
+from rsstp_replay.viewer._serve import WebServer, ctrl_c_remembered
 from waiting import HANG_S
 
 ROOT = Path(__file__).resolve().parents[2]

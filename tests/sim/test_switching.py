@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-from rsstp_replay._container import open_container
+from rsstp_replay.reader._container import open_container
 from rsstp_sim import RandomStrategy, load_scenario
 from rsstp_sim.recording.recorder import Recorder
 from rsstp_sim.switching import SWITCH_INTERVAL, sooner_switches

@@ -27,8 +27,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rsstp_format import records
-from rsstp_replay._chunks import gc_paused
 from rsstp_replay.errors import PhysicsDifference
+from rsstp_replay.reader._chunks import gc_paused
 from rsstp_sim.bodies import make_world
 from rsstp_sim.errors import ActionError
 from rsstp_sim.recording import builders
@@ -39,7 +39,7 @@ IntArray = NDArray[np.int64]  # (rsstp_sim._arrays is the simulator's own)
 if TYPE_CHECKING:
     import pandas as pd
 
-    from rsstp_replay.recording import Recording
+    from rsstp_replay.reader.recording import Recording
 
 __all__ = ["PhysicsFindings", "check_physics"]
 

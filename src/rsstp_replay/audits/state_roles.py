@@ -13,7 +13,7 @@ step's internal state and ``step_classes[t]`` the true class of its pose
 
 A version equivalent to the truth (:mod:`rsstp_replay.audits.verdict`) has no aliased state on
 the steps it was in force; a redundant one is allowed (a correct model need not be minimal).
-The viewer colours the model's states by role (:mod:`rsstp_replay._viewer_model`).
+The viewer colours the model's states by role (:mod:`rsstp_replay.viewer._model`).
 """
 
 from __future__ import annotations

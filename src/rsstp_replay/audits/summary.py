@@ -54,7 +54,7 @@ __all__ = [
 
 
 class AuditSource(HasMemory, HasModelVersions, Protocol):
-    """What the audits read from a recording (:class:`rsstp_replay.recording.Recording` has it).
+    """What the audits read from a recording (:class:`~rsstp_replay.Recording` has it).
 
     - ``memory()``: the agent's :class:`~rsstp_sim.memory.Memory`;
     - ``model_versions()``: the ``/rsstp/model`` messages, in order;

@@ -1,7 +1,7 @@
 """The messages inside chunks: found, sliced out and counted.
 
-The reader's second layer, above :mod:`rsstp_replay._container` (which reads each chunk
-record, decompressed and CRC-checked) and below :mod:`rsstp_replay._contract`. A chunk's
+The reader's second layer, above :mod:`rsstp_replay.reader._container` (which reads each chunk
+record, decompressed and CRC-checked) and below :mod:`rsstp_replay.reader._contract`. A chunk's
 message records are found in its bytes (:func:`split_bounds`, or through the chunk's
 message index, :func:`message_bounds`) and sliced out for a decoder to take many at once;
 :func:`topic_chunks` reads a topic chunk by chunk (:func:`topics_chunks` several topics in
@@ -23,8 +23,8 @@ import numpy.typing as npt
 from mcap.opcode import Opcode
 
 from rsstp_format.schemas import STEP_NS
-from rsstp_replay._container import MESSAGE_TIME, ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording
+from rsstp_replay.reader._container import MESSAGE_TIME, ChunkRef, Container
 
 __all__ = [
     "count_messages",

@@ -25,10 +25,10 @@ import pandas as pd
 import rerun as rr
 
 from rsstp_format.records import ModelRecord
-from rsstp_replay._viewer_chunks import TIMELINE, send_rows
 from rsstp_replay.audits.consistency import ConsistencyFindings, StateContradiction
 from rsstp_replay.audits.determinism import DeterminismFindings
 from rsstp_replay.audits.summary import phase_changes
+from rsstp_replay.viewer._chunks import TIMELINE, send_rows
 from rsstp_sim.words import counted
 
 __all__ = [

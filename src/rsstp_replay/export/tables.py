@@ -8,8 +8,8 @@
 - ``scenario``: :func:`scenario_table`, one row: the ``/rsstp/scenario`` message.
 
 Their columns are named the same way for every scenario, so the tables of several recordings
-concatenate. :mod:`rsstp_replay.table_files` writes them to Parquet or CSV and reads them back
-with their types.
+concatenate. :mod:`rsstp_replay.export.table_files` writes them to Parquet or CSV and reads
+them back with their types.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_format.records import ModelRecord, RoverScenarioRecord, ScenarioRecord
 from rsstp_replay.errors import TableError
-from rsstp_replay.recording import Recording
+from rsstp_replay.reader.recording import Recording
 
 __all__ = ["TABLES", "model_table", "recording_table", "scenario_table"]
 

@@ -5,14 +5,14 @@ version), the ``rsstp`` metadata record, and the ``scenario.toml`` attachment ag
 ``/rsstp/scenario`` message and the metadata (``schemas/README.md`` is the contract).
 
 The reader's layers, each importing only those below it: the container
-(:mod:`rsstp_replay._container`: the file's records, its chunk records decompressed and
-CRC-checked), the chunks (:mod:`rsstp_replay._chunks`: the messages inside them), the contract
-(this module) and the recording (:mod:`rsstp_replay.recording`). Opening a recording goes
-down them once: :func:`~rsstp_replay.open_recording` takes what
-:func:`~rsstp_replay._container.open_container` found to :func:`check_file`, which reads the
+(:mod:`rsstp_replay.reader._container`: the file's records, its chunk records decompressed and
+CRC-checked), the chunks (:mod:`rsstp_replay.reader._chunks`: the messages inside them), the
+contract (this module) and the recording (:mod:`rsstp_replay.reader.recording`). Opening a
+recording goes down them once: :func:`~rsstp_replay.open_recording` takes what
+:func:`~rsstp_replay.reader._container.open_container` found to :func:`check_file`, which reads the
 scenario message (and, for a file without statistics, the message counts) through the chunks
 layer, which reads the chunk records through the container. No call goes back up. After
-that, :class:`~rsstp_replay.recording.Recording` reads messages through
+that, :class:`~rsstp_replay.reader.recording.Recording` reads messages through
 :meth:`CheckedFile.chunks`, down the same way.
 """
 
@@ -54,9 +54,9 @@ from rsstp_format.schemas import (
     parse_version,
     version_refusal,
 )
-from rsstp_replay._chunks import Messages, count_messages, topic_chunks, topics_chunks
-from rsstp_replay._container import ChunkRef, Container
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
+from rsstp_replay.reader._chunks import Messages, count_messages, topic_chunks, topics_chunks
+from rsstp_replay.reader._container import ChunkRef, Container
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.rover import RoverScenario
@@ -73,7 +73,7 @@ class CheckedFile:
     schema versions, metadata (``metadata_verified``: by its checksum; False for a file older
     than the checksum), message counts per topic (an unfinished file's cut at
     ``limit_ns``, its last recovered step), the last step, and the scenario. It reads the
-    messages of a topic chunk by chunk for :class:`~rsstp_replay.recording.Recording`."""
+    messages of a topic chunk by chunk for :class:`~rsstp_replay.reader.recording.Recording`."""
 
     container: Container
     channels: dict[str, int]
@@ -103,7 +103,7 @@ class CheckedFile:
         self, topics: Sequence[str]
     ) -> Generator[tuple[ChunkRef, bytes, list[Messages]], None, None]:
         """The chunks with messages of any of ``topics``, each read once, with its records
-        and, topic by topic, its :class:`~rsstp_replay._chunks.Messages`."""
+        and, topic by topic, its :class:`~rsstp_replay.reader._chunks.Messages`."""
         channels = [self.channels[topic] for topic in topics]
         return topics_chunks(self.container, channels, self.limit_ns)
 

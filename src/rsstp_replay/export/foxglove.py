@@ -22,7 +22,7 @@ The recording itself is JSON described by this project's schemas: Foxglove plots
   its text; level WARNING for ``blocked`` and ``contradiction``, INFO for the others.
 
 A rover's recording gives the same topics with the rover's entities and frames
-(:mod:`rsstp_replay._foxglove_rover`): its room on the static topic, the robot on
+(:mod:`rsstp_replay.export._foxglove_rover`): its room on the static topic, the robot on
 ``/rsstp/scene``, ``world -> robot`` on the transforms.
 
 A metadata record ``rsstp.scene`` names what the scene was made from (scenario and its
@@ -37,7 +37,7 @@ protobuf encoding); the file is written by the recorder's chunked MCAP writer
 (:mod:`rsstp_sim.recording.chunks`, zstd chunks, every index), not by one SDK call per
 message: the arm's entity and the links' transforms of a pose are encoded once without their
 timestamp, which each step puts in front (it is the first field of both, see
-:mod:`rsstp_replay._foxglove_stamps`).
+:mod:`rsstp_replay.export._foxglove_stamps`).
 """
 
 from __future__ import annotations
@@ -73,9 +73,9 @@ from foxglove.messages import (
 )
 
 from rsstp_format.schemas import STEP_NS
-from rsstp_replay._foxglove_rover import RoverDrawing, RoverPoses
-from rsstp_replay._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
-from rsstp_replay._foxglove_stamps import PoseMessages
+from rsstp_replay.export._foxglove_rover import RoverDrawing, RoverPoses
+from rsstp_replay.export._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
+from rsstp_replay.export._foxglove_stamps import PoseMessages
 from rsstp_sim import __version__, palette
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.files import written_whole
@@ -85,7 +85,7 @@ from rsstp_sim.rover import RoverScenario
 from rsstp_sim.words import counted
 
 if TYPE_CHECKING:
-    from rsstp_replay.recording import Recording
+    from rsstp_replay.reader.recording import Recording
 
 __all__ = [
     "ARM_TOPIC",

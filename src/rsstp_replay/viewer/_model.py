@@ -50,7 +50,6 @@ import pandas as pd
 import rerun as rr
 
 from rsstp_format.records import ModelRecord
-from rsstp_replay._viewer_chunks import TIMELINE, send_rows
 from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.state_roles import (
     ALIASED,
@@ -60,6 +59,7 @@ from rsstp_replay.audits.state_roles import (
     UNVISITED,
     state_roles,
 )
+from rsstp_replay.viewer._chunks import TIMELINE, send_rows
 from rsstp_sim import palette
 from rsstp_sim.transition_system import TransitionSystem
 

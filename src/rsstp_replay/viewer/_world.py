@@ -15,8 +15,8 @@ import numpy.typing as npt
 import pandas as pd
 import rerun as rr
 
-from rsstp_replay._decode import blocker_texts
-from rsstp_replay._viewer_chunks import send_rows
+from rsstp_replay.reader._decode import blocker_texts
+from rsstp_replay.viewer._chunks import send_rows
 from rsstp_sim import palette
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.rover import RoverScenario

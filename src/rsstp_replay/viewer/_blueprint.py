@@ -7,7 +7,7 @@ from typing import NamedTuple
 import numpy as np
 import rerun.blueprint as rrb
 
-from rsstp_replay._viewer_chunks import TIMELINE
+from rsstp_replay.viewer._chunks import TIMELINE
 from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import AnyScenario
 

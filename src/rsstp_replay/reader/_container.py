@@ -6,7 +6,7 @@ CRC. A file without a footer (the writer was killed) is scanned sequentially fro
 every complete chunk is kept, and the scan stops at the first truncated or invalid record.
 A chunk record is read whole, decompressed and checked against its CRC here
 (:meth:`Container.chunk_data`); the messages inside it are the business of the layer above,
-:mod:`rsstp_replay._chunks`, which this module never calls. Every problem raises a
+:mod:`rsstp_replay.reader._chunks`, which this module never calls. Every problem raises a
 :mod:`rsstp_replay.errors` exception whose message names the file and the byte offset.
 """
 

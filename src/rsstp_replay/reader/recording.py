@@ -33,11 +33,6 @@ import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_format.records import EventKind, EventRecord, ModelRecord, json_array
 from rsstp_format.schemas import STEP_NS
-from rsstp_replay._chunks import Messages, gc_paused, message_times
-from rsstp_replay._container import ChunkRef, open_container
-from rsstp_replay._contract import CheckedFile, check_file
-from rsstp_replay._decode import StepColumns
-from rsstp_replay._models import HEADS, ChainCheck, ModelHead, build_model
 from rsstp_replay.errors import (
     BadStep,
     CorruptRecording,
@@ -46,6 +41,11 @@ from rsstp_replay.errors import (
     TableError,
     UnfinishedRecordingWarning,
 )
+from rsstp_replay.reader._chunks import Messages, gc_paused, message_times
+from rsstp_replay.reader._container import ChunkRef, open_container
+from rsstp_replay.reader._contract import CheckedFile, check_file
+from rsstp_replay.reader._decode import StepColumns
+from rsstp_replay.reader._models import HEADS, ChainCheck, ModelHead, build_model
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
@@ -318,7 +318,7 @@ class Recording:
     def _checked_models(self) -> tuple[ModelRecord, ...]:
         """The model messages, each checked against the chain as it is read: a message that
         is byte for byte what its operations make is read without parsing its transitions
-        (:meth:`~rsstp_replay._models.ChainCheck.head`)."""
+        (:meth:`~rsstp_replay.reader._models.ChainCheck.head`)."""
         topic = "/rsstp/model"
         chain = ChainCheck(self.path, last_step=self.n_steps)
         found: list[ModelRecord] = []
@@ -472,7 +472,7 @@ class Recording:
         """The steps table (:meth:`steps`) in parts of ``rows`` rows, in order (their
         ``pd.concat`` is :meth:`steps`), each given as soon as its steps are decoded, the
         last once every step is checked: to write a long table while the rest is decoded
-        (``rsstp-replay table`` does, :func:`~rsstp_replay.table_files.write_table_parts`).
+        (``rsstp-replay table`` does, :func:`~rsstp_replay.export.table_files.write_table_parts`).
         An error raised on the way (a corrupt step) voids the parts given before it. Until
         the last part is taken, the garbage collector is paused (the decoding makes and
         drops millions of acyclic objects): what runs between parts frees by reference

@@ -1,4 +1,4 @@
-"""The rover in a Foxglove scene (:mod:`rsstp_replay.foxglove_scene`): its room once, then the
+"""The rover in a Foxglove scene (:mod:`rsstp_replay.export.foxglove`): its room once, then the
 robot at step 0 and at every step where it moved or turned.
 
 - ``/rsstp/scene/static``: entity ``room`` (line strips: the room's edges and its walls, and
@@ -35,7 +35,7 @@ from foxglove.messages import (
     Vector3,
 )
 
-from rsstp_replay._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
+from rsstp_replay.export._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
 from rsstp_sim import palette
 from rsstp_sim.rover import RoverScenario
 

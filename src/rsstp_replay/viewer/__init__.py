@@ -34,14 +34,18 @@ import pandas as pd
 import rerun as rr
 
 from rsstp_format.records import ModelRecord
-from rsstp_replay import _viewer_model as model_part
-from rsstp_replay import _viewer_plots as plots_part
-from rsstp_replay import _viewer_world as world_part
-from rsstp_replay._decode import ROVER_COLUMNS
-from rsstp_replay._viewer_blueprint import default_blueprint, view_frame
-from rsstp_replay._viewer_chunks import TIMELINE
-from rsstp_replay._viewer_layout import graph_positions
-from rsstp_replay._viewer_serve import (
+from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
+from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
+from rsstp_replay.audits.truth import step_true_classes
+from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
+from rsstp_replay.reader._decode import ROVER_COLUMNS
+from rsstp_replay.viewer import _model as model_part
+from rsstp_replay.viewer import _plots as plots_part
+from rsstp_replay.viewer import _world as world_part
+from rsstp_replay.viewer._blueprint import default_blueprint, view_frame
+from rsstp_replay.viewer._chunks import TIMELINE
+from rsstp_replay.viewer._layout import graph_positions
+from rsstp_replay.viewer._serve import (
     DEFAULT_BIND,
     CtrlC,
     WebServer,
@@ -50,10 +54,6 @@ from rsstp_replay._viewer_serve import (
     has_display,
     rerun_command,
 )
-from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
-from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
-from rsstp_replay.audits.truth import step_true_classes
-from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
 from rsstp_sim import graph
 from rsstp_sim.errors import OutputError, RsstpError
 from rsstp_sim.files import side_file, write_whole
@@ -116,7 +116,7 @@ ENTITY_PATHS: tuple[str, ...] = (
 
 
 class ViewSource(Protocol):
-    """What the viewer reads of a recording (:class:`rsstp_replay.recording.Recording`)."""
+    """What the viewer reads of a recording (:class:`rsstp_replay.reader.recording.Recording`)."""
 
     @property
     def path(self) -> Path: ...
@@ -149,7 +149,7 @@ class LogSummary:
     log_lines: int
     thinned: tuple[str, ...]
     """The series paths that kept only their extremes (more changes than
-    :data:`~rsstp_replay._viewer_plots.SERIES_MAX_ROWS` in the steps shown)."""
+    :data:`~rsstp_replay.viewer._plots.SERIES_MAX_ROWS` in the steps shown)."""
     every: int
     """The arm, its blocked marker and the current state are shown every ``every``-th step
     (1: every step; more over :data:`OVERVIEW_MAX_STEPS` steps shown)."""

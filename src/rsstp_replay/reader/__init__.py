@@ -1,0 +1,7 @@
+"""Reading a recording, in four layers from the bottom up: the MCAP file's records
+(:mod:`~rsstp_replay.reader._container`), the messages inside its chunks
+(:mod:`~rsstp_replay.reader._chunks`), the recording contract
+(:mod:`~rsstp_replay.reader._contract`), and the :class:`~rsstp_replay.reader.recording.Recording`
+(its steps decoded by :mod:`~rsstp_replay.reader._decode`, its model versions by
+:mod:`~rsstp_replay.reader._models`). Reading never imports the audits.
+"""
