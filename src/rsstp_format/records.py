@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Mapping, Sequence
-from typing import Annotated, Any, ClassVar, Literal, Self, TypeVar
+from typing import Annotated, Any, ClassVar, Literal, Self, TypeAlias, TypeVar
 
 import msgspec
 
@@ -63,6 +63,8 @@ __all__ = [
     "PointRecord",
     "RECORD_TYPES",
     "STEP_RECORDS",
+    "ScenarioMessage",
+    "StepMessage",
     "RecordFormatError",
     "RegionRecord",
     "RoverRecord",
@@ -981,7 +983,13 @@ RECORD_TYPES: dict[str, type[MessageRecord]] = {
 }
 """Schema name -> record class."""
 
-STEP_RECORDS: dict[type, type[StepRecord | RoverStepRecord]] = {
+ScenarioMessage: TypeAlias = ScenarioRecord | RoverScenarioRecord
+"""The scenario message of any body (one member a body)."""
+
+StepMessage: TypeAlias = StepRecord | RoverStepRecord
+"""The step message of any body (one member a body)."""
+
+STEP_RECORDS: dict[type, type[StepMessage]] = {
     TruthRecord: StepRecord,
     RoverTruthRecord: RoverStepRecord,
 }

@@ -1,6 +1,7 @@
 """The replay side's decode-only step structs agree with the records, field for field.
 
-``rsstp_replay.reader._decode`` reads step messages with structs of its own, for speed: they skip
+``rsstp_replay.reader`` reads step messages with structs of its own (the agent's in
+``_decode``, each body's truth in ``_arm`` and ``_rover``), for speed: they skip
 what a batch does not need (the joint positions and distances that follow from the angles)
 and are not tracked by the garbage collector, and decoding a chunk's steps with them takes
 about a third of the time :class:`~rsstp_format.records.StepRecord` takes (2026-11-28,
@@ -21,20 +22,22 @@ import msgspec
 import pytest
 
 from rsstp_format import records
-from rsstp_replay.reader import _decode
+from rsstp_replay.reader import _arm, _decode, _rover
 
 WHOLE = [
-    (_decode._Step, records.StepRecord),
-    (_decode._Agent, records.AgentRecord),
-    (_decode._Truth, records.TruthRecord),
-    (_decode._BlockedBy, records.BlockedByRecord),
-    (_decode._Point, records.PointRecord),
-    (_decode._Distances, records.DistancesRecord),
+    (_arm._Step, records.StepRecord),
+    (_decode.Agent, records.AgentRecord),
+    (_arm._Truth, records.TruthRecord),
+    (_decode.BlockedBy, records.BlockedByRecord),
+    (_decode.Point, records.PointRecord),
+    (_arm._Distances, records.DistancesRecord),
+    (_rover._RoverStep, records.RoverStepRecord),
+    (_rover._RoverTruth, records.RoverTruthRecord),
 ]
 """Decode struct -> the record it reads, every field."""
 PARTS = [
-    (_decode._PoseStep, records.StepRecord),
-    (_decode._PoseTruth, records.TruthRecord),
+    (_arm._PoseStep, records.StepRecord),
+    (_arm._PoseTruth, records.TruthRecord),
     (_decode._AgentStep, records.StepRecord),
 ]
 """Decode struct -> the record of which it reads some fields (the parser skips the others)."""
@@ -120,7 +123,7 @@ def test_a_partial_decode_struct_reads_some_of_its_record_s_fields(
 
 
 def test_the_check_finds_a_difference() -> None:
-    class Agent(msgspec.Struct, kw_only=True):  # _decode._Agent with a field mistyped
+    class Agent(msgspec.Struct, kw_only=True):  # _decode.Agent with a field mistyped
         action: int | None = None
         state_before: int | None = None
         internal_state: int

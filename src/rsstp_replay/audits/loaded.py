@@ -22,7 +22,7 @@ import numpy.typing as npt
 import pandas as pd
 
 from rsstp_format.records import ModelRecord
-from rsstp_replay.reader._decode import BLOCKED_COLUMNS
+from rsstp_replay.reader import BLOCKED_COLUMNS
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.memory import Memory
 

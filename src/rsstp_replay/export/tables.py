@@ -22,7 +22,7 @@ from typing import Any, Protocol
 import numpy as np
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
-from rsstp_format.records import ModelRecord, RoverScenarioRecord, ScenarioRecord
+from rsstp_format.records import ModelRecord, ScenarioMessage
 from rsstp_replay.errors import TableError
 from rsstp_replay.reader.recording import Recording
 
@@ -38,7 +38,7 @@ class _Models(Protocol):
 
 class _Scenario(Protocol):
     @property
-    def scenario_record(self) -> ScenarioRecord | RoverScenarioRecord: ...
+    def scenario_record(self) -> ScenarioMessage: ...
 
 
 def model_table(source: _Models) -> pd.DataFrame:

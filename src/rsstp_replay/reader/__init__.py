@@ -5,3 +5,13 @@
 (its steps decoded by :mod:`~rsstp_replay.reader._decode`, its model versions by
 :mod:`~rsstp_replay.reader._models`). Reading never imports the audits.
 """
+
+from rsstp_replay.reader._decode import (
+    BLOCKED_COLUMNS,
+    BodyReader,
+    blocker_label,
+    blocker_texts,
+    body_reader,
+)
+
+__all__ = ["BLOCKED_COLUMNS", "BodyReader", "blocker_label", "blocker_texts", "body_reader"]

@@ -32,8 +32,7 @@ import numpy.typing as npt
 
 from rsstp_format.records import (
     RecordFormatError,
-    RoverScenarioRecord,
-    ScenarioRecord,
+    ScenarioMessage,
     decode,
     decode_many,
 )
@@ -57,9 +56,8 @@ from rsstp_format.schemas import (
 from rsstp_replay.errors import CorruptRecording, ForeignRecording, UnsupportedVersion
 from rsstp_replay.reader._chunks import Messages, count_messages, topic_chunks, topics_chunks
 from rsstp_replay.reader._container import ChunkRef, Container
-from rsstp_sim.arm.scenario import Scenario
+from rsstp_replay.reader._decode import body_reader
 from rsstp_sim.errors import ScenarioError
-from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import AnyScenario, parse_scenario
 
 __all__ = ["CheckedFile", "check_file"]
@@ -83,7 +81,7 @@ class CheckedFile:
     topic_counts: dict[str, int]
     limit_ns: int | None
     n_steps: int
-    scenario_record: ScenarioRecord | RoverScenarioRecord
+    scenario_record: ScenarioMessage
     scenario: AnyScenario
     topics: dict[str, str]
     """Topic -> schema name, of the recording's body (:data:`BODY_TOPICS`)."""
@@ -185,7 +183,7 @@ def _scenario_message(
     topics: dict[str, str],
     counts: dict[str, int],
     limit_ns: int | None,
-) -> ScenarioRecord | RoverScenarioRecord:
+) -> ScenarioMessage:
     """The one ``/rsstp/scenario`` message."""
     count = counts.get("/rsstp/scenario", 0)
     if count != 1:
@@ -200,7 +198,7 @@ def _scenario_message(
                 record = _decode_one(
                     container.path, name, "/rsstp/scenario", parts[0], times[0], ref
                 )
-                assert isinstance(record, ScenarioRecord | RoverScenarioRecord)
+                assert isinstance(record, ScenarioMessage)
                 return record
     raise CorruptRecording(f"{container.path}: the /rsstp/scenario message is missing")
 
@@ -343,7 +341,7 @@ def cut_time(container: Container, step_channel: int) -> int:
 
 
 def rebuild_scenario(
-    container: Container, record: ScenarioRecord | RoverScenarioRecord, metadata: dict[str, str]
+    container: Container, record: ScenarioMessage, metadata: dict[str, str]
 ) -> AnyScenario:
     path = container.path
     attachments = [a for a in container.attachments if a.name == ATTACHMENT_NAME]
@@ -367,29 +365,14 @@ def rebuild_scenario(
         scenario = parse_scenario(text, origin=record.origin)
     except ScenarioError as exc:
         raise CorruptRecording(f"{path}: the {ATTACHMENT_NAME} attachment: {exc}") from None
-    if isinstance(record, RoverScenarioRecord) != isinstance(scenario, RoverScenario):
-        said = "a rover" if isinstance(record, RoverScenarioRecord) else "an arm"
+    if record.schema_name != BODY_TOPICS[scenario.body]["/rsstp/scenario"]:
         raise CorruptRecording(
             f"{path}: the {ATTACHMENT_NAME} attachment describes a {scenario.body}, the "
-            f"/rsstp/scenario message {said}"
+            f"/rsstp/scenario message is {record.schema_name}"
         )
-    if isinstance(record, ScenarioRecord) and isinstance(scenario, Scenario):
-        if scenario.n_joints != record.n_joints or len(scenario.obstacles) != len(record.obstacles):
-            raise CorruptRecording(
-                f"{path}: the /rsstp/scenario message has {record.n_joints} joints and "
-                f"{len(record.obstacles)} obstacles, its scenario file {scenario.n_joints} and "
-                f"{len(scenario.obstacles)}"
-            )
-    elif isinstance(record, RoverScenarioRecord) and isinstance(scenario, RoverScenario):
-        told = (len(record.obstacles), len(record.rover.walls), len(record.rover.doors))
-        given = (len(scenario.obstacles), len(scenario.walls), len(scenario.doors))
-        if list(record.rover.room) != list(scenario.room) or told != given:
-            raise CorruptRecording(
-                f"{path}: the /rsstp/scenario message has a {record.rover.room[0]} x "
-                f"{record.rover.room[1]} room with {told[0]} obstacles, {told[1]} walls and "
-                f"{told[2]} doors, its scenario file a {scenario.room[0]} x {scenario.room[1]} "
-                f"one with {given[0]}, {given[1]} and {given[2]}"
-            )
+    shape = body_reader(scenario.body).shape_difference(record, scenario)
+    if shape is not None:
+        raise CorruptRecording(f"{path}: {shape}")
     if metadata["seed"] != str(record.seed) or metadata["strategy"] != record.strategy.name:
         raise CorruptRecording(
             f"{path}: the metadata says seed {metadata['seed']} and strategy "

@@ -8,20 +8,16 @@ structs check types and ranges while decoding (integers stay integers, angles in
 ``0..359``, feedback in ``[0, 1]``); shapes and the rules between fields are checked on the
 columns.
 
-The joint positions and obstacle distances of an arm's step depend on its pose alone, and
-parsing their floats is most of the cost of a step, so a batch is decoded without them, and
-only the first message of each pose met is decoded whole: the table's numbers of a pose are
-that message's, what the file holds. Whether they are what the scenario's geometry gives, and
-the same at every visit, is the physics check's business (``rsstp-replay check --physics``),
-so a recording written before a geometry fix still opens, and that check names the first
-step that differs.
+The fields every body's step has (the agent's, the blocker) are read here; a body's own
+ground truth by its :class:`BodyReader` (:data:`BODY_READERS`: the arm's in
+:mod:`~rsstp_replay.reader._arm`, the rover's in :mod:`~rsstp_replay.reader._rover`).
 """
 
 from __future__ import annotations
 
 import re
-from itertools import chain
-from typing import Annotated, Any
+from importlib import import_module
+from typing import Annotated, Any, Protocol
 
 import msgspec
 import numpy as np
@@ -30,110 +26,66 @@ import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_format.records import json_array
 from rsstp_format.vocabulary import BLOCKER_ARITY, BLOCKER_KINDS, BlockerKind
-from rsstp_replay.errors import BadStep, ReplayError
+from rsstp_replay.errors import BadStep
 
 __all__ = [
     "BLOCKED_COLUMNS",
-    "ROVER_COLUMNS",
     "BLOCKER_KINDS",
+    "BODY_READERS",
+    "Agent",
+    "Angle",
+    "BlockedBy",
+    "Closeness",
+    "Count",
+    "Point",
+    "BodyReader",
     "StepColumns",
+    "TruthColumns",
     "blocker_label",
     "blocker_texts",
+    "body_reader",
+    "check_lengths",
+    "describe",
 ]
 
-_Count = Annotated[int, msgspec.Meta(ge=0, le=2**63 - 1)]
+Count = Annotated[int, msgspec.Meta(ge=0, le=2**63 - 1)]
 """A count or an id: read into int64 columns, so bounded where it is read."""
-_Angle = Annotated[int, msgspec.Meta(ge=0, le=359)]
-_Closeness = Annotated[float, msgspec.Meta(ge=0.0, le=1.0)]
+Angle = Annotated[int, msgspec.Meta(ge=0, le=359)]
+Closeness = Annotated[float, msgspec.Meta(ge=0.0, le=1.0)]
 
 
-class _Agent(msgspec.Struct, gc=False, kw_only=True):
-    action: _Count | None = None  # absent at step 0
-    state_before: _Count | None = None
-    internal_state: _Count
+class Agent(msgspec.Struct, gc=False, kw_only=True):
+    """The agent's part of a step message (``rsstp.Step``'s ``agent``: every body's)."""
+
+    action: Count | None = None  # absent at step 0
+    state_before: Count | None = None
+    internal_state: Count
     sensation: bool
-    feedback: _Closeness
-    model_version: _Count
+    feedback: Closeness
+    model_version: Count
     no_transition: bool
 
 
-class _BlockedBy(msgspec.Struct, gc=False, frozen=True):
+class BlockedBy(msgspec.Struct, gc=False, frozen=True):
+    """What blocked a move (``truth.blocked_by``: every body's)."""
+
     kind: BlockerKind
-    indices: Annotated[tuple[_Count, ...], msgspec.Meta(min_length=1, max_length=2)]
+    indices: Annotated[tuple[Count, ...], msgspec.Meta(min_length=1, max_length=2)]
 
 
-class _Point(msgspec.Struct, gc=False):
+class Point(msgspec.Struct, gc=False):
+    """A point ``{x, y}``."""
+
     x: float
     y: float
-
-
-class _Distances(msgspec.Struct, gc=False):
-    obstacles: list[float]
-
-
-class _Truth(msgspec.Struct, gc=False, kw_only=True):
-    angles_deg: list[_Angle]
-    joint_positions: list[_Point]
-    blocked: bool
-    blocked_by: _BlockedBy | None = None  # absent when the arm moved
-    distances: list[_Distances]
-
-
-class _Step(msgspec.Struct, gc=False):
-    step: _Count
-    agent: _Agent
-    truth: _Truth
-
-
-class _PoseTruth(msgspec.Struct, gc=False):
-    """The ground truth of a step without the numbers that follow from its angles (skipped by
-    the parser, not built)."""
-
-    angles_deg: list[_Angle]
-    blocked: bool
-    blocked_by: _BlockedBy | None = None
-
-
-class _PoseStep(msgspec.Struct, gc=False):
-    step: _Count
-    agent: _Agent
-    truth: _PoseTruth
-
-
-class _RoverTruth(msgspec.Struct, gc=False):
-    """A rover's ground truth after a step (``rsstp.RoverStep``)."""
-
-    cell: Annotated[list[_Count], msgspec.Meta(min_length=2, max_length=2)]
-    heading_deg: _Angle
-    position: _Point
-    blocked: bool
-    blocked_by: _BlockedBy | None = None
-
-
-class _RoverStep(msgspec.Struct, gc=False):
-    step: _Count
-    agent: _Agent
-    truth: _RoverTruth
 
 
 class _AgentStep(msgspec.Struct, gc=False):
     """A step message without its ground truth (skipped by the parser, not built)."""
 
-    step: _Count
-    agent: _Agent
+    step: Count
+    agent: Agent
 
-
-_DECODERS: dict[tuple[str, bool], tuple[msgspec.json.Decoder[Any], msgspec.json.Decoder[Any]]] = {
-    ("arm", True): (msgspec.json.Decoder(list[_PoseStep]), msgspec.json.Decoder(_Step)),
-    ("rover", True): (msgspec.json.Decoder(list[_RoverStep]), msgspec.json.Decoder(_RoverStep)),
-}
-for _body in ("arm", "rover"):
-    _DECODERS[_body, False] = (
-        msgspec.json.Decoder(list[_AgentStep]),
-        msgspec.json.Decoder(_AgentStep),
-    )
-_WHOLE_STEPS = msgspec.json.Decoder(list[_Step])
-"""Whole arm step messages, many in one call (the first message of each pose met)."""
 
 # BLOCKER_KINDS (rsstp_sim.interface) are the categories of the steps table's ``blocked_kind``
 # column, in that order in every recording (so tables of several recordings concatenate with
@@ -152,16 +104,6 @@ BLOCKED_COLUMNS: dict[str, tuple[str, ...]] = {
 (nullable ``Int64``, missing elsewhere)."""
 
 _KIND_DTYPE = pd.CategoricalDtype(list(BLOCKER_KINDS))
-
-_BODY_KINDS: dict[str, tuple[str, ...]] = {
-    "arm": ("fold", "obstacle", "links"),
-    "rover": ("room", "obstacle", "wall", "door"),
-}
-"""The blocker kinds of each body: its steps table has their index columns."""
-
-ROVER_COLUMNS = ("cell_x", "cell_y", "heading_deg")
-"""A rover's pose in the steps table: its cell and heading (degrees), the ground truth's
-``value_names``."""
 
 
 def blocker_label(kind: BlockerKind, indices: tuple[int, ...]) -> str:
@@ -182,28 +124,78 @@ def blocker_label(kind: BlockerKind, indices: tuple[int, ...]) -> str:
     return f"{kind} {indices[0]}"
 
 
+_AGENT_DECODERS = (msgspec.json.Decoder(list[_AgentStep]), msgspec.json.Decoder(_AgentStep))
+"""Many step messages of any body without their truth, and one."""
+
+BODY_READERS: dict[str, str] = {
+    "arm": "rsstp_replay.reader._arm:ARM",
+    "rover": "rsstp_replay.reader._rover:ROVER",
+}
+"""Body name -> ``module:attribute`` of its :class:`BodyReader` (one line a body)."""
+
+
+class TruthColumns(Protocol):
+    """A body's part of the steps table: the ground truth's pose columns, filled batch by
+    batch (the blocker fields, which every body's truth has, are :class:`StepColumns`')."""
+
+    batch: msgspec.json.Decoder[Any]
+    """Decodes many of the body's step messages (a JSON array) into structs."""
+    one: msgspec.json.Decoder[Any]
+    """Decodes one (to name the culprit of a batch that failed)."""
+
+    def add(self, truths: list[Any], rows: slice, parts: list[memoryview]) -> None:
+        """The truths of a batch (its ``parts``, their bytes) into ``rows``; :class:`BadStep`
+        (its ``index`` in the batch) for a bad one."""
+
+    def columns(self, part: slice, *, geometry: bool) -> dict[str, Any]:
+        """The columns of the rows ``part``: the pose's, and with ``geometry`` the numbers
+        that follow from it (positions, distances)."""
+
+
+class BodyReader(Protocol):
+    """How the reader reads one body's steps (:data:`BODY_READERS`)."""
+
+    kinds: tuple[BlockerKind, ...]
+    """The body's blocker kinds: its steps table has their index columns."""
+
+    def truth_columns(self, n_rows: int, scenario: Any, *, numbers: bool) -> TruthColumns:
+        """Empty columns for ``n_rows`` steps of ``scenario``; ``numbers``: read the numbers
+        that follow from a pose too (else :meth:`TruthColumns.columns` has no geometry)."""
+
+    def pose_columns(self, scenario: Any) -> tuple[str, ...]:
+        """The steps table's integer columns that say a pose."""
+
+    def place_columns(self, scenario: Any) -> tuple[str, str]:
+        """The steps table's columns that place the body in the plane (its tip, its
+        centre), present with the geometry."""
+
+    def shape_difference(self, record: Any, scenario: Any) -> str | None:
+        """How the scenario message's shape (what the columns are sized by) differs from
+        the attached scenario file's, as ``the message has ..., its scenario file ...``;
+        None when it does not."""
+
+
+def body_reader(name: str) -> BodyReader:
+    """The registered reader of body ``name`` (KeyError for none)."""
+    module, attribute = BODY_READERS[name].split(":")
+    reader: BodyReader = getattr(import_module(module), attribute)
+    return reader
+
+
 class StepColumns:
     """The columns of ``n_rows`` step messages, filled batch by batch with :meth:`add`.
 
-    With ``truth=False`` only the agent's fields are decoded (what a memory needs).
+    With ``truth`` (a body's :class:`TruthColumns`) the ground truth is decoded too; without,
+    only the agent's fields (what a memory needs).
     """
 
     def __init__(
-        self,
-        n_rows: int,
-        *,
-        n_joints: int,
-        n_obstacles: int,
-        truth: bool = True,
-        body: str = "arm",
-        numbers: bool = True,
+        self, n_rows: int, *, truth: TruthColumns | None = None, kinds: tuple[str, ...] = ()
     ) -> None:
-        self.body = body
-        self.numbers = numbers
         self.n_rows = n_rows
-        self.n_joints = n_joints
-        self.n_obstacles = n_obstacles
-        self.truth = truth
+        self.truth = truth is not None
+        self._pose = truth
+        self._kinds = kinds
         self.rows = 0
         self.step = np.empty(n_rows, np.int64)
         self.log_time = np.empty(n_rows, np.int64)
@@ -216,19 +208,10 @@ class StepColumns:
         self.no_transition = np.empty(n_rows, np.bool_)
         self.action_nulls: list[int] = []
         self.state_before_nulls: list[int] = []
-        if truth:
+        if truth is not None:
             self.blocked = np.empty(n_rows, np.bool_)
             self.blocker = np.full(n_rows, -1, np.int16)
-            self.blocker_labels: dict[_BlockedBy, int] = {}
-            # One row per column, so each DataFrame column is a contiguous array.
-            self.angles_deg = np.empty((n_joints, n_rows), np.int64)
-            self.rover_values = np.empty((3 if body == "rover" else 0, n_rows), np.int64)
-            # An arm's pose code -> its positions (n + 1, 2) and distances (n, m), as the
-            # first message at that pose holds them.
-            # x0, y0, x1, y1, ... then the distances tip by tip
-            self.pose_numbers: dict[int, list[float]] = {}
-            self._met = np.zeros(0, np.int64)
-            self._places = 360 ** np.arange(n_joints, dtype=np.int64)
+            self.blocker_labels: dict[BlockedBy, int] = {}
 
     # -- filling ----------------------------------------------------------------------------
 
@@ -237,7 +220,7 @@ class StepColumns:
         next rows."""
         if not parts:
             return
-        batch, one = _DECODERS[self.body, self.truth]
+        batch, one = _AGENT_DECODERS if self._pose is None else (self._pose.batch, self._pose.one)
         try:
             rows: list[Any] = batch.decode(json_array(parts))
         except (msgspec.DecodeError, RecursionError):
@@ -247,7 +230,7 @@ class StepColumns:
                 try:
                     one.decode(part)
                 except msgspec.DecodeError as exc:
-                    raise BadStep(_describe(exc), index=index) from None
+                    raise BadStep(describe(exc), index=index) from None
                 except RecursionError:
                     raise BadStep("nested too deeply", index=index) from None
             raise BadStep("the messages do not decode one by one", index=0)
@@ -268,96 +251,23 @@ class StepColumns:
         self.feedback[s] = [a.feedback for a in agents]
         self.model_version[s] = [a.model_version for a in agents]
         self.no_transition[s] = np.array([a.no_transition for a in agents], np.bool_)
-        if self.truth:
-            self._add_truth([x.truth for x in rows], r, parts)
+        if self._pose is not None:
+            truths = [x.truth for x in rows]
+            self._pose.add(truths, s, parts)
+            self._add_blockers(truths, r)
         self.rows = r + k
 
-    def _read_numbers(self, parts: list[memoryview], angles: npt.NDArray[np.int64]) -> None:
-        """The positions and distances of every pose of this batch not met before, from its
-        first message here (see the module docstring): those messages decoded whole, in one
-        call."""
-        codes = angles @ self._places
-        met = self._met  # the codes of the poses read so far, sorted
-        if len(met):
-            at = np.minimum(np.searchsorted(met, codes), len(met) - 1)
-            unmet = np.flatnonzero(met[at] != codes)
-            if not len(unmet):
-                return
-        else:
-            unmet = np.arange(len(codes))
-        fresh, first = np.unique(codes[unmet], return_index=True)
-        self._met = np.insert(met, np.searchsorted(met, fresh), fresh)
-        indices = unmet[first].tolist()
-        new = fresh.tolist()
-        try:
-            truths = [
-                step.truth for step in _WHOLE_STEPS.decode(json_array([parts[i] for i in indices]))
-            ]
-        except msgspec.DecodeError:
-            truths = []
-            for index in indices:  # which one, and why
-                try:
-                    truths.append(_DECODERS["arm", True][1].decode(parts[index]).truth)
-                except msgspec.DecodeError as exc:
-                    raise BadStep(_describe(exc), index=index) from None
-        n, m = self.n_joints, self.n_obstacles
-        known = self.pose_numbers
-        for code, index, truth in zip(new, indices, truths, strict=True):
-            if len(truth.joint_positions) != n + 1:
-                found = len(truth.joint_positions)
-                raise BadStep(
-                    f"truth.joint_positions: expected {n + 1} points, found {found}", index=index
-                )
-            rows = [tip.obstacles for tip in truth.distances]
-            if len(rows) != n:
-                raise BadStep(
-                    f"truth.distances: expected {n} entries (one per tip), found {len(rows)}",
-                    index=index,
-                )
-            if any(len(row) != m for row in rows):
-                raise BadStep(f"truth.distances: expected {m} obstacles per tip", index=index)
-            numbers = [v for p in truth.joint_positions for v in (p.x, p.y)]
-            for row in rows:
-                numbers += row
-            known[code] = numbers
-
-    def _add_rover_truth(self, truths: list[_RoverTruth], s: slice) -> None:
-        """A rover's cell and heading; its position must be its cell's centre."""
-        k = s.stop - s.start
-        cells = np.fromiter(chain.from_iterable(t.cell for t in truths), np.int64, 2 * k)
-        self.rover_values[:2, s] = cells.reshape(k, 2).T
-        self.rover_values[2, s] = [t.heading_deg for t in truths]
-        found = np.array([(t.position.x, t.position.y) for t in truths], np.float64)
-        wrong = np.flatnonzero((found != cells.reshape(k, 2) + 0.5).any(axis=1))
-        if wrong.size:
-            index = int(wrong[0])
-            raise BadStep(
-                f"truth.position {found[index].tolist()} is not the centre of its cell "
-                f"{cells.reshape(k, 2)[index].tolist()}",
-                index=index,
-            )
-
-    def _add_truth(self, truths: list[Any], r: int, parts: list[memoryview]) -> None:
+    def _add_blockers(self, truths: list[Any], r: int) -> None:
         k = len(truths)
-        n = self.n_joints
         s = slice(r, r + k)
-        if self.body == "rover":
-            self._add_rover_truth(truths, s)
-        else:
-            angles = [t.angles_deg for t in truths]
-            _check_lengths(angles, n, "truth.angles_deg", "angles")
-            flat = np.fromiter(chain.from_iterable(angles), np.int64, k * n)
-            self.angles_deg[:, s] = flat.reshape(k, n).T
-            if self.numbers:
-                self._read_numbers(parts, flat.reshape(k, n))
         self.blocked[s] = np.array([t.blocked for t in truths], np.bool_)
         labels = self.blocker_labels
         bys = [t.blocked_by for t in truths]
         with_blocker = k - bys.count(None)
         if not with_blocker:
             return
-        # The rows with a blocker are the blocked ones, unless one stands where the arm moved
-        # (check() then names it): then every row is looked at.
+        # The rows with a blocker are the blocked ones, unless one stands where the body
+        # moved (check() then names it): then every row is looked at.
         blocked = np.flatnonzero(self.blocked[s]).tolist()
         among = sum(bys[index] is not None for index in blocked)
         for index in blocked if among == with_blocker else range(k):
@@ -433,42 +343,12 @@ class StepColumns:
             "model_version": self.model_version[part],
             "no_transition": self.no_transition[part],
         }
-        if self.truth:
+        if self._pose is not None:
             columns["blocked"] = self.blocked[part]
             if blockers:
                 columns |= self._blocked_columns(part)
-            for j in range(self.n_joints):
-                columns[f"angle_deg_{j}"] = self.angles_deg[j, part]
-            for name, values in zip(ROVER_COLUMNS, self.rover_values, strict=False):
-                columns[name] = values[part]
-        if self.truth and geometry and self.body == "rover":
-            columns["x"] = self.rover_values[0, part] + 0.5
-            columns["y"] = self.rover_values[1, part] + 0.5
-        elif self.truth and geometry:
-            if not self.numbers:
-                raise ReplayError("the joint positions were not read (numbers=False)")
-            columns |= self._geometry_columns(part)
+            columns |= self._pose.columns(part, geometry=geometry)
         return pd.DataFrame(columns, index=pd.RangeIndex(start, stop, name="step"), copy=copy)
-
-    def _geometry_columns(self, part: slice) -> dict[str, npt.NDArray[np.float64]]:
-        """``joint{k}_x``, ``joint{k}_y`` and ``dist_{k}_{j}`` of the rows ``part``: each
-        distinct pose's numbers as the file holds them (found by its code,
-        ``sum_j angle_j * 360**j``), each column taken whole from those."""
-        index, codes = pd.factorize(self._places @ self.angles_deg[:, part])
-        n, m = self.n_joints, self.n_obstacles
-        known = self.pose_numbers
-        numbers = np.array([known[code] for code in np.asarray(codes).tolist()], np.float64)
-        numbers = numbers.reshape(len(codes), 2 * (n + 1) + n * m)
-        positions = numbers[:, : 2 * (n + 1)].reshape(len(codes), n + 1, 2)
-        distances = numbers[:, 2 * (n + 1) :].reshape(len(codes), n, m)
-        columns = {}
-        for k in range(n + 1):
-            columns[f"joint{k}_x"] = positions[:, k, 0].take(index)
-            columns[f"joint{k}_y"] = positions[:, k, 1].take(index)
-        for k in range(n):
-            for j in range(m):
-                columns[f"dist_{k}_{j}"] = distances[:, k, j].take(index)
-        return columns
 
     def _blocked_columns(self, part: slice) -> dict[str, Any]:
         """``blocked_kind`` and the index columns of :data:`BLOCKED_COLUMNS` of the rows
@@ -479,7 +359,7 @@ class StepColumns:
         kinds = np.full(n_codes + 1, -1, np.int8)
         values = {
             name: np.full(n_codes + 1, -1, np.int64)
-            for kind in _BODY_KINDS[self.body]
+            for kind in self._kinds
             for name in BLOCKED_COLUMNS[kind]
         }
         for by, code in self.blocker_labels.items():
@@ -524,7 +404,7 @@ def _nullable(values: list[int | None], first: int, nulls: list[int]) -> list[in
     return [-1 if v is None else v for v in values]
 
 
-def _check_lengths(items: list[Any], expected: int, field: str, what: str) -> None:
+def check_lengths(items: list[Any], expected: int, field: str, what: str) -> None:
     if set(map(len, items)) != {expected}:
         index, found = next((i, len(x)) for i, x in enumerate(items) if len(x) != expected)
         raise BadStep(f"{field}: expected {expected} {what}, found {found}", index=index)
@@ -533,7 +413,7 @@ def _check_lengths(items: list[Any], expected: int, field: str, what: str) -> No
 _AT = re.compile(r"(?P<message>.*) - at `\$(?P<at>.*)`")
 
 
-def _describe(exc: msgspec.DecodeError) -> str:
+def describe(exc: msgspec.DecodeError) -> str:
     """msgspec's message as ``field.path: problem``."""
     text = str(exc)
     located = _AT.fullmatch(text)

@@ -44,12 +44,11 @@ from rsstp_replay.errors import (
 from rsstp_replay.reader._chunks import Messages, gc_paused, message_times
 from rsstp_replay.reader._container import ChunkRef, open_container
 from rsstp_replay.reader._contract import CheckedFile, check_file
-from rsstp_replay.reader._decode import StepColumns
+from rsstp_replay.reader._decode import StepColumns, body_reader
 from rsstp_replay.reader._models import HEADS, ChainCheck, ModelHead, build_model
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
-from rsstp_sim.rover import RoverScenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
 from rsstp_sim.truth_cache import load_truth
@@ -492,18 +491,12 @@ class Recording:
             yield columns.frame(rows=slice(done, columns.n_rows))
 
     def _new_step_columns(self, *, truth: bool, numbers: bool = True) -> StepColumns:
-        scenario = self.scenario
-        if isinstance(scenario, RoverScenario):
-            return StepColumns(
-                self.n_steps + 1, n_joints=0, n_obstacles=0, truth=truth, body="rover"
-            )
-        return StepColumns(
-            self.n_steps + 1,
-            n_joints=scenario.n_joints,
-            n_obstacles=len(scenario.obstacles),
-            truth=truth,
-            numbers=numbers,
-        )
+        n_rows = self.n_steps + 1
+        if not truth:
+            return StepColumns(n_rows)
+        reader = body_reader(self.scenario.body)
+        pose = reader.truth_columns(n_rows, self.scenario, numbers=numbers)
+        return StepColumns(n_rows, truth=pose, kinds=reader.kinds)
 
     def _decoding(
         self, columns: StepColumns, events: list[Any] | None
@@ -545,10 +538,9 @@ class Recording:
             row = _row(columns, step)
             if row is not None:
                 return row
-        body = self.scenario.body
         with closing(self._chunks("/rsstp/step", step=step)) as chunks:
             for ref, data, parts, times in chunks:
-                columns = StepColumns(len(parts), n_joints=0, n_obstacles=0, truth=False, body=body)
+                columns = StepColumns(len(parts))
                 self._decode_steps(columns, ref, data, parts, times)
                 if len(self._agent_cache) >= _CACHED_CHUNKS:
                     self._agent_cache.pop(next(iter(self._agent_cache)))

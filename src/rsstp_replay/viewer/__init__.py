@@ -38,7 +38,7 @@ from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consisten
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.audits.truth import step_true_classes
 from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
-from rsstp_replay.reader._decode import ROVER_COLUMNS
+from rsstp_replay.reader import body_reader
 from rsstp_replay.viewer import _model as model_part
 from rsstp_replay.viewer import _plots as plots_part
 from rsstp_replay.viewer import _world as world_part
@@ -54,11 +54,11 @@ from rsstp_replay.viewer._serve import (
     has_display,
     rerun_command,
 )
+from rsstp_replay.viewer._world import body_view
 from rsstp_sim import graph
 from rsstp_sim.errors import OutputError, RsstpError
 from rsstp_sim.files import side_file, write_whole
 from rsstp_sim.memory import Memory
-from rsstp_sim.rover import RoverScenario
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth_cache import load_truth
@@ -97,11 +97,10 @@ WEB_PORT = 9090
 
 ENTITY_PATHS: tuple[str, ...] = (
     world_part.WORLD,
-    world_part.ARM,
     world_part.OBSTACLES,
     world_part.FEEDBACK_POINTS,
-    world_part.SENSOR,
     world_part.BLOCKED,
+    *(path for name in world_part.BODY_VIEWS for path in world_part.body_view(name).paths),
     model_part.STATES + "/{id}",
     model_part.CURRENT,
     model_part.LEGEND,
@@ -433,10 +432,8 @@ def _log(
     stream.send_recording_name(f"{scenario.name} ({getattr(recording, 'path', 'recording')})")
     # The small entities first: a viewer reads the file in order, so the model, its size and
     # the audit log show while the per-step series still load.
-    if isinstance(scenario, RoverScenario):
-        world_part.log_rover_static(stream, scenario)
-    else:
-        world_part.log_world_static(stream, scenario)
+    body = body_view(scenario.body)
+    body.log_static(stream, scenario)
     if loaded.roles is not None:
         frame = view_frame(scenario)
         model_part.log_legend(stream, reach=frame.half, center=frame.center)
@@ -466,14 +463,10 @@ def _log(
         sampled["internal_state"].to_numpy(np.int64),
         loaded.places,
     )
-    if isinstance(scenario, RoverScenario):
-        rows |= world_part.log_rover(stream, sampled)
-        series, thinned = plots_part.log_series(stream, window, n_joints=0, n_obstacles=0)
-    else:
-        rows |= world_part.log_world(stream, sampled, scenario, sensor=every == 1)
-        series, thinned = plots_part.log_series(
-            stream, window, n_joints=scenario.n_joints, n_obstacles=len(scenario.obstacles)
-        )
+    rows |= body.log_steps(stream, sampled, scenario, sensor=every == 1)
+    series, thinned = plots_part.log_series(
+        stream, window, distances=body.distance_series(scenario)
+    )
     rows |= series
     return LogSummary(
         first_step=first,
@@ -537,20 +530,15 @@ def render_graph(recording: ViewSource, step: int, path: Path, *, on_world: bool
 
 
 def _pose_columns(scenario: AnyScenario) -> tuple[str, ...]:
-    """The steps table's integer columns that say a pose: an arm's angles, a rover's cell and
-    heading."""
-    if isinstance(scenario, RoverScenario):
-        return ROVER_COLUMNS
-    return tuple(f"angle_deg_{j}" for j in range(scenario.n_joints))
+    """The steps table's integer columns that say a pose (an arm's angles, a rover's cell and
+    heading)."""
+    return body_reader(scenario.body).pose_columns(scenario)
 
 
 def _place_columns(scenario: AnyScenario) -> tuple[str, str]:
-    """The steps table's columns a state is placed by on the world: an arm's last tip, a
-    rover's position."""
-    if isinstance(scenario, RoverScenario):
-        return ("x", "y")
-    n = scenario.n_joints
-    return (f"joint{n}_x", f"joint{n}_y")
+    """The steps table's columns a state is placed by on the world (an arm's last tip, a
+    rover's position)."""
+    return body_reader(scenario.body).place_columns(scenario)
 
 
 def _step_range(recording: ViewSource, start: int | None, end: int | None) -> tuple[int, int]:

@@ -2,25 +2,13 @@
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
-import numpy as np
 import rerun.blueprint as rrb
 
 from rsstp_replay.viewer._chunks import TIMELINE
-from rsstp_sim.rover import RoverScenario
+from rsstp_replay.viewer._world import ViewFrame, body_view
 from rsstp_sim.scenario import AnyScenario
 
 __all__ = ["ViewFrame", "default_blueprint", "view_frame", "view_reach"]
-
-
-class ViewFrame(NamedTuple):
-    """The square both 2D views frame: its centre and half its side (world frame, length
-    units), and the length that sizes what is drawn on it (offsets, label room)."""
-
-    center: tuple[float, float]
-    half: float
-    scale: float
 
 
 def view_reach(scenario: AnyScenario) -> float:
@@ -29,16 +17,8 @@ def view_reach(scenario: AnyScenario) -> float:
 
 
 def view_frame(scenario: AnyScenario) -> ViewFrame:
-    """An arm's: centred on the base, its reach and every obstacle with a margin, sized by
-    its length; a rover's: its room with a margin, sized by half the room's longer side."""
-    if isinstance(scenario, RoverScenario):
-        width, height = scenario.room
-        side = max(width, height)
-        return ViewFrame((width / 2, height / 2), 0.55 * side, side / 2)
-    reach = 1.1 * scenario.total_length
-    for obstacle in scenario.obstacles:
-        reach = max(reach, 1.05 * (float(np.hypot(*obstacle.center)) + obstacle.radius))
-    return ViewFrame((0.0, 0.0), reach, scenario.total_length)
+    """The square both 2D views frame, as the scenario's body frames it."""
+    return body_view(scenario.body).frame(scenario)
 
 
 def default_blueprint(scenario: AnyScenario, *, first: int, last: int) -> rrb.Blueprint:

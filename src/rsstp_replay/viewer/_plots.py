@@ -42,7 +42,6 @@ __all__ = [
     "SERIES_MAX_ROWS",
     "LogLine",
     "audit_lines",
-    "distance_name",
     "log_lines",
     "log_model_size",
     "log_phases",
@@ -58,20 +57,15 @@ PHASE = "plots/strategy/phase"
 LOG = "log/audit"
 
 
-def distance_name(link: int, obstacle: int) -> str:
-    """The name of the series of the distance from link ``link``'s tip to ``obstacle``."""
-    return f"tip of link {link} to obstacle {obstacle}"
-
-
 def log_series(
     stream: rr.RecordingStream,
     steps: pd.DataFrame,
     *,
-    n_joints: int,
-    n_obstacles: int,
+    distances: list[tuple[str, str]],
 ) -> tuple[dict[str, int], list[str]]:
-    """Sensation, feedback and the sensor readings; returns rows per path, and the paths
-    thinned to their extremes.
+    """Sensation, feedback and the sensor readings (``distances``: the steps table's distance
+    columns, each with its series name); returns rows per path, and the paths thinned to
+    their extremes.
 
     A step's value holds until the next step, so every series is drawn as steps
     (``StepAfter``) and has a row only where its value changes (and at the first and last
@@ -87,15 +81,10 @@ def log_series(
         (SENSATION, ["sensation"], steps[["sensation"]].to_numpy(np.float64)),
         (FEEDBACK, ["feedback"], steps[["feedback"]].to_numpy(np.float64)),
     ]
-    if n_obstacles:
-        pairs = [(k, j) for k in range(n_joints) for j in range(n_obstacles)]
-        series.append(
-            (
-                DISTANCE,
-                [distance_name(k, j) for k, j in pairs],
-                steps[[f"dist_{k}_{j}" for k, j in pairs]].to_numpy(np.float64),
-            )
-        )
+    if distances:
+        columns = [column for column, _ in distances]
+        names = [name for _, name in distances]
+        series.append((DISTANCE, names, steps[columns].to_numpy(np.float64)))
     logged, thinned = {}, []
     for path, names, values in series:
         # A boolean drawn zoomed out: min and max per pixel, not their average (0.5 is no

@@ -24,10 +24,8 @@ from rsstp_format.records import (
     OperationRecord,
     ParamRecord,
     PointRecord,
-    RoverScenarioRecord,
-    RoverStepRecord,
-    ScenarioRecord,
-    StepRecord,
+    ScenarioMessage,
+    StepMessage,
     StrategyRecord,
     TransitionsRecord,
     encode_json,
@@ -65,7 +63,7 @@ def scenario_record(
     strategy_name: str,
     strategy_params: Mapping[str, Any],
     strategy_origin: StrategyOrigin,
-) -> ScenarioRecord | RoverScenarioRecord:
+) -> ScenarioMessage:
     """The scenario message of a run (``rsstp.Scenario``, a rover's ``rsstp.RoverScenario``).
 
     ``origin`` keeps only the base name of a scenario file (recordings must not depend on
@@ -101,9 +99,7 @@ def scenario_record(
         "seed": int(seed),
         "strategy": strategy,
     }
-    record: ScenarioRecord | RoverScenarioRecord = body_of(scenario).scenario_record(
-        scenario, common
-    )
+    record: ScenarioMessage = body_of(scenario).scenario_record(scenario, common)
     return record
 
 
@@ -117,7 +113,7 @@ def step_record(
     model_version: int,
     no_transition: bool,
     blocker: Blocker | None,
-) -> StepRecord | RoverStepRecord:
+) -> StepMessage:
     """The step message of step ``step`` ending in the world pose ``pose`` (``rsstp.Step``;
     a rover's ``rsstp.RoverStep``).
 
@@ -135,7 +131,7 @@ def step_record(
     )
     truth = pose.truth_record(blocker)
     step_type: Any = STEP_RECORDS[type(truth)]
-    record: StepRecord | RoverStepRecord = step_type(step=int(step), agent=agent, truth=truth)
+    record: StepMessage = step_type(step=int(step), agent=agent, truth=truth)
     return record
 
 
