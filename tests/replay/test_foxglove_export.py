@@ -26,6 +26,7 @@ from rerun.chunk import RrdReader
 
 from rsstp_cli.replay import main
 from rsstp_replay import open_recording
+from rsstp_replay.export import _foxglove_arm
 from rsstp_replay.export import foxglove as foxglove_scene
 from rsstp_replay.export.foxglove import ARM_TOPIC, LOG_TOPIC, STATIC_TOPIC, TRANSFORMS_TOPIC
 from rsstp_sim import __version__, palette
@@ -361,7 +362,7 @@ def test_ctrl_c_leaves_no_part_of_a_scene(
     """Interrupted half way: the file that was there stays as it was, no side file stays."""
     out = tmp_path / "run.scene.mcap"
     out.write_bytes(b"keep me")
-    links = foxglove_scene._Drawing.links
+    links = _foxglove_arm.ArmDrawing.links
     calls = 0
 
     def interrupted(self: Any, *args: Any) -> Any:
@@ -371,7 +372,7 @@ def test_ctrl_c_leaves_no_part_of_a_scene(
             raise KeyboardInterrupt
         return links(self, *args)
 
-    monkeypatch.setattr(foxglove_scene._Drawing, "links", interrupted)
+    monkeypatch.setattr(_foxglove_arm.ArmDrawing, "links", interrupted)
     with open_recording(recorded.path) as recording, pytest.raises(KeyboardInterrupt):
         foxglove_scene.export_foxglove(recording, out)
     assert out.read_bytes() == b"keep me"

@@ -7,8 +7,8 @@ from __future__ import annotations
 import pytest
 from foxglove.messages import Timestamp
 
+from rsstp_replay.export._foxglove_arm import ArmDrawing as _Drawing
 from rsstp_replay.export._foxglove_stamps import PoseMessages
-from rsstp_replay.export.foxglove import _Drawing
 from rsstp_sim import World, load_scenario
 from rsstp_sim.scenario import parse_scenario
 from scenarios import arm_toml

@@ -35,13 +35,19 @@ from foxglove.messages import (
     Vector3,
 )
 
-from rsstp_replay.export._foxglove_shapes import color, pose_rows, step_numbers, timestamp, turn
+from rsstp_replay.export._foxglove_shapes import (
+    WORLD_FRAME,
+    color,
+    pose_rows,
+    step_numbers,
+    timestamp,
+    turn,
+)
 from rsstp_sim import palette
 from rsstp_sim.rover import RoverScenario
 
-__all__ = ["RoverDrawing", "RoverPoses"]
+__all__ = ["ROVER_SCENE", "RoverDrawing", "RoverPoses"]
 
-WORLD_FRAME = "world"
 _WALL = (60, 60, 60)
 _DOOR = (150, 150, 150)
 
@@ -201,3 +207,18 @@ class RoverDrawing:
                 )
             ]
         )
+
+
+class _RoverScene:
+    """The rover's :class:`~rsstp_replay.export._foxglove_body.BodyScene`."""
+
+    needs_geometry = False  # (its cell and heading say everything)
+
+    def poses(self, steps: pd.DataFrame, scenario: RoverScenario, *, source: Path) -> RoverPoses:
+        return RoverPoses.from_steps(steps, scenario, source=source)
+
+    def drawing(self, scenario: RoverScenario, poses: RoverPoses) -> RoverDrawing:
+        return RoverDrawing(scenario, poses)
+
+
+ROVER_SCENE = _RoverScene()

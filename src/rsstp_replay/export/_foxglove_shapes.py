@@ -16,7 +16,10 @@ from rsstp_format.schemas import STEP_NS
 from rsstp_replay.errors import ReplayError
 from rsstp_sim import palette
 
-__all__ = ["BLOCK", "color", "pose_rows", "step_numbers", "timestamp", "turn"]
+__all__ = ["BLOCK", "WORLD_FRAME", "color", "pose_rows", "step_numbers", "timestamp", "turn"]
+
+WORLD_FRAME = "world"
+"""The frame every body's world is drawn in (the plane z = 0)."""
 
 BLOCK = 65_536
 """Poses turned into Python numbers at a time."""
