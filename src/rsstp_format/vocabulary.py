@@ -1,5 +1,6 @@
-"""The words of the recording contract that both packages speak: why a move was blocked, how
-feedback is read, how collisions are checked, and the model's operations.
+"""The words of the recording contract that both packages speak: why a move was blocked (and
+how a steps table and a label say it), how feedback is read, how collisions are checked, and
+the model's operations. A body with a blocker kind of its own adds one line to each table.
 
 Every other module takes them from here, the schemas included (they are generated from the
 records, which use these types).
@@ -12,8 +13,10 @@ from dataclasses import dataclass
 from typing import Literal, get_args
 
 __all__ = [
+    "BLOCKED_COLUMNS",
     "BLOCKER_ARITY",
     "BLOCKER_KINDS",
+    "BLOCKER_LABELS",
     "BlockerKind",
     "CollisionMode",
     "FeedbackMode",
@@ -42,14 +45,29 @@ BLOCKER_KINDS: tuple[BlockerKind, ...] = get_args(BlockerKind)
 """The blocker kinds in their order (the order of a steps table's ``blocked_kind``
 categories)."""
 
-BLOCKER_ARITY: dict[BlockerKind, int] = {
-    "fold": 1,
-    "obstacle": 2,
-    "links": 2,
-    "room": 1,
-    "wall": 1,
-    "door": 1,
+BLOCKED_COLUMNS: dict[BlockerKind, tuple[str, ...]] = {
+    "fold": ("blocked_joint",),
+    "obstacle": ("blocked_link", "blocked_obstacle"),
+    "links": ("blocked_link_i", "blocked_link_j"),
+    "room": ("blocked_edge",),
+    "wall": ("blocked_wall",),
+    "door": ("blocked_door",),
 }
+"""A steps table's index columns of each blocker kind, in the order of the step message's
+``truth.blocked_by.indices``: a column holds a value exactly at the steps blocked by its kind
+(nullable ``Int64``, missing elsewhere)."""
+
+BLOCKER_LABELS: dict[BlockerKind, str] = {
+    "fold": "fold joint {0}",
+    "obstacle": "obstacle {1} link {0}",
+    "links": "links {0} {1}",
+    "room": "room edge {0}",
+    "wall": "wall {0}",
+    "door": "door {0}",
+}
+"""A blocker as text (the viewer's label, ``str.format`` of its indices)."""
+
+BLOCKER_ARITY: dict[BlockerKind, int] = {kind: len(BLOCKED_COLUMNS[kind]) for kind in BLOCKER_KINDS}
 """How many indices a blocker of each kind has."""
 
 

@@ -27,22 +27,25 @@ from gymnasium import spaces
 from gymnasium.envs.registration import EnvSpec
 from numpy.typing import NDArray
 
-from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.bodies import body_of
 from rsstp_sim.errors import ActionError, EnvError
 from rsstp_sim.interface import Blocker
-from rsstp_sim.rover import RoverScenario
-from rsstp_sim.scenario import load_scenario
+from rsstp_sim.scenario import AnyScenario, load_scenario
 
-__all__ = ["ENV_ID", "MAX_EPISODE_STEPS", "ROVER_ENV_ID", "ArmEnv", "RoverEnv", "register_envs"]
+__all__ = ["ENV_ID", "MAX_EPISODE_STEPS", "ROVER_ENV_ID", "ArmEnv", "register_envs"]
 
 ENV_ID = "rsstp/Arm-v0"
 """The id under which :func:`register_envs` registers :class:`ArmEnv`."""
 
 _ENTRY_POINT = "rsstp_sim.env:ArmEnv"
 ROVER_ENV_ID = "rsstp/Rover-v0"
-"""The id under which :func:`register_envs` registers :class:`RoverEnv`."""
-_ROVER_ENTRY_POINT = "rsstp_sim.env:RoverEnv"
+"""The id under which :func:`register_envs` registers the rover's env
+(:class:`rsstp_sim.rover.env.RoverEnv`)."""
+_ENVS = {
+    ENV_ID: _ENTRY_POINT,
+    ROVER_ENV_ID: "rsstp_sim.rover.env:RoverEnv",
+}
+"""Env id -> its entry point: one line a body."""
 MAX_EPISODE_STEPS = 1000
 """The time limit ``gymnasium.make(ENV_ID)`` puts on an episode (steps)."""
 _REWARDS = ("none", "sensation")
@@ -143,7 +146,7 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
 
     def __init__(
         self,
-        scenario: Scenario | RoverScenario | str | Path = "three-joint",
+        scenario: AnyScenario | str | Path = "three-joint",
         *,
         render_mode: str | None = None,
         reward: str = "none",
@@ -160,9 +163,7 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
             raise EnvError(f"step_cost must be a number, got {step_cost!r}")
         self._reward = reward
         self._step_cost = float(step_cost)
-        loaded = (
-            scenario if isinstance(scenario, Scenario | RoverScenario) else load_scenario(scenario)
-        )
+        loaded = scenario if not isinstance(scenario, str | Path) else load_scenario(scenario)
         self.scenario = loaded
         self.render_mode = render_mode
         self._body = body_of(loaded)
@@ -261,32 +262,11 @@ class ArmEnv(gymnasium.Env[ArmObs, np.int64]):
         }
 
 
-class RoverEnv(ArmEnv):
-    """The rover (the second body, ``docs/scenarios.md``) as a Gymnasium environment: the same
-    spaces, rewards and episodes as :class:`ArmEnv`, its actions 0 forward, 1 back, 2 turn
-    left, 3 turn right, and its ``info`` the rover's ground truth: ``cell`` ``(x, y)``,
-    ``heading_deg``, ``position`` (the cell's centre, length units), with ``pose_code``,
-    ``blocked``, ``blocked_by``, ``sensation``, ``feedback`` and ``action`` as every body's.
-    ``gymnasium.make("rsstp/Rover-v0")`` builds it (default scenario ``rover-room``)."""
-
-    env_id = ROVER_ENV_ID
-
-    def __init__(
-        self,
-        scenario: Scenario | RoverScenario | str | Path = "rover-room",
-        *,
-        render_mode: str | None = None,
-        reward: str = "none",
-        step_cost: float = 0.0,
-    ) -> None:
-        super().__init__(scenario, render_mode=render_mode, reward=reward, step_cost=step_cost)
-
-
 def register_envs() -> None:
-    """Register :class:`ArmEnv` as ``rsstp/Arm-v0`` and :class:`RoverEnv` as
-    ``rsstp/Rover-v0`` with Gymnasium (idempotent), with a :data:`MAX_EPISODE_STEPS` time
+    """Register every body's env (:class:`ArmEnv` as ``rsstp/Arm-v0``, the rover's as
+    ``rsstp/Rover-v0``) with Gymnasium (idempotent), with a :data:`MAX_EPISODE_STEPS` time
     limit."""
-    for env_id, entry_point in ((ENV_ID, _ENTRY_POINT), (ROVER_ENV_ID, _ROVER_ENTRY_POINT)):
+    for env_id, entry_point in _ENVS.items():
         if env_id not in gymnasium.registry:
             gymnasium.register(
                 id=env_id, entry_point=entry_point, max_episode_steps=MAX_EPISODE_STEPS

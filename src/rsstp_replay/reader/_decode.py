@@ -25,7 +25,13 @@ import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_format.records import json_array
-from rsstp_format.vocabulary import BLOCKER_ARITY, BLOCKER_KINDS, BlockerKind
+from rsstp_format.vocabulary import (
+    BLOCKED_COLUMNS,
+    BLOCKER_ARITY,
+    BLOCKER_KINDS,
+    BLOCKER_LABELS,
+    BlockerKind,
+)
 from rsstp_replay.errors import BadStep
 
 __all__ = [
@@ -87,41 +93,21 @@ class _AgentStep(msgspec.Struct, gc=False):
     agent: Agent
 
 
-# BLOCKER_KINDS (rsstp_sim.interface) are the categories of the steps table's ``blocked_kind``
-# column, in that order in every recording (so tables of several recordings concatenate with
-# the categorical kept).
-
-BLOCKED_COLUMNS: dict[str, tuple[str, ...]] = {
-    "fold": ("blocked_joint",),
-    "obstacle": ("blocked_link", "blocked_obstacle"),
-    "links": ("blocked_link_i", "blocked_link_j"),
-    "room": ("blocked_edge",),
-    "wall": ("blocked_wall",),
-    "door": ("blocked_door",),
-}
-"""The steps table's index columns of each blocker kind, in the order of the step message's
-``truth.blocked_by.indices``: a column holds a value exactly at the steps blocked by its kind
-(nullable ``Int64``, missing elsewhere)."""
-
 _KIND_DTYPE = pd.CategoricalDtype(list(BLOCKER_KINDS))
+"""The categories of the steps table's ``blocked_kind`` column: every body's blocker kinds
+(:data:`~rsstp_format.vocabulary.BLOCKER_KINDS`), in that order in every recording, so tables
+of several recordings concatenate with the categorical kept."""
 
 
 def blocker_label(kind: BlockerKind, indices: tuple[int, ...]) -> str:
-    """A blocker as text (the viewer's label): ``fold joint 1``, ``obstacle 1 link 2``,
-    ``links 0 2``; a rover's ``room edge 3``, ``wall 0``, ``door 1``."""
+    """A blocker as text (the viewer's label, :data:`~rsstp_format.vocabulary.BLOCKER_LABELS`):
+    ``fold joint 1``, ``obstacle 1 link 2``, ``links 0 2``; a rover's ``room edge 3``,
+    ``wall 0``, ``door 1``."""
     arity = BLOCKER_ARITY[kind]
     if len(indices) != arity:
         found = list(indices)
         raise BadStep(f"truth.blocked_by: a {kind} blocker has {arity} indices, found {found}")
-    if kind == "fold":
-        return f"fold joint {indices[0]}"
-    if kind == "obstacle":
-        return f"obstacle {indices[1]} link {indices[0]}"
-    if kind == "links":
-        return f"links {indices[0]} {indices[1]}"
-    if kind == "room":
-        return f"room edge {indices[0]}"
-    return f"{kind} {indices[0]}"
+    return BLOCKER_LABELS[kind].format(*indices)
 
 
 _AGENT_DECODERS = (msgspec.json.Decoder(list[_AgentStep]), msgspec.json.Decoder(_AgentStep))
@@ -190,7 +176,11 @@ class StepColumns:
     """
 
     def __init__(
-        self, n_rows: int, *, truth: TruthColumns | None = None, kinds: tuple[str, ...] = ()
+        self,
+        n_rows: int,
+        *,
+        truth: TruthColumns | None = None,
+        kinds: tuple[BlockerKind, ...] = (),
     ) -> None:
         self.n_rows = n_rows
         self.truth = truth is not None
