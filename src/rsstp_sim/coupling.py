@@ -25,7 +25,7 @@ import numpy as np
 
 from rsstp_sim.bodies import make_world
 from rsstp_sim.errors import ActionError, StrategyError
-from rsstp_sim.interface import Blocker
+from rsstp_sim.interface import Blocker, World
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.strategies import AgentView, Strategy, StrategyBase
@@ -111,6 +111,10 @@ class Runner:
     model operations applied during a step (or at reset) as soon as the step
     ends. Both are how a recorder observes the run from outside.
 
+    ``world``: the world the agent acts in (by default the scenario's body's, made here). A
+    loop that moves the world itself (a Gymnasium env) passes its world, and tells the runner
+    of each move with :meth:`taken` instead of calling :meth:`step`.
+
     A strategy that calls :meth:`~rsstp_sim.strategies.AgentView.stop` ends the run:
     :attr:`stopped` is then its reason, :meth:`run` returns early and :meth:`step` refuses.
     """
@@ -123,13 +127,14 @@ class Runner:
         seed: int,
         on_event: Callable[[Event], None] | None = None,
         on_model_change: Callable[[int, Sequence[Operation]], None] | None = None,
+        world: World | None = None,
     ) -> None:
         if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
             raise StrategyError(f"seed must be an integer >= 0, got {seed!r}")
         self.scenario = scenario
         self.strategy = strategy
         self.seed = seed
-        self.world = make_world(scenario)
+        self.world: World = make_world(scenario) if world is None else world
         self._on_event = on_event
         self._on_model_change = on_model_change
         self.reset()
@@ -191,7 +196,6 @@ class Runner:
 
     def step(self) -> StepOutcome:
         """One coupled step (see the module docstring)."""
-        model = self.model
         if self.agent.stopped is not None:
             raise StrategyError(
                 f"strategy {self.strategy.name!r} ended the run at step {self._step} "
@@ -207,6 +211,14 @@ class Runner:
             raise StrategyError(
                 f"strategy {self.strategy.name!r} at step {self._step + 1}: {exc}"
             ) from None
+        return self.taken(action, blocker)
+
+    def taken(self, action: int, blocker: Blocker | None) -> StepOutcome:
+        """The rest of a step whose move the world has made (``blocker``: its answer): the
+        internal transition, the memory entry, the strategy's refinement. :meth:`step` calls
+        it after moving the world; a loop that moves the world itself calls it after each
+        move."""
+        model = self.model
         self._step += 1
         before = model.current
         successors = model.successors(before, action)

@@ -24,8 +24,7 @@ done), ``step`` returns ``terminated=True`` and ``info["stopped"]`` is its reaso
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import Any, ClassVar, SupportsFloat
+from typing import Any, SupportsFloat
 
 import gymnasium
 
@@ -33,44 +32,8 @@ from rsstp_sim.coupling import Runner, stop_text
 from rsstp_sim.env import ArmEnv
 from rsstp_sim.errors import EnvError, StrategyError
 from rsstp_sim.strategies import AgentView, Strategy
-from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["StrategyPolicy"]
-
-
-class _Proposed:
-    """``strategy`` with its ``choose_action`` asked ahead of the step: the runner gets the
-    action the strategy chose (and the environment took), asked once, as in a plain run.
-    Made by :func:`_proposing`, which gives the class the strategy's name."""
-
-    name: ClassVar[str] = "proposed"
-
-    def __init__(self, strategy: Strategy) -> None:
-        self.strategy = strategy
-        self.proposal: int | None = None
-
-    def params(self) -> Mapping[str, Any]:
-        return self.strategy.params()
-
-    def initial_model(self, actions: tuple[int, ...]) -> TransitionSystem:
-        return self.strategy.initial_model(actions)
-
-    def reset(self, agent: AgentView) -> None:
-        self.strategy.reset(agent)
-
-    def choose_action(self, agent: AgentView) -> int:
-        action, self.proposal = self.proposal, None
-        if action is None:  # pragma: no cover - StrategyPolicy.step proposes first
-            raise EnvError("no action was proposed for this step")
-        return action
-
-    def refine(self, agent: AgentView) -> None:
-        self.strategy.refine(agent)
-
-
-def _proposing(strategy: Strategy) -> _Proposed:
-    named: type[_Proposed] = type(_Proposed.__name__, (_Proposed,), {"name": strategy.name})
-    return named(strategy)
 
 
 class StrategyPolicy(gymnasium.Wrapper[Any, Any, Any, Any]):
@@ -105,7 +68,6 @@ class StrategyPolicy(gymnasium.Wrapper[Any, Any, Any, Any]):
             raise EnvError(f"StrategyPolicy needs a strategy, got {type(strategy).__name__}")
         self.strategy = strategy
         self._episodes = 0
-        self._proposed = _proposing(strategy)
         self._runner: Runner | None = None
         self._actions = env.unwrapped.scenario.actions
         self.action: int | None = None
@@ -122,7 +84,10 @@ class StrategyPolicy(gymnasium.Wrapper[Any, Any, Any, Any]):
         arm = self.env.unwrapped
         assert isinstance(arm, ArmEnv)  # checked in __init__
         self._runner = Runner(
-            arm.scenario, self._proposed, seed=self._episodes if seed is None else seed
+            arm.scenario,
+            self.strategy,
+            seed=self._episodes if seed is None else seed,
+            world=arm.world,
         )
         self._episodes += 1
         return observation, self._told(info)
@@ -140,16 +105,8 @@ class StrategyPolicy(gymnasium.Wrapper[Any, Any, Any, Any]):
                 f"step {runner.step_index + 1:,}: the strategy chose action index "
                 f"{proposed}, step() was given {action!r} (pass StrategyPolicy.action)"
             )
-        self._proposed.proposal = self._actions[proposed]
         observation, reward, terminated, truncated, info = self.env.step(action)
-        runner.step()
-        mirrored = runner.world.current.code
-        if mirrored != info["pose_code"]:
-            raise EnvError(
-                f"step {runner.step_index:,}: the strategy's body is at pose {mirrored}, the "
-                f"environment's at pose {info['pose_code']}: was the environment moved "
-                f"outside step()?"
-            )
+        runner.taken(int(info["action"]), runner.world.last_blocker)
         info = self._told(info)
         return observation, reward, terminated or runner.stopped is not None, truncated, info
 

@@ -89,6 +89,10 @@ class World(Protocol):
     @property
     def current(self) -> Any: ...
     @property
+    def last_blocker(self) -> Any:
+        """What blocked the last move (None when it moved, and after a reset)."""
+
+    @property
     def sensation(self) -> bool: ...
     @property
     def feedback(self) -> float: ...

@@ -84,6 +84,25 @@ def test_the_recording_is_what_the_environment_did(tmp_path: Path) -> None:
     assert any(b for _, _, _, b in seen)  # blocked moves are part of the truth
 
 
+def test_the_recorder_reads_the_environments_own_world(tmp_path: Path) -> None:
+    """No second world beside the environment's: the recorder is handed each step, and a move
+    made behind the wrapper's back is in the next step's truth (the physics check would name
+    it), not silently mirrored."""
+    env = RecordMcap(gymnasium.make(ENV_ID, scenario="three-joint"), tmp_path)
+    env.reset(seed=1)
+    recorder = env._recorder
+    assert recorder is not None and recorder.runner.world is env.unwrapped.world
+    env.step(0)
+    env.unwrapped.world.move(2)  # behind the wrapper's back
+    env.step(0)
+    env.close()
+    with open_recording(env.recordings[0]) as recording:
+        angles = recording.steps()[["angle_deg_0", "angle_deg_1"]].to_numpy()
+    start = np.array(load_scenario("three-joint").initial_deg[:2])
+    step_deg = load_scenario("three-joint").step_deg
+    assert angles[2].tolist() == ((start + [2 * step_deg, step_deg]) % 360).tolist()
+
+
 def test_the_same_episode_gives_the_same_bytes(tmp_path: Path) -> None:
     runs = []
     for name in ("one", "two"):

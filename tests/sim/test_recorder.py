@@ -44,6 +44,7 @@ from rsstp_sim import (
     make_strategy,
 )
 from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.bodies import make_world
 from rsstp_sim.recording import builders
 from rsstp_sim.recording import recorder as recorder_module
 from rsstp_sim.recording.recorder import Recorder, record
@@ -349,6 +350,32 @@ def test_same_scenario_strategy_and_seed_give_the_same_bytes(
     record(first, scenario, make_strategy(strategy), steps=500, seed=7)
     record(second, load_scenario(name), make_strategy(strategy), steps=500, seed=7)
     assert first.read_bytes() == second.read_bytes()
+
+
+@pytest.mark.parametrize(
+    ("name", "strategy"),
+    [("two-joint-30", "learner"), ("thesis-algo", "random"), ("rover-one-way", "random")],
+)
+def test_a_loop_that_moves_its_own_world_records_the_same_bytes(
+    tmp_path: Path, name: str, strategy: str
+) -> None:
+    """The recorder as a sink: a user's loop moves its own world and hands each step over
+    (``world=``, :meth:`Recorder.taken`); the file is the one ``record`` writes, byte for
+    byte, whatever the body, with the model's changes (the learner) and blocked moves."""
+    scenario = load_scenario(name)
+    ran, handed = tmp_path / "ran.mcap", tmp_path / "handed.mcap"
+    record(ran, scenario, make_strategy(strategy), steps=1_500, seed=3)
+    world = make_world(scenario)
+    chooser = make_strategy(strategy)
+    recorder = Recorder(handed, scenario, chooser, seed=3, world=world)
+    agent = recorder.runner.agent
+    while recorder.runner.step_index < 1_500 and agent.stopped is None:
+        action = chooser.choose_action(agent)
+        blocker = world.move(action)  # the loop's own move
+        recorder.taken(action, blocker)
+    recorder.close()
+    assert recorder.runner.world is world
+    assert handed.read_bytes() == ran.read_bytes()
 
 
 def test_a_different_seed_gives_different_steps(tmp_path: Path, three_joint: Scenario) -> None:

@@ -12,9 +12,11 @@ recording has the model channel as a strategy's run does: the internal state fol
 model's transitions at each step, and an operation made between two steps is recorded at
 the later one.
 
-The recording mirrors the environment's moves in a world of its own (the world is
-deterministic, so both agree; the wrapper checks the pose at every step), which keeps the
-writer, the crash safety and the bytes those of :class:`~rsstp_sim.recording.Recorder`.
+The recording is written by :class:`~rsstp_sim.recording.Recorder` as a sink: it reads the
+environment's own world, and the wrapper hands it each step the environment took
+(:meth:`Recorder.taken <rsstp_sim.recording.Recorder.taken>`), so the writer, the crash
+safety and the bytes are those of ``rsstp-sim record``, with no second world beside the
+environment's.
 
 >>> import gymnasium, tempfile
 >>> folder = tempfile.mkdtemp()
@@ -47,13 +49,13 @@ ModelFactory = Callable[[tuple[int, ...]], TransitionSystem]
 
 
 class GymnasiumAgent(StrategyBase):
-    """The strategy of a recorded Gymnasium run: its actions are the environment's, given
-    from outside (:class:`RecordMcap` sets :attr:`action` before each step)."""
+    """The strategy of a recorded Gymnasium run: its actions are the environment's, handed to
+    the recorder as steps already taken (:meth:`Recorder.taken
+    <rsstp_sim.recording.Recorder.taken>`), never chosen here."""
 
     name: ClassVar[str] = "gymnasium"
 
     def __init__(self, model: ModelFactory | None = None) -> None:
-        self.action: int | None = None
         self._model = model
 
     def initial_model(self, actions: tuple[int, ...]) -> TransitionSystem:
@@ -62,10 +64,10 @@ class GymnasiumAgent(StrategyBase):
         return self._model(actions)
 
     def choose_action(self, agent: AgentView) -> int:
-        if self.action is None:
-            raise EnvError("no action was given for this step")
-        action, self.action = self.action, None
-        return action
+        raise EnvError(
+            "a Gymnasium run's actions are the environment's: step the environment, which "
+            "hands each step to the recorder"
+        )
 
 
 class RecordMcap(gymnasium.Wrapper[Any, Any, Any, Any]):
@@ -106,7 +108,6 @@ class RecordMcap(gymnasium.Wrapper[Any, Any, Any, Any]):
         self._force = force
         self._chunk_size = chunk_size
         self._recorder: Recorder | None = None
-        self._agent: GymnasiumAgent | None = None
         self.recordings: list[Path] = []
         """The recordings written so far, the current one last."""
 
@@ -124,33 +125,26 @@ class RecordMcap(gymnasium.Wrapper[Any, Any, Any, Any]):
         observation, info = self.env.reset(seed=seed, options=options)
         episode = len(self.recordings)
         path = self.folder / f"{self.name_prefix}-{episode:04d}.mcap"
-        self._agent = GymnasiumAgent(self._model_factory)
+        body = self._arm()
         self._recorder = Recorder(
             path,
-            self._arm().scenario,
-            self._agent,
+            body.scenario,
+            GymnasiumAgent(self._model_factory),
             seed=episode if seed is None else seed,
             chunk_size=self._chunk_size,
             force=self._force,
             model=self._model_factory is not None,
+            world=body.world,
         )
         self.recordings.append(path)
         return observation, info
 
     def step(self, action: Any) -> tuple[Any, SupportsFloat, bool, bool, dict[str, Any]]:
-        recorder, agent = self._recorder, self._agent
-        if recorder is None or agent is None:
+        recorder = self._recorder
+        if recorder is None:
             raise EnvError("RecordMcap: call reset() before step()")
         observation, reward, terminated, truncated, info = self.env.step(action)
-        agent.action = int(info["action"])  # the action id the arm executed
-        outcome = recorder.step()
-        mirrored = recorder.runner.world.current.code
-        if mirrored != info["pose_code"]:
-            raise EnvError(
-                f"step {outcome.step}: the recording's body is at pose {mirrored}, the "
-                f"environment's at pose {info['pose_code']}: was the environment moved "
-                f"outside step()?"
-            )
+        recorder.taken(int(info["action"]), self._arm().world.last_blocker)
         stopped = info.get("stopped")
         if terminated and isinstance(stopped, str):  # a strategy ended the episode
             recorder.runner.agent.stop(stopped)

@@ -61,6 +61,7 @@ from rsstp_sim.errors import (
     RsstpError,
 )
 from rsstp_sim.files import side_file
+from rsstp_sim.interface import Blocker, World
 from rsstp_sim.recording import builders
 from rsstp_sim.recording.chunk_process import ChunkProcess
 from rsstp_sim.recording.chunks import ChunkedWriter, Message
@@ -151,6 +152,10 @@ class RecordResult:
 class Recorder:
     """Runs a strategy in a scenario and records every step to an MCAP file.
 
+    The steps come from its runner (:meth:`run`, :meth:`step`), or from a loop that moves the
+    world itself (``world=``, the loop's world, and :meth:`taken` after each move): the file
+    is the same either way.
+
     ``versions`` overrides the library versions written in the metadata (used
     to reproduce a reference recording byte for byte on newer libraries).
     """
@@ -166,6 +171,7 @@ class Recorder:
         force: bool = False,
         versions: Mapping[str, str] | None = None,
         model: bool = True,
+        world: World | None = None,
     ) -> None:
         if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1024:
             raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
@@ -183,6 +189,7 @@ class Recorder:
             seed=seed,
             on_event=self._on_event,
             on_model_change=self._on_model_change,
+            world=world,
         )
         self._versions = dict(environment_versions())
         if versions is not None:
@@ -485,6 +492,17 @@ class Recorder:
         """Take and record one step; the file stays open until :meth:`close`."""
         with self._closed_on_failure():
             outcome = self.runner.step()
+            self._write((outcome,))
+        self._counts["/rsstp/step"] += 1
+        return outcome
+
+    def taken(self, action: int, blocker: Blocker | None) -> StepOutcome:
+        """Record a step whose move the world (the one given as ``world=``) has made, with
+        ``blocker`` its answer: the agent's part of it (:meth:`Runner.taken
+        <rsstp_sim.coupling.Runner.taken>`) and its messages. A loop that moves the world
+        itself (a Gymnasium env, a user's own) hands each step over this way."""
+        with self._closed_on_failure():
+            outcome = self.runner.taken(action, blocker)
             self._write((outcome,))
         self._counts["/rsstp/step"] += 1
         return outcome
