@@ -46,8 +46,8 @@ import orjson
 
 from rsstp_format.records import StepRecord, decode, encode
 from rsstp_sim.arm.world import Pose
-from rsstp_sim.coupling import Runner, StepOutcome
 from rsstp_sim.recording.builders import step_record
+from rsstp_sim.runner import Runner, StepOutcome
 from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import RandomStrategy
 

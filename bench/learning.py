@@ -71,7 +71,7 @@ import numpy as np
 from _cold import measure_cpu
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.arm.world import World
-from rsstp_sim.coupling import Runner
+from rsstp_sim.runner import Runner
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth

@@ -35,7 +35,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from rsstp_sim.coupling import Runner
+from rsstp_sim.runner import Runner
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.truth import check_equivalence, compute_truth

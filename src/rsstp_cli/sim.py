@@ -26,10 +26,10 @@ from rsstp_cli._commandline import (
 )
 from rsstp_sim import graph
 from rsstp_sim.bodies import body_of
-from rsstp_sim.coupling import Runner, stop_text
 from rsstp_sim.errors import RecordingWriteError
 from rsstp_sim.files import check_output
 from rsstp_sim.nesting import too_deep
+from rsstp_sim.runner import Runner, stop_text
 from rsstp_sim.scenario import AnyScenario, builtin_scenarios, load_scenario
 from rsstp_sim.strategies import builtin_strategies, make_strategy
 from rsstp_sim.transition_system import TransitionSystem

@@ -8,7 +8,6 @@ them one step at a time with one seeded generator per run.
 
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.arm.world import Blocker, Pose, World
-from rsstp_sim.coupling import Event, Runner, RunSummary, StepOutcome
 from rsstp_sim.env import ArmEnv, register_envs
 from rsstp_sim.errors import (
     ActionError,
@@ -22,6 +21,7 @@ from rsstp_sim.errors import (
 )
 from rsstp_sim.memory import CompareKind, CompareResult, Memory, MemoryEntry
 from rsstp_sim.rover.env import RoverEnv
+from rsstp_sim.runner import Event, Runner, RunSummary, StepOutcome
 from rsstp_sim.scenario import Obstacle, builtin_scenarios, load_scenario, parse_scenario
 from rsstp_sim.strategies import (
     AgentView,

@@ -28,9 +28,9 @@ from typing import Any, SupportsFloat
 
 import gymnasium
 
-from rsstp_sim.coupling import Runner, stop_text
 from rsstp_sim.env import ArmEnv
 from rsstp_sim.errors import EnvError, StrategyError
+from rsstp_sim.runner import Runner, stop_text
 from rsstp_sim.strategies import AgentView, Strategy
 
 __all__ = ["StrategyPolicy"]

@@ -83,7 +83,7 @@ class Memory:
     - :attr:`actions` (int32): the action that led to the entry, ``0 .. 2n-1`` for an arm of
       ``n`` links; :data:`NO_ACTION` (-1) at entry 0.
     - :attr:`internal_states` (int64): the internal state id at the end of the step (after the
-      strategy's refinement, see :mod:`rsstp_sim.coupling`).
+      strategy's refinement, see :mod:`rsstp_sim.runner`).
     - :attr:`sensations` (bool): the boolean sensation after the step.
     - :attr:`feedback` (float64): the float feedback (closeness in ``[0, 1]``) after the step.
 
@@ -145,7 +145,7 @@ class Memory:
 
     def relocate_last(self, internal_state: int) -> None:
         """Set the internal state of the last entry: the agent re-localised in the step's
-        refinement, so the step ended in ``internal_state`` (see :mod:`rsstp_sim.coupling`)."""
+        refinement, so the step ended in ``internal_state`` (see :mod:`rsstp_sim.runner`)."""
         if self._length == 0:
             raise MemoryRangeError("relocate_last on an empty memory: there is no entry yet")
         self._states[self._length - 1] = internal_state

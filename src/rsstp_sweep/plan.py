@@ -31,9 +31,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import RsstpError
 from rsstp_sim.nesting import too_deep
+from rsstp_sim.runner import Runner
 from rsstp_sim.scenario import AnyScenario, load_scenario
 from rsstp_sim.strategies import make_strategy
 from rsstp_sweep.errors import SweepError

@@ -20,9 +20,9 @@ import pandas as pd
 from rsstp_format import records
 from rsstp_format.schemas import STEP_NS
 from rsstp_sim import Runner, Scenario, Strategy
-from rsstp_sim.coupling import Event
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording import builders
+from rsstp_sim.runner import Event
 from rsstp_sim.strategies import AgentView, StrategyBase
 from rsstp_sim.transition_system import Operation, TransitionSystem
 

@@ -23,8 +23,8 @@ from rsstp_format.records import ModelRecord
 from rsstp_replay import open_recording
 from rsstp_replay.audits.contract import check_contract
 from rsstp_sim import AgentView, load_scenario, make_strategy
-from rsstp_sim.coupling import Runner
 from rsstp_sim.recording import record
+from rsstp_sim.runner import Runner
 from rsstp_sim.strategies import Strategy
 from waiting import HANG_S
 

@@ -15,9 +15,9 @@ from conftest import THIN_OBSTACLE_TOML
 from rsstp_sim.arm import geometry
 from rsstp_sim.arm.geometry import ArmGeometry, Blocker
 from rsstp_sim.arm.world import World
-from rsstp_sim.coupling import Event, Runner
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.memory import Memory, MemoryEntry
+from rsstp_sim.runner import Event, Runner
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies import RandomStrategy, ScriptStrategy
 from rsstp_sim.transition_system import TransitionSystem

@@ -13,9 +13,9 @@ from hypothesis import strategies as st
 
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.arm.world import World
-from rsstp_sim.coupling import Runner
 from rsstp_sim.errors import StrategyError
 from rsstp_sim.memory import Memory
+from rsstp_sim.runner import Runner
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies import AgentView
 from rsstp_sim.strategies._learner_hypothesis import Hypothesis

@@ -32,9 +32,9 @@ from steps import step_record_after
 import rsstp_sim
 from rsstp_format import records, schemas
 from rsstp_sim.arm.scenario import Scenario
-from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.recording import builders
 from rsstp_sim.rover import RoverScenario
+from rsstp_sim.runner import Event, Runner, StepOutcome
 from rsstp_sim.scenario import builtin_scenarios, load_scenario
 from rsstp_sim.strategies import RandomStrategy, strategy_origin
 from rsstp_sim.transition_system import TransitionSystem

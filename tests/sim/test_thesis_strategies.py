@@ -17,9 +17,9 @@ from hypothesis import strategies as st
 from splitter_reference import ReferenceSplitter
 
 from rsstp_replay.audits import audit_consistency, find_contradictions
-from rsstp_sim.coupling import Event, Runner
 from rsstp_sim.errors import StrategyError
 from rsstp_sim.memory import CompareKind, Memory
+from rsstp_sim.runner import Event, Runner
 from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import AgentView, Strategy
 from rsstp_sim.strategies import roulette as roulette_module

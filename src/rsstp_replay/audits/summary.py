@@ -35,8 +35,8 @@ from rsstp_format.records import ModelRecord
 from rsstp_replay.audits.compare import HasMemory
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
 from rsstp_replay.audits.determinism import HasModelVersions
-from rsstp_sim.coupling import stop_text
 from rsstp_sim.errors import ModelError
+from rsstp_sim.runner import stop_text
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.words import counted
 

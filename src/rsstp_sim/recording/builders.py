@@ -31,13 +31,13 @@ from rsstp_format.records import (
     encode_json,
 )
 from rsstp_sim.bodies import body_of
-from rsstp_sim.coupling import stop_text
 from rsstp_sim.errors import RecordFormatError
+from rsstp_sim.runner import stop_text
 from rsstp_sim.transition_system import Operation
 
 if TYPE_CHECKING:
-    from rsstp_sim.coupling import Event
     from rsstp_sim.interface import Blocker, Pose
+    from rsstp_sim.runner import Event
     from rsstp_sim.scenario import AnyScenario
     from rsstp_sim.strategies import StrategyOrigin
     from rsstp_sim.transition_system import TransitionSystem
@@ -206,7 +206,7 @@ def stop_event(step: int, *, reason: str, budget: int | None) -> EventRecord:
 def event_record(
     event: Event, *, state: int | None = None, action: int | None = None
 ) -> EventRecord:
-    """The record of a :class:`~rsstp_sim.coupling.Event` from the runner's ``on_event``.
+    """The record of a :class:`~rsstp_sim.runner.Event` from the runner's ``on_event``.
 
     A ``no_transition`` event needs the ``state`` that stayed and the ``action`` (the
     runner's event only says them in its text); a ``note`` needs nothing more.

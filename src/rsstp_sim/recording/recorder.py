@@ -1,6 +1,6 @@
 """The recorder: writes a run to MCAP as it happens (docs/contract.md, schemas/README.md).
 
-A layer around :class:`~rsstp_sim.coupling.Runner`, the way a monitor wraps an
+A layer around :class:`~rsstp_sim.runner.Runner`, the way a monitor wraps an
 environment: the world and the model do not know a file exists. The recorder
 observes each step's outcome, the model operations and the events through the
 runner's callbacks and writes:
@@ -53,7 +53,6 @@ from rsstp_format.schemas import (
     metadata_checksum,
     schema_bytes,
 )
-from rsstp_sim.coupling import Event, Runner, StepOutcome
 from rsstp_sim.errors import (
     ChunkProcessFailed,
     RecordingError,
@@ -67,6 +66,7 @@ from rsstp_sim.recording.chunk_process import ChunkProcess
 from rsstp_sim.recording.chunks import ChunkedWriter, Message
 from rsstp_sim.recording.output import SideFileWriter, open_side_file
 from rsstp_sim.recording.step_messages import Block, BlockMessages, StepMessages
+from rsstp_sim.runner import Event, Runner, StepOutcome
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.strategies import Strategy, strategy_origin
 from rsstp_sim.transition_system import Operation
@@ -368,7 +368,7 @@ class Recorder:
         first step, ``False`` never; by default for a run of more than :data:`HELPER_STEPS`
         steps, from then on, when its steps were light (see :meth:`_write_run`).
         Stops early (file finished, ``interrupted=True``) after :meth:`request_stop`. When
-        the strategy ends the run (:attr:`Runner.stopped <rsstp_sim.coupling.Runner.stopped>`),
+        the strategy ends the run (:attr:`Runner.stopped <rsstp_sim.runner.Runner.stopped>`),
         the file ends with an event saying so, at that step, of a budget of ``steps``.
         """
         _check_steps(steps)
@@ -499,7 +499,7 @@ class Recorder:
     def taken(self, action: int, blocker: Blocker | None) -> StepOutcome:
         """Record a step whose move the world (the one given as ``world=``) has made, with
         ``blocker`` its answer: the agent's part of it (:meth:`Runner.taken
-        <rsstp_sim.coupling.Runner.taken>`) and its messages. A loop that moves the world
+        <rsstp_sim.runner.Runner.taken>`) and its messages. A loop that moves the world
         itself (a Gymnasium env, a user's own) hands each step over this way."""
         with self._closed_on_failure():
             outcome = self.runner.taken(action, blocker)

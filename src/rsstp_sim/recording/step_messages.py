@@ -36,8 +36,8 @@ from rsstp_sim.recording import builders
 from rsstp_sim.recording.chunks import Message
 
 if TYPE_CHECKING:
-    from rsstp_sim.coupling import StepOutcome
     from rsstp_sim.interface import Blocker, Pose, World
+    from rsstp_sim.runner import StepOutcome
     from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["POSE_CACHE_BYTES", "Block", "BlockMessages", "StepMessages", "Steps"]
