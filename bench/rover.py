@@ -28,6 +28,9 @@ the learner says the run started in (:attr:`LearnerStrategy.start_state
 is from some state of the model (``right model, start unknown``: walls can bring two starts
 to one pose before the sensation is first seen, and then no trajectory tells them apart).
 
+``--diagnose``: after each run, what the learner's hypothesis got wrong against the truth
+(:func:`diagnose`): duplicate states, and confirmed transitions that lead to the wrong class.
+
 Targets (issue 31): thousands of classes per built-in; the learner learns every rover world
 exactly within 4 N^2 steps (missed, 2026-11-28: docs/strategies.md).
 """
@@ -48,7 +51,7 @@ import numpy as np
 from rsstp_sim.coupling import Runner
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies.learner import LearnerStrategy
-from rsstp_sim.truth import check_equivalence, compute_truth
+from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
 
 BUILT_INS = ("rover-room", "rover-two-rooms", "rover-one-way")
 RSSTP_SIM = str(Path(sys.executable).with_name("rsstp-sim"))
@@ -91,6 +94,40 @@ def generated_room(seed: int) -> str:
             return text
 
 
+def diagnose(learner: LearnerStrategy, truth: GroundTruth) -> str:
+    """What the learner's hypothesis got wrong, against the truth: each state stands for the
+    class its access word (from the sensed pose) reaches; the classes it stands for twice or
+    more (duplicates, waiting for the merge at the end), and the confirmed transitions that
+    lead to a state standing for another class than the truth's (wrong, waiting for a
+    counterexample or the final verification). Reads the learner's internals: a bench tool."""
+    learning = learner._learning  # noqa: SLF001 - a diagnosis, not an API
+    if learning is None or not learning.found:
+        return "diagnosis: the sensed pose never seen"
+    h = learning.h
+    column = {a: k for k, a in enumerate(truth.actions)}
+    (sensed,) = np.flatnonzero(truth.class_sensation).tolist()
+    stands_for: dict[int, int] = {}
+    for s, word in h.access.items():
+        c = sensed
+        for a in word:
+            c = int(truth.class_next[c, column[a]])
+        stands_for[s] = c
+    states = list(stands_for)
+    wrong = confirmed = 0
+    for s in states:
+        for a in truth.actions:
+            t = int(h.next[s, h.column[a]])
+            if t >= 0:
+                confirmed += 1
+                wrong += stands_for.get(t) != int(truth.class_next[stands_for[s], column[a]])
+    classes = len(set(stands_for.values()))
+    return (
+        f"  diagnosis: {len(states):,} states for {classes:,} of {truth.n_classes:,} classes "
+        f"({len(states) - classes:,} duplicates); {confirmed:,} confirmed transitions, "
+        f"{wrong:,} wrong"
+    )
+
+
 def cold(*args: str) -> tuple[str, float]:
     started = time.perf_counter()
     done = subprocess.run([RSSTP_SIM, *args], capture_output=True, text=True, check=True)
@@ -103,7 +140,14 @@ def cold_replay(*args: str) -> float:
     return time.perf_counter() - started
 
 
-def learn(text_or_name: str, budget: int | None, *, seed: int = 0, factor: float = 4.0) -> str:
+def learn(
+    text_or_name: str,
+    budget: int | None,
+    *,
+    seed: int = 0,
+    factor: float = 4.0,
+    diagnosis: bool = False,
+) -> str:
     scenario = (
         load_scenario(text_or_name) if "\n" not in text_or_name else parse_scenario(text_or_name)
     )
@@ -137,6 +181,7 @@ def learn(text_or_name: str, budget: int | None, *, seed: int = 0, factor: float
         f"{steps:,} steps ({steps / n**2:.2f} N^2) in {seconds:.1f} s, "
         f"{len(runner.model):,} model states, {verdict}"
         + (f" ({runner.stopped})" if runner.stopped else "")
+        + (f"\n{diagnose(learner, truth)}" if diagnosis else "")
     )
 
 
@@ -151,6 +196,9 @@ def main() -> None:
     parser.add_argument("--factor", type=float, default=4.0, help="the rooms' budget, x N^2")
     parser.add_argument("--no-cold", action="store_true", help="skip the cold subprocess runs")
     parser.add_argument("--no-built-ins", action="store_true", help="the learner on rooms only")
+    parser.add_argument(
+        "--diagnose", action="store_true", help="duplicates and wrong transitions at the end"
+    )
     args = parser.parse_args()
     print(f"load average {os.getloadavg()[0]:.2f}")
     for name in () if args.no_cold else BUILT_INS:
@@ -180,9 +228,9 @@ def main() -> None:
     rooms += [generated_room(i) for i in range(args.generated)]
     for seed in range(args.seeds):
         for room in rooms:
-            print(learn(room, None, seed=seed, factor=args.factor), flush=True)
+            print(learn(room, None, seed=seed, factor=args.factor, diagnosis=args.diagnose))
         for name in () if args.no_built_ins else BUILT_INS:
-            print(learn(name, args.budget, seed=seed), flush=True)
+            print(learn(name, args.budget, seed=seed, diagnosis=args.diagnose), flush=True)
 
 
 if __name__ == "__main__":
