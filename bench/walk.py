@@ -9,10 +9,12 @@ A one-run sweep (the scenario, a strategy, 300 steps) is planned from its sweep 
 (:func:`rsstp_sweep.execute.execute_run`: record, then audit with the truth), in this process,
 under :func:`sys.setprofile`. Every call of a function of this project's packages (``src/``)
 that is handed a scenario object (an argument that is a scenario of any body, the one the
-sweep plans with, the worker's and the reader's) is a *visit* of that function's file. A
-*stop* is a run of consecutive visits to one file; a *return* is a stop at a file the walk
-has stopped at before (it left the file and came back). Target (issue 31): the walk goes down
-through the floors (format, simulator, replay, sweep) without coming back.
+sweep plans with, the worker's and the reader's; not the scenario's own properties) is a
+*visit* of that function's file. A *stop* is a run of consecutive visits to one file; a
+*return* is a stop at a file the walk has stopped at before (it left the file and came back).
+The same is counted by floor (a package, or one of its subpackages: the sweep, the run, a
+body, the recorder, the ground truth, the replay side's reader). Target (issue 31): the walk
+goes down through the floors without coming back.
 """
 
 from __future__ import annotations
@@ -46,6 +48,8 @@ def walk(scenario: str, strategy: str, steps: int) -> list[tuple[str, str]]:
         n = code.co_argcount + code.co_kwonlyargcount
         values = frame.f_locals
         for name in code.co_varnames[:n]:
+            if name == "self":  # the scenario answering about itself (a property) is no stop
+                continue
             if isinstance(values.get(name), SCENARIO_TYPES):
                 where = Path(code.co_filename).relative_to(SRC).as_posix()
                 visits.append((where, code.co_qualname))
@@ -54,8 +58,8 @@ def walk(scenario: str, strategy: str, steps: int) -> list[tuple[str, str]]:
     with tempfile.TemporaryDirectory() as folder:
         sweep_file = Path(folder) / "sweep.toml"
         sweep_file.write_text(
-            f'scenarios = ["{scenario}"]\nstrategies = ["{strategy}"]\nseeds = [0]\n'
-            f"steps = {steps}\n",
+            f'scenarios = ["{scenario}"]\nseeds = 1\nsteps = {steps}\n\n'
+            f'[[strategy]]\nname = "{strategy}"\n',
             encoding="utf-8",
         )
         output = Path(folder) / "out"
@@ -83,6 +87,31 @@ def stops_of(visits: list[tuple[str, str]]) -> list[tuple[str, list[str]]]:
     return stops
 
 
+def floor_of(where: str) -> str:
+    """The floor of a file: its package's subpackage (``rsstp_sim/arm``), or the package for a
+    module at its top (``rsstp_sim``)."""
+    parts = where.split("/")
+    return "/".join(parts[:2]) if len(parts) > 2 else parts[0]
+
+
+def report(stops: list[tuple[str, list[str]]], what: str, *, listed: bool) -> None:
+    seen: set[str] = set()
+    returns: dict[str, int] = {}
+    for index, (where, functions) in enumerate(stops):
+        back = where in seen
+        seen.add(where)
+        if back:
+            returns[where] = returns.get(where, 0) + 1
+        if listed:
+            mark = "  (back)" if back else ""
+            print(f"{index + 1:3d}  {where}: {', '.join(functions)}{mark}")
+    print(
+        f"by {what}: {len(stops)} stops in {len(seen)} {what}s, {sum(returns.values())} returns"
+    )
+    for where, count in sorted(returns.items(), key=lambda item: -item[1]):
+        print(f"  back to {where}: {count} time{'s' * (count != 1)}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--scenario", default="thesis-algo")
@@ -90,27 +119,10 @@ def main() -> None:
     parser.add_argument("--steps", type=int, default=300)
     parser.add_argument("--list", action="store_true", help="print every stop")
     args = parser.parse_args()
-    stops = stops_of(walk(args.scenario, args.strategy, args.steps))
-    seen: set[str] = set()
-    returns = []
-    for index, (where, functions) in enumerate(stops):
-        back = where in seen
-        seen.add(where)
-        if back:
-            returns.append(where)
-        if args.list:
-            mark = "  (back)" if back else ""
-            print(f"{index + 1:3d}  {where}: {', '.join(functions)}{mark}")
-    print(
-        f"{args.scenario} ({args.strategy}, {args.steps} steps): {len(stops)} stops in "
-        f"{len(seen)} files, {len(returns)} returns"
-    )
-    counts: dict[str, int] = {}
-    for where in returns:
-        counts[where] = counts.get(where, 0) + 1
-    for where, count in sorted(counts.items(), key=lambda item: -item[1]):
-        print(f"  back to {where}: {count} time{'s' * (count != 1)}")
-
+    visits = walk(args.scenario, args.strategy, args.steps)
+    print(f"{args.scenario} ({args.strategy}, {args.steps} steps)")
+    report(stops_of(visits), "file", listed=args.list)
+    report(stops_of([(floor_of(where), f) for where, f in visits]), "floor", listed=args.list)
 
 if __name__ == "__main__":
     main()
