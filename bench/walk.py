@@ -105,9 +105,7 @@ def report(stops: list[tuple[str, list[str]]], what: str, *, listed: bool) -> No
         if listed:
             mark = "  (back)" if back else ""
             print(f"{index + 1:3d}  {where}: {', '.join(functions)}{mark}")
-    print(
-        f"by {what}: {len(stops)} stops in {len(seen)} {what}s, {sum(returns.values())} returns"
-    )
+    print(f"by {what}: {len(stops)} stops in {len(seen)} {what}s, {sum(returns.values())} returns")
     for where, count in sorted(returns.items(), key=lambda item: -item[1]):
         print(f"  back to {where}: {count} time{'s' * (count != 1)}")
 
@@ -123,6 +121,7 @@ def main() -> None:
     print(f"{args.scenario} ({args.strategy}, {args.steps} steps)")
     report(stops_of(visits), "file", listed=args.list)
     report(stops_of([(floor_of(where), f) for where, f in visits]), "floor", listed=args.list)
+
 
 if __name__ == "__main__":
     main()
