@@ -117,6 +117,24 @@ BODY_INSIDES = {
 module outside the package imports (everything else goes through the world interface)."""
 
 
+def test_no_floor_of_the_replay_side_imports_anothers_private_module() -> None:
+    """The replay side's floors (reader, audits, viewer, export) reach each other through
+    public modules and names only, as packages do."""
+    reaching = []
+    for path, tree in _modules():
+        parts = path.relative_to(SRC).parts
+        if parts[0] != "rsstp_replay" or len(parts) < 3:
+            continue
+        floor = parts[1]
+        for name in sorted(_imports(tree)):
+            names = name.split(".")
+            if names[0] != "rsstp_replay" or len(names) < 3 or names[1] == floor:
+                continue
+            if any(part.startswith("_") and not part.startswith("__") for part in names[2:]):
+                reaching.append(f"{path.relative_to(SRC)} imports {name}")
+    assert reaching == []
+
+
 def test_only_a_body_imports_its_own_geometry() -> None:
     reaching = []
     for path, tree in _modules():

@@ -28,7 +28,6 @@ from numpy.typing import NDArray
 
 from rsstp_format import records
 from rsstp_replay.errors import PhysicsDifference
-from rsstp_replay.reader._chunks import gc_paused
 from rsstp_sim.bodies import make_world
 from rsstp_sim.errors import ActionError
 from rsstp_sim.recording import builders
@@ -177,20 +176,18 @@ def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: Int
         truth = world.truth_at(row, code)
         expected.append(_TRUTH_KEY + records.encode_json(truth) + b"}")
     step = 0
-    with gc_paused():
-        for _, data, [found] in recording._chunks_of(("/rsstp/step",)):
-            starts, ends = found.starts, found.ends
-            chunk_keys = np.searchsorted(distinct, keys[step : step + len(starts)]).tolist()
-            if len(chunk_keys) != len(starts):  # pragma: no cover - the steps were counted
-                raise PhysicsDifference(step, "truth", "more step messages than steps")
-            tails = list(map(expected.__getitem__, chunk_keys))
-            # One C-level pass over the chunk's messages, in place; Python looks closer only
-            # at a mismatch.
-            if not all(map(data.endswith, tails, starts, ends)):
-                for offset, (a, b, tail) in enumerate(zip(starts, ends, tails, strict=True)):
-                    if not data.endswith(tail, a, b):
-                        _compare_decoded(step + offset, data[a:b], tail[len(_TRUTH_KEY) : -1])
-            step += len(starts)
+    for data, starts, ends in recording.step_message_bytes():
+        chunk_keys = np.searchsorted(distinct, keys[step : step + len(starts)]).tolist()
+        if len(chunk_keys) != len(starts):  # pragma: no cover - the steps were counted
+            raise PhysicsDifference(step, "truth", "more step messages than steps")
+        tails = list(map(expected.__getitem__, chunk_keys))
+        # One C-level pass over the chunk's messages, in place; Python looks closer only
+        # at a mismatch.
+        if not all(map(data.endswith, tails, starts, ends)):
+            for offset, (a, b, tail) in enumerate(zip(starts, ends, tails, strict=True)):
+                if not data.endswith(tail, a, b):
+                    _compare_decoded(step + offset, data[a:b], tail[len(_TRUTH_KEY) : -1])
+        step += len(starts)
 
 
 def _compare_decoded(step: int, data: bytes, want: bytes) -> None:

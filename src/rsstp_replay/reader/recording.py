@@ -410,6 +410,15 @@ class Recording:
         self._check_open()
         return self._file.chunks_of(topics)
 
+    def step_message_bytes(self) -> Generator[tuple[bytes, list[int], list[int]], None, None]:
+        """The step messages' own bytes, a chunk at a time: the chunk's decompressed data and
+        where each of its step messages starts and ends in it, in step order; the garbage
+        collector paused meanwhile. For a check that compares bytes (the physics check), with
+        no decoding."""
+        with gc_paused():
+            for _, data, [found] in self._chunks_of(("/rsstp/step",)):
+                yield data, found.starts, found.ends
+
     def _records(self, topic: str) -> list[Any]:
         """Every message of ``topic`` as its record, checked against its log time."""
         found: list[Any] = []
