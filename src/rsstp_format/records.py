@@ -62,6 +62,7 @@ __all__ = [
     "ParamRecord",
     "PointRecord",
     "RECORD_TYPES",
+    "NO_TRANSITIONS",
     "STEP_RECORDS",
     "ScenarioMessage",
     "StepMessage",
@@ -694,6 +695,10 @@ class TransitionsRecord(_Record, frozen=True, kw_only=True, gc=False):
             )
 
 
+NO_TRANSITIONS = TransitionsRecord(source=(), action=(), target=())
+"""A change's transitions as written: none (the one object, so that the encoder leaves the
+field out, and a reader tells a change's from a keyframe's by identity)."""
+
 _OPERATION_ARGS = _schema(
     "split: [s]; merge: [s, t]; add and delete: [s, t, a] (state ids, then an action id)",
     minItems=1,
@@ -733,21 +738,27 @@ class OperationRecord(_Record, frozen=True, kw_only=True):
 
 
 class ModelRecord(_Record, frozen=True, kw_only=True):
-    """``rsstp.Model`` on ``/rsstp/model``: the model after a change, and the operations since
-    the previous model message."""
+    """``rsstp.Model`` on ``/rsstp/model``: a model version, as a keyframe (the whole model)
+    or as a change (the operations since the previous message, the whole model left out)."""
 
     schema_name: ClassVar[str] = "rsstp.Model"
     schema_description: ClassVar[str] = (
         "The agent's internal model (a transition system) after a change. Topic /rsstp/model, "
         "once at step 0 and at every step where the model changed, log_time = step * 1_000_000 "
-        "ns. Applying each message's operations to the previous message's model gives this one."
+        "ns. A keyframe (keyframe absent or true) holds the whole model, states and "
+        "transitions; a change (keyframe false) leaves them out: applying each message's "
+        "operations to the previous message's model gives this one. The first message is a "
+        "keyframe."
     )
 
     version: Annotated[
         int, _schema("model version: operations applied since the start (count)", minimum=0)
     ]
     step: Annotated[int, _schema("step at which the model has this version (steps)", minimum=0)]
-    states: Annotated[tuple[_Id, ...], _schema("state ids, sorted (never reused)", minItems=1)]
+    states: Annotated[
+        tuple[_Id, ...],
+        _schema("state ids, sorted (never reused); a keyframe's only", minItems=1),
+    ] = ()
     next_id: Annotated[int, _schema("the id the next split will create (state id)", minimum=1)]
     current: Annotated[int, _schema("the current internal state (state id)", minimum=0)]
     actions: Annotated[tuple[_Id, ...], _schema("the action alphabet, sorted (action ids)")]
@@ -755,9 +766,9 @@ class ModelRecord(_Record, frozen=True, kw_only=True):
         TransitionsRecord,
         _schema(
             "every transition as three parallel arrays, sorted by source, action, target: "
-            "transition i is source[i] -action[i]-> target[i]"
+            "transition i is source[i] -action[i]-> target[i]; a keyframe's only"
         ),
-    ]
+    ] = NO_TRANSITIONS
     operations: Annotated[
         tuple[Annotated[OperationRecord, _schema("one operation on the model")], ...],
         _schema("the operations applied since the previous model message, in order"),
@@ -767,9 +778,17 @@ class ModelRecord(_Record, frozen=True, kw_only=True):
         int,
         _schema("number of (state, action) pairs with more than one successor (count)", minimum=0),
     ]
+    keyframe: Annotated[
+        bool,
+        _schema(
+            "true (or absent, as in schema 2.x): the message holds the whole model; false: a "
+            "change, states and transitions left out"
+        ),
+    ] = True
 
     def triples(self) -> tuple[tuple[int, int, int], ...]:
-        """The transitions as ``(source, action, target)`` triples, sorted as written."""
+        """The transitions as ``(source, action, target)`` triples, sorted as written (a
+        keyframe's, or a change's once the reader has rebuilt it)."""
         return self.transitions.triples()
 
     def snapshot(self) -> dict[str, object]:
@@ -777,10 +796,18 @@ class ModelRecord(_Record, frozen=True, kw_only=True):
         return snapshot_form(self.states, self.next_id, self.current, self.actions, self.triples())
 
     def _check(self) -> None:
-        try:
-            self.transitions._check()
-        except RecordFormatError as exc:
-            raise RecordFormatError(f"{self.schema_name}: {exc}") from None
+        whole = (bool(self.states), self.transitions is not NO_TRANSITIONS)
+        if whole != (self.keyframe, self.keyframe):
+            said = "a keyframe" if self.keyframe else "a change (keyframe false)"
+            raise RecordFormatError(
+                f"{self.schema_name}: {said} has states {'present' if whole[0] else 'absent'} "
+                f"and transitions {'present' if whole[1] else 'absent'}"
+            )
+        if whole[1]:
+            try:
+                self.transitions._check()
+            except RecordFormatError as exc:
+                raise RecordFormatError(f"{self.schema_name}: {exc}") from None
 
 
 # ------------------------------------------------------------------- rsstp.Event

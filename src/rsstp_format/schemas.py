@@ -40,6 +40,7 @@ __all__ = [
     "METADATA_NAME",
     "SCHEMA_ENCODING",
     "SCHEMA_NAMES",
+    "READ_MAJORS",
     "SCHEMA_VERSION",
     "STEP_NS",
     "TOPICS",
@@ -55,8 +56,12 @@ __all__ = [
     "version_refusal",
 ]
 
-SCHEMA_VERSION = "2.3"
+SCHEMA_VERSION = "3.0"
 """The version (``major.minor``) of the schemas this package writes."""
+
+READ_MAJORS = (2, 3)
+"""The major versions this package reads: 3 (a model message is a keyframe or a change) and
+2 (every model message a whole snapshot: a keyframe each)."""
 
 SCHEMA_NAMES = (
     "rsstp.Scenario",
@@ -181,7 +186,8 @@ def validate(name: str, instance: Mapping[str, Any]) -> None:
 
 
 def check_schema_version(name: str, data: bytes) -> tuple[int, int]:
-    """Check a schema found in a recording: title ``name`` and a ``2.x`` version.
+    """Check a schema found in a recording: title ``name`` and a version of a major this
+    package reads (:data:`READ_MAJORS`).
 
     Returns ``(major, minor)``. A later minor version is accepted (its new fields are
     ignored); another major version, or a schema that is not ours, is refused.
@@ -199,8 +205,7 @@ def check_schema_version(name: str, data: bytes) -> tuple[int, int]:
         major, minor = parse_version(schema.get("version"))
     except RecordFormatError as exc:
         raise RecordFormatError(f"{name}: {exc}") from None
-    supported, _ = parse_version(SCHEMA_VERSION)
-    if major != supported:
+    if major not in READ_MAJORS:
         raise RecordFormatError(f"{name}: schema {version_refusal(f'{major}.{minor}')}")
     return major, minor
 
@@ -208,7 +213,8 @@ def check_schema_version(name: str, data: bytes) -> tuple[int, int]:
 def version_refusal(version: object) -> str:
     """Why a recording's schema ``version`` of another major is not read, and what to do."""
     return (
-        f"version {version} is not supported (this reader understands {SCHEMA_VERSION[0]}.x; "
+        f"version {version} is not supported (this reader understands "
+        f"{' and '.join(f'{major}.x' for major in READ_MAJORS)}; "
         f"re-record the run with rsstp-sim record: its scenario.toml is attached)"
     )
 

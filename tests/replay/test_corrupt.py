@@ -185,8 +185,8 @@ CASES: dict[str, Case] = {
     "version1": Case(
         errors.UnsupportedVersion,
         r"version1\.mcap: channel /rsstp/step: schema rsstp\.Step version 1\.0 is not "
-        r"supported \(this reader understands 2\.x; re-record the run with rsstp-sim record: "
-        r"its scenario\.toml is attached\)",
+        r"supported \(this reader understands 2\.x and 3\.x; re-record the run with "
+        r"rsstp-sim record: its scenario\.toml is attached\)",
     ),
     "in-magic": Case(
         errors.CorruptRecording, r"in-magic\.mcap: truncated: the file ends at byte 5"
@@ -290,7 +290,12 @@ def damaged(tmp_path_factory: pytest.TempPathFactory, original: Path) -> dict[st
         changed = recording.model_versions()[2]
 
     def drop_transition(model: dict[str, Any]) -> None:
-        model["transitions"] = {k: v[1:] for k, v in model["transitions"].items()}
+        """The change made a keyframe whose snapshot lacks one of the version's transitions."""
+        model.pop("keyframe", None)
+        model["states"] = list(changed.states)
+        whole = changed.transitions
+        columns = {"source": whole.source, "action": whole.action, "target": whole.target}
+        model["transitions"] = {k: list(v)[1:] for k, v in columns.items()}
         model["deterministic"], model["nondeterministic_pairs"] = _determinism(model)
 
     rewrite(

@@ -22,6 +22,7 @@ from typing import Any, ClassVar
 import numpy as np
 import pandas as pd
 import pytest
+from fakes import RandomRefiner
 from mcap.reader import make_reader
 
 from rsstp_format import records
@@ -160,10 +161,10 @@ def test_open_reads_the_scenario_metadata_and_counts(random_run: tuple[Path, Any
         assert recording.metadata["seed"] == str(SEED)
         assert recording.metadata["scenario_sha256"] == recording.scenario.sha256
         assert recording.schema_versions == {
-            "rsstp.Scenario": "2.3",
-            "rsstp.Step": "2.3",
-            "rsstp.Model": "2.3",
-            "rsstp.Event": "2.3",
+            "rsstp.Scenario": "3.0",
+            "rsstp.Step": "3.0",
+            "rsstp.Model": "3.0",
+            "rsstp.Event": "3.0",
         }
         assert "steps=0..2000" in repr(recording)
 
@@ -456,3 +457,53 @@ def test_a_killed_writer_leaves_a_readable_recording(tmp_path: Path) -> None:
     runner.run(n)
     assert recording.memory() == runner.memory
     assert recording.model_at(n) == runner.model
+
+
+# ------------------------------------------------------------ schema 3.0 and the 2.x files
+
+SCHEMA_2 = Path(__file__).parent / "data" / "schema-2.3-two-joint-30-learner.mcap"
+"""``recordings/two-joint-30-learner.mcap`` as schema 2.3 wrote it (every model message a
+whole snapshot), kept when the reference recordings were re-recorded for schema 3.0."""
+
+
+def test_a_schema_2_recording_reads_as_its_schema_3_re_recording(tmp_path: Path) -> None:
+    """The same run in both schemas: 2.3's snapshot in every model message, 3.0's keyframes
+    and changes; the reader gives the same model at every version, and the same steps."""
+    new = tmp_path / "new.mcap"
+    record(new, load_scenario("two-joint-30"), make_strategy("learner"), steps=12_000, seed=0)
+    with open_recording(SCHEMA_2) as old_file, open_recording(new) as new_file:
+        assert set(old_file.schema_versions.values()) == {"2.3"}
+        assert set(new_file.schema_versions.values()) == {"3.0"}
+        old, fresh = old_file.model_versions(), new_file.model_versions()
+        assert len(old) == len(fresh) > 400
+        for was, now in zip(old, fresh, strict=True):
+            assert (was.version, was.step, was.current) == (now.version, now.step, now.current)
+            assert tuple(was.states) == tuple(now.states)
+            assert was.triples() == now.triples()
+        assert all(m.keyframe for m in old)
+        assert fresh[0].keyframe and sum(m.keyframe for m in fresh) < len(fresh) / 10
+        for step in (0, 4_000, old_file.n_steps):
+            assert old_file.model_at(step).snapshot() == new_file.model_at(step).snapshot()
+        pd.testing.assert_frame_equal(old_file.steps(), new_file.steps())
+
+
+def test_a_change_rebuilt_from_its_keyframe_is_what_the_run_had(tmp_path: Path) -> None:
+    """Every version the reader gives, keyframe or change, is the live model of the run at
+    that version (a strategy that splits, merges, adds and deletes)."""
+    path = tmp_path / "run.mcap"
+    scenario = load_scenario("three-joint")
+    record(path, scenario, RandomRefiner(split=0.05, max_states=5), steps=3_000, seed=2)
+    live: dict[int, dict[str, object]] = {}
+    runner = Runner(scenario, RandomRefiner(split=0.05, max_states=5), seed=2)
+    live[runner.model.version] = runner.model.snapshot()
+    for _ in range(3_000):
+        runner.step()
+        live[runner.model.version] = runner.model.snapshot()
+    with open_recording(path) as recording:
+        versions = recording.model_versions()
+        assert not all(m.keyframe for m in versions)
+        for record_ in versions:
+            snapshot = dict(record_.snapshot())
+            expected = dict(live[record_.version])
+            snapshot.pop("current"), expected.pop("current")
+            assert snapshot == expected

@@ -438,7 +438,10 @@ def test_model_messages_are_live_copies_of_the_model(
     messages = read_messages(path)
 
     models: list[ModelRecord] = list(decoded(messages, "/rsstp/model"))
-    assert [(m.step, m.snapshot()) for m in models] == live.models
+    # The first message is a keyframe, the whole model; the others are changes (schema 3.0).
+    assert [m.keyframe for m in models] == [True, False, False]
+    assert (models[0].step, models[0].snapshot()) == live.models[0]
+    assert all(m.states == () and m.transitions is records.NO_TRANSITIONS for m in models[1:])
     assert [m.step for m in models] == [0, 3, 5]
     assert result.messages["/rsstp/model"] == 3
     assert [m.version for m in models] == [
@@ -454,14 +457,16 @@ def test_model_messages_are_live_copies_of_the_model(
     model_times = [m.log_time for m in messages if m.topic == "/rsstp/model"]
     assert model_times == [0, 3 * STEP_NS, 5 * STEP_NS]
 
-    # The model at any step: the first message's model with the later operations applied.
+    # The model at any step: the keyframe's model with the later operations applied is the
+    # live run's.
     rebuilt = TransitionSystem.from_snapshot(models[0].snapshot(), version=models[0].version)
-    for model in models[1:]:
+    for model, (step, snapshot) in zip(models[1:], live.models[1:], strict=True):
         for op in model.operations:
             rebuilt.apply(op.to_operation())
         rebuilt.current = model.current
-        assert rebuilt.snapshot() == model.snapshot()
+        assert (model.step, rebuilt.snapshot()) == (step, snapshot)
         assert rebuilt.version == model.version
+        assert (model.next_id, model.actions) == (rebuilt.next_id, rebuilt.actions)
 
     # The step messages follow the model versions and still equal the live run's.
     steps = [m.data for m in messages if m.topic == "/rsstp/step"]

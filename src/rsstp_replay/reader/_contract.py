@@ -44,8 +44,8 @@ from rsstp_format.schemas import (
     METADATA_CHECKSUM_SINCE,
     METADATA_KEYS,
     METADATA_NAME,
+    READ_MAJORS,
     SCHEMA_ENCODING,
-    SCHEMA_VERSION,
     STEP_NS,
     TOPICS,
     check_schema_version,
@@ -263,7 +263,6 @@ def check_schemas(
     a known major version; name -> version."""
     path = container.path
     versions: dict[str, str] = {}
-    supported, _ = parse_version(SCHEMA_VERSION)
     for topic, channel_id in channels.items():
         channel = container.channels[channel_id]
         name = topics[topic]
@@ -282,8 +281,8 @@ def check_schemas(
             version = json.loads(schema.data).get("version")
             major, minor = parse_version(version)
         except (ValueError, AttributeError, RecordFormatError, RecursionError):
-            major = supported
-        if major != supported:
+            major = READ_MAJORS[-1]  # (check_schema_version names what is wrong)
+        if major not in READ_MAJORS:
             raise UnsupportedVersion(f"{where}: schema {name} {version_refusal(version)}")
         try:
             major, minor = check_schema_version(name, schema.data)

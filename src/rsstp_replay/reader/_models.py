@@ -1,9 +1,12 @@
-"""The chain of model messages: each snapshot must follow from the previous one.
+"""The chain of model messages: each version must follow from the previous one.
 
-Every ``/rsstp/model`` message carries the whole model (a sparse snapshot) and the operations
-applied since the previous message. :class:`ChainCheck` rebuilds each version from the
-previous snapshot with :meth:`TransitionSystem.apply` and checks that it gives the message's own
-snapshot, so a model at any step is known to be the one the run had.
+Every ``/rsstp/model`` message carries the operations applied since the previous message. A
+*keyframe* (every message of a schema 2.x file; the first one and one every so often in 3.x)
+carries the whole model (a sparse snapshot) too, a *change* does not. :class:`ChainCheck`
+rebuilds each version from the previous one with :meth:`TransitionSystem.apply`: a keyframe
+must give its own snapshot, so a model at any step is known to be the one the run had, and a
+change is the version rebuilt. Every record it hands back is whole (its ``keyframe`` says
+whether the file held it whole).
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from typing import Any, cast
 
 import msgspec
 
-from rsstp_format.records import ModelRecord, TransitionsRecord, encode
+from rsstp_format.records import ModelRecord, RecordFormatError, TransitionsRecord, encode
 from rsstp_replay.errors import CorruptRecording
 from rsstp_sim.errors import ModelError
 from rsstp_sim.transition_system import TransitionSystem
@@ -74,6 +77,8 @@ class ChainCheck:
         if self._previous is None:
             return self._first(record)
         touched = self._advance(record)
+        if not record.keyframe:
+            return self._change(record, touched)
         return self._compare(record, touched)
 
     def head(self, head: ModelHead, data: bytes, decode: Callable[[], ModelRecord]) -> ModelRecord:
@@ -85,6 +90,14 @@ class ChainCheck:
         previous = self._previous
         if previous is None:
             return self._first(decode())
+        if not head.keyframe:  # a change: its head is all of it
+            fields = {name: getattr(head, name) for name in head.__struct_fields__}
+            try:
+                change = ModelRecord(**fields)
+                change._check()
+            except RecordFormatError as exc:
+                raise CorruptRecording(f"{self._path}: {_name(head)}: {exc}") from None
+            return self._change(change, self._advance(change))
         touched = self._advance(head)
         model = self._model
         assert model is not None
@@ -96,6 +109,11 @@ class ChainCheck:
         return self._accept(msgspec.structs.replace(expected, transitions=patched), "")
 
     def _first(self, record: ModelRecord) -> ModelRecord:
+        if not record.keyframe:
+            raise CorruptRecording(
+                f"{self._path}: the first model message ({_name(record)}) is a change: "
+                f"expected a keyframe, the whole model"
+            )
         if record.step != 0:
             raise CorruptRecording(
                 f"{self._path}: the first model message is at step {record.step}, expected step 0"
@@ -144,6 +162,14 @@ class ChainCheck:
             record = msgspec.structs.replace(record, transitions=patched)
             return self._accept(record, _difference(model, record))
         return self._accept(record, _difference(model, record, full=True))
+
+    def _change(self, record: ModelRecord, touched: set[int]) -> ModelRecord:
+        """A change: the version its operations made from the previous one, whole."""
+        previous, model = self._previous, self._model
+        assert previous is not None and model is not None
+        patched = _patched(previous.transitions, model, touched)
+        whole = msgspec.structs.replace(record, states=model.states, transitions=patched)
+        return self._accept(whole, _difference(model, whole))
 
     def _accept(self, record: ModelRecord, difference: str) -> ModelRecord:
         path, previous, model = self._path, self._previous, self._model

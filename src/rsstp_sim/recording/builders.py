@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING, Any
 import msgspec
 
 from rsstp_format.records import (
+    NO_TRANSITIONS,
     STEP_RECORDS,
     AgentRecord,
     EventKind,
@@ -146,24 +147,36 @@ def operation_record(op: Operation) -> OperationRecord:
 
 
 def model_record(
-    model: TransitionSystem, *, step: int, operations: Iterable[Operation]
+    model: TransitionSystem,
+    *,
+    step: int,
+    operations: Iterable[Operation],
+    keyframe: bool = True,
 ) -> ModelRecord:
-    """The ``rsstp.Model`` message: ``model`` as it is at ``step``, after ``operations``."""
-    source, action, target = model.transition_columns()
+    """The ``rsstp.Model`` message: ``model`` as it is at ``step``, after ``operations``; a
+    keyframe (the whole model) or, with ``keyframe=False``, a change (its states and
+    transitions left out: the operations give them)."""
     pairs = model.nondeterministic_pairs
+    states: tuple[int, ...] = ()
+    transitions = NO_TRANSITIONS
+    if keyframe:
+        source, action, target = model.transition_columns()
+        states = model.states
+        transitions = TransitionsRecord(
+            source=tuple(source), action=tuple(action), target=tuple(target)
+        )
     return ModelRecord(
         version=int(model.version),
         step=int(step),
-        states=model.states,
+        states=states,
         next_id=int(model.next_id),
         current=int(model.current),
         actions=model.actions,
-        transitions=TransitionsRecord(
-            source=tuple(source), action=tuple(action), target=tuple(target)
-        ),
+        transitions=transitions,
         operations=tuple(operation_record(op) for op in operations),
         deterministic=pairs == 0,
         nondeterministic_pairs=pairs,
+        keyframe=keyframe,
     )
 
 

@@ -74,6 +74,7 @@ from rsstp_sim.transition_system import Operation
 __all__ = [
     "DEFAULT_CHUNK_SIZE",
     "HELPER_STEPS",
+    "KEYFRAME_CHANGES",
     "TRIAL_STEPS",
     "RecordResult",
     "Recorder",
@@ -83,6 +84,10 @@ __all__ = [
 
 DEFAULT_CHUNK_SIZE = 1024 * 1024
 """Bytes of uncompressed messages per chunk (see the README for steps per chunk)."""
+
+KEYFRAME_CHANGES = 256
+"""At most this many model messages from one keyframe (the whole model) to the next; the
+ones between are changes (their operations alone)."""
 
 HELPER_STEPS = 131_072
 """A run of more steps than this may build its chunks in a helper process, left to choose
@@ -196,6 +201,8 @@ class Recorder:
             self._versions.update({k: v for k, v in versions.items() if k in _VERSION_KEYS})
         self._stop = False
         self._budget: int | None = None
+        # Since the last keyframe: model messages, operations; its states and transitions.
+        self._changes_since = self._operations_since = self._keyframe_size = 0
         self._messages = StepMessages()
         self._counts = dict.fromkeys(self._topics, 0)
         self.side_file = side_file(self.path)
@@ -330,12 +337,32 @@ class Recorder:
         model = self.runner.model
         for model_step, change in self._waiting:
             if isinstance(change, tuple):
-                record = builders.model_record(model, step=model_step, operations=change)
+                record = builders.model_record(
+                    model, step=model_step, operations=change, keyframe=self._keyframe_due(change)
+                )
                 yield self._message("/rsstp/model", step, records.encode(record))
         for event_step, change in self._waiting:
             if isinstance(change, bytes):
                 yield self._message("/rsstp/event", event_step, change)
         self._waiting.clear()
+
+    def _keyframe_due(self, operations: tuple[Operation, ...]) -> bool:
+        """Whether the next model message is a keyframe (the whole model): the first, then
+        once :data:`KEYFRAME_CHANGES` changes or more operations than the last keyframe's
+        states and transitions have passed since the last one (a reader rebuilds a version
+        from the nearest keyframe before it, and the file grows with the changes)."""
+        self._changes_since += 1
+        self._operations_since += len(operations)
+        due = (
+            self._keyframe_size == 0
+            or self._changes_since >= KEYFRAME_CHANGES
+            or self._operations_since > self._keyframe_size
+        )
+        if due:
+            model = self.runner.model
+            self._keyframe_size = len(model) + len(model.transitions())
+            self._changes_since = self._operations_since = 0
+        return due
 
     def _write_step_zero(self) -> None:
         runner = self.runner
