@@ -540,6 +540,43 @@ class TransitionSystem:
             model._link(s, a, t)
         return model
 
+    @classmethod
+    def from_columns(
+        cls,
+        states: Sequence[int],
+        actions: Iterable[int],
+        columns: tuple[Sequence[int], Sequence[int], Sequence[int]],
+        *,
+        next_id: int,
+        current: int,
+        version: int = 0,
+    ) -> TransitionSystem:
+        """A model from columns already checked (a recording's version, which its reader
+        rebuilt and checked): ``states`` sorted, the transitions as ``(sources, actions,
+        targets)`` sorted by source, action and target, all between known states. One pass,
+        no check per transition (:meth:`from_snapshot` checks everything)."""
+        model = cls(1, actions=actions)
+        out: dict[int, dict[int, tuple[int, ...]]] = {s: {} for s in states}
+        into: dict[int, dict[int, set[int]]] = {s: {} for s in states}
+        nondeterministic = 0
+        for s, a, t in zip(*columns, strict=True):
+            row = out[s]
+            targets = row.get(a)
+            if targets is None:
+                row[a] = (t,)
+            else:
+                if len(targets) == 1:
+                    nondeterministic += 1
+                row[a] = (*targets, t)
+            into[t].setdefault(a, set()).add(s)
+        model._out, model._in = out, into
+        model._n_nondeterministic = nondeterministic
+        model._states_sorted = tuple(states)
+        model._current = current
+        model._next_id = next_id
+        model._version = version
+        return model
+
     # -------------------------------------------------------------- internals
 
     def _check(self, s: object, operation: str) -> None:

@@ -606,3 +606,45 @@ def test_split_then_merge_gives_back_the_original(
     assert model.merge(s, new) == s
     assert model == original
     assert model.is_deterministic() == original.is_deterministic()
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.lists(
+        st.tuples(st.sampled_from(["split", "merge", "add", "delete"]), st.integers(0, 50)),
+        max_size=40,
+    )
+)
+def test_from_columns_is_from_snapshot_without_the_checks(steps: list[tuple[str, int]]) -> None:
+    """A model built from its checked columns behaves as the one rebuilt from its snapshot:
+    the same snapshot, determinism, predecessors, and the same answers to further changes."""
+    model = TransitionSystem.universal((0, 1, 2))
+    for kind, seed in steps:
+        states = model.states
+        s, t = states[seed % len(states)], states[(seed // 7) % len(states)]
+        if kind == "split":
+            model.split(s)
+        elif kind == "merge" and s != t:
+            model.merge(s, t)
+        elif kind == "add":
+            model.add(s, t, seed % 3)
+        elif kind == "delete":
+            model.delete(s, t, seed % 3)
+    checked = TransitionSystem.from_snapshot(model.snapshot(), version=model.version)
+    fast = TransitionSystem.from_columns(
+        model.states,
+        model.actions,
+        model.transition_columns(),
+        next_id=model.next_id,
+        current=model.current,
+        version=model.version,
+    )
+    assert fast.snapshot() == checked.snapshot()
+    assert fast.version == checked.version
+    assert fast.nondeterministic_pairs == checked.nondeterministic_pairs
+    for state in model.states:
+        assert fast.predecessors(state) == checked.predecessors(state)
+    for built in (fast, checked):
+        new = built.split(model.states[0])
+        built.add(new, model.states[-1], 1)
+    assert fast.snapshot() == checked.snapshot()

@@ -45,7 +45,7 @@ from rsstp_replay.reader._chunks import Messages, gc_paused, message_times
 from rsstp_replay.reader._container import ChunkRef, open_container
 from rsstp_replay.reader._contract import CheckedFile, check_file
 from rsstp_replay.reader._decode import StepColumns, body_reader
-from rsstp_replay.reader._models import HEADS, ChainCheck, ModelHead, build_model
+from rsstp_replay.reader._models import HEADS, ChainCheck, ModelHead
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
@@ -360,7 +360,15 @@ class Recording:
         models = self.model_versions()
         index = bisect.bisect_right([m.step for m in models], step) - 1
         record = models[index]
-        model = build_model(self.path, record)
+        transitions = record.transitions  # (the chain check rebuilt and checked them)
+        model = TransitionSystem.from_columns(
+            record.states,
+            record.actions,
+            (transitions.source, transitions.action, transitions.target),
+            next_id=record.next_id,
+            current=record.current,
+            version=record.version,
+        )
         here = self._agent_row(step)
         if here.model_version != record.version:
             raise CorruptRecording(
