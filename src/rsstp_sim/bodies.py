@@ -16,7 +16,7 @@ from typing import Any
 
 from rsstp_sim.interface import Body
 
-__all__ = ["BODIES", "body_named", "body_of", "make_world"]
+__all__ = ["BODIES", "body_named", "body_of", "make_world", "registered"]
 
 BODIES: dict[str, str] = {
     "arm": "rsstp_sim.arm.world:ARM",
@@ -25,10 +25,16 @@ BODIES: dict[str, str] = {
 """Body name (its scenario table) -> ``module:attribute`` of its :class:`Body`."""
 
 
+def registered(registry: dict[str, str], name: str) -> Any:
+    """What a registry of bodies (body name -> ``module:attribute``) holds for ``name``, its
+    module imported now (KeyError for none): this one, and each floor's of the replay side."""
+    module, attribute = registry[name].split(":")
+    return getattr(import_module(module), attribute)
+
+
 def body_named(name: str) -> Body:
     """The registered body ``name`` (KeyError for none)."""
-    module, attribute = BODIES[name].split(":")
-    body: Body = getattr(import_module(module), attribute)
+    body: Body = registered(BODIES, name)
     return body
 
 

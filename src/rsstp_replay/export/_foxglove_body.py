@@ -5,12 +5,13 @@ by a line in :data:`BODY_SCENES`."""
 from __future__ import annotations
 
 from collections.abc import Iterator
-from importlib import import_module
 from pathlib import Path
 from typing import Any, Protocol
 
 import pandas as pd
 from foxglove.messages import FrameTransforms, SceneUpdate
+
+from rsstp_sim.bodies import registered
 
 __all__ = ["BODY_SCENES", "BodyDrawing", "BodyPoses", "BodyScene", "body_scene"]
 
@@ -62,6 +63,5 @@ BODY_SCENES: dict[str, str] = {
 
 def body_scene(name: str) -> BodyScene:
     """The registered scene of body ``name`` (KeyError for none)."""
-    module, attribute = BODY_SCENES[name].split(":")
-    scene: BodyScene = getattr(import_module(module), attribute)
+    scene: BodyScene = registered(BODY_SCENES, name)
     return scene

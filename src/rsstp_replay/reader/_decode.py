@@ -16,7 +16,6 @@ ground truth by its :class:`BodyReader` (:data:`BODY_READERS`: the arm's in
 from __future__ import annotations
 
 import re
-from importlib import import_module
 from typing import Annotated, Any, Protocol
 
 import msgspec
@@ -33,6 +32,7 @@ from rsstp_format.vocabulary import (
     BlockerKind,
 )
 from rsstp_replay.errors import BadStep
+from rsstp_sim.bodies import registered
 
 __all__ = [
     "BLOCKED_COLUMNS",
@@ -163,8 +163,7 @@ class BodyReader(Protocol):
 
 def body_reader(name: str) -> BodyReader:
     """The registered reader of body ``name`` (KeyError for none)."""
-    module, attribute = BODY_READERS[name].split(":")
-    reader: BodyReader = getattr(import_module(module), attribute)
+    reader: BodyReader = registered(BODY_READERS, name)
     return reader
 
 

@@ -12,7 +12,6 @@ marker) is here.
 
 from __future__ import annotations
 
-from importlib import import_module
 from typing import Any, NamedTuple, Protocol
 
 import numpy as np
@@ -23,6 +22,7 @@ import rerun as rr
 from rsstp_replay.reader import blocker_texts
 from rsstp_replay.viewer._chunks import send_rows
 from rsstp_sim import palette
+from rsstp_sim.bodies import registered
 
 __all__ = [
     "BLOCKED",
@@ -87,8 +87,7 @@ BODY_VIEWS: dict[str, str] = {
 
 def body_view(name: str) -> BodyView:
     """The registered view of body ``name`` (KeyError for none)."""
-    module, attribute = BODY_VIEWS[name].split(":")
-    view: BodyView = getattr(import_module(module), attribute)
+    view: BodyView = registered(BODY_VIEWS, name)
     return view
 
 
