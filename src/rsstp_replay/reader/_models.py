@@ -55,16 +55,16 @@ class ChainCheck:
     with each, then :meth:`finish`); :class:`CorruptRecording` names the version. No message
     may come after ``last_step``, the recording's last step.
 
-    The first snapshot is built; every later message's operations are applied to the model
-    rebuilt so far, and the result is compared with the message's snapshot field by field, so
-    a snapshot is never built twice. The transitions are compared through what the operations
-    touched: the previous snapshot, with the rows of every state whose transitions an
-    operation may have changed replaced by the rebuilt model's, must be the message's
-    snapshot (whole tuples compared at C speed, Python only for the touched rows). The record
-    handed back then holds those patched tuples, whose ints are the previous record's: a run's
-    thousands of snapshots, which repeat most of their transitions, share one int object per
-    state id instead of one per transition end. A snapshot that differs (or lists its
-    transitions out of order) is compared in full, which names the difference.
+    The first message (a keyframe) is built; every later message's operations are applied to the
+    model rebuilt so far. A change is that model, handed back whole; a keyframe's snapshot is
+    compared with it field by field, so a snapshot is never built twice. The transitions are
+    compared through what the operations touched: the previous snapshot, with the rows of every
+    state whose transitions an operation may have changed replaced by the rebuilt model's, must
+    be the message's snapshot (whole tuples compared at C speed, Python only for the touched
+    rows). The record handed back then holds those patched tuples, whose ints are the previous
+    record's: a run's thousands of snapshots, which repeat most of their transitions, share one
+    int object per state id instead of one per transition end. A snapshot that differs (or lists
+    its transitions out of order) is compared in full, which names the difference.
     """
 
     def __init__(self, path: Path, *, last_step: int) -> None:
@@ -90,8 +90,8 @@ class ChainCheck:
         previous = self._previous
         if previous is None:
             return self._first(decode())
+        fields = {name: getattr(head, name) for name in head.__struct_fields__}
         if not head.keyframe:  # a change: its head is all of it
-            fields = {name: getattr(head, name) for name in head.__struct_fields__}
             try:
                 change = ModelRecord(**fields)
                 change._check()
@@ -102,7 +102,6 @@ class ChainCheck:
         model = self._model
         assert model is not None
         patched = _patched(previous.transitions, model, touched)
-        fields = {name: getattr(head, name) for name in head.__struct_fields__}
         expected = ModelRecord(**fields, transitions=patched.as_lists())
         if encode(expected) != data:
             return self._compare(decode(), touched, patched)
