@@ -356,6 +356,24 @@ def test_with_float_feedback_a_local_maximum_wider_than_a_run_is_left(seed: int)
     assert_minimal_and_equivalent(learner, runner.model, truth)
 
 
+CIRCLING = parse_scenario(
+    'name = "circling"\n[arm]\nlengths = [0.69, 2.21]\ninitial_deg = [20, 220]\n'
+    'step_deg = 10\n[feedback]\ntarget_deg = [330, 160]\nmode = "float"\n'
+)
+"""Two links and no obstacle (a generated world): before the landmark is found no action is
+known to undo another, and a climb that counted any rise as progress went down a step and back
+up among the same 35 poses for ever (200,000 steps, never sensed)."""
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_with_float_feedback_a_climb_without_undo_does_not_go_round(seed: int) -> None:
+    learner, runner = learn(CIRCLING, 20_000, seed=seed)
+    sensed = runner.memory.sensations.tolist()
+    assert True in sensed and sensed.index(True) < 5_000
+    felt = np.unique(runner.memory.feedback[: sensed.index(True) + 1])
+    assert len(felt) > 1
+
+
 @pytest.mark.slow
 def test_every_seed_learns_the_two_joint_world() -> None:
     # Seed 8 once went round for ever in a test whose path to the landmark led through the
@@ -405,6 +423,75 @@ def test_the_way_to_the_landmark_is_kept_up_to_date() -> None:
             assert int(h.toward[s]) == (nearer[0] if nearer else -1)
         checked += 1
     assert learner.done and checked >= 50
+
+
+def _first_shortest_word(
+    successors: list[list[int]], order: list[int], actions: list[int], source: int, goals: set[int]
+) -> tuple[list[int], int] | None:
+    """Breadth first, one state at a time, the action columns tried in ``order``."""
+    parent: dict[int, tuple[int, int] | None] = {source: None}
+    queue = [source]
+    for s in queue:
+        if s in goals:
+            word: list[int] = []
+            step = parent[s]
+            while step is not None:
+                word.append(step[1])
+                step = parent[step[0]]
+            return word[::-1], s
+        for k in order:
+            t = successors[s][k]
+            if t >= 0 and t not in parent:
+                parent[t] = (s, actions[k])
+                queue.append(t)
+    return None
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.integers(2, 14).flatmap(
+        lambda n: st.tuples(
+            st.lists(
+                st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
+            ),
+            st.integers(0, n - 1),
+            st.sets(st.integers(0, n - 1), max_size=n),
+            st.integers(0, 2**32 - 1),
+        )
+    )
+)
+def test_paths_are_the_first_shortest_words_a_breadth_first_search_finds(
+    case: tuple[list[list[int]], int, set[int], int],
+) -> None:
+    # The learner walks to its next goal, and home to the landmark (state 0), by the word a
+    # breadth-first search over confirmed transitions finds (-1: not confirmed), the actions
+    # in the order the run's generator drew once: the shortest, ties broken by that order.
+    successors, source, goals, seed = case
+    actions = [7, 3, 5]
+    order = [int(k) for k in np.random.default_rng(seed).permutation(3)]
+    h = Hypothesis(
+        TransitionSystem.universal(tuple(actions)), tuple(actions), landmark=0,
+        rng=np.random.default_rng(seed),
+    )  # fmt: skip
+    n = len(successors)
+    h._grow(n)
+    h.next[:n] = successors
+    h.alive[:n] = True
+    h.label[0] = True
+    h._changed()
+    wanted = np.zeros(n, dtype=bool)
+    wanted[list(goals)] = True
+    assert h.nearest_where(source, wanted) == _first_shortest_word(
+        successors, order, actions, source, goals
+    )
+    assert h.nearest(source, goals) == _first_shortest_word(
+        successors, order, actions, source, goals
+    )
+    home = _first_shortest_word(successors, order, actions, source, {0})
+    assert h.path(source, 0) == (None if home is None else home[0])
+    for goal in goals:
+        found = _first_shortest_word(successors, order, actions, source, {goal})
+        assert h.path(source, goal) == (None if found is None else found[0])
 
 
 def _separating_word_pair_by_pair(

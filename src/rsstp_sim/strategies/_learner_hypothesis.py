@@ -14,7 +14,6 @@ recording shows the learning operation by operation.
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Callable
 
 import numpy as np
 from numpy.typing import NDArray
@@ -89,8 +88,6 @@ class Hypothesis:
         self._distance: IntArray | None = None
         self._toward: IntArray | None = None
         self._edits = 0
-        self._rows_cache: list[list[int]] = []
-        self._rows_edits = -1
         self._inverse: tuple[int, dict[int, int]] = (-1, {})
 
     # ----------------------------------------------------------------- queries
@@ -273,47 +270,79 @@ class Hypothesis:
         return self._guide()[1]
 
     def path(self, source: int, goal: int) -> list[int] | None:
-        """A shortest confirmed action word from ``source`` to ``goal``."""
-        found = self._search(source, lambda s: s == goal)
+        """A shortest confirmed action word from ``source`` to ``goal``: of the shortest, the
+        first in the run's order of the actions (as a breadth-first search finds it)."""
+        if goal == self.landmark:
+            return self._home_word(source)
+        wanted = np.zeros(len(self.label), dtype=bool)
+        wanted[goal] = True
+        found = self._search(source, wanted)
         return None if found is None else found[0]
 
     def nearest(self, source: int, wanted: set[int]) -> tuple[list[int], int] | None:
         """A shortest confirmed word from ``source`` to one of ``wanted``, and that state."""
-        return self._search(source, wanted.__contains__)
+        mask = np.zeros(len(self.label), dtype=bool)
+        mask[list(wanted)] = True
+        return self._search(source, mask)
 
     def nearest_where(self, source: int, wanted: BoolArray) -> tuple[list[int], int] | None:
         """:meth:`nearest`, the states wanted given as a mask over the state ids."""
-        flags: list[bool] = wanted.tolist()
-        return self._search(source, flags.__getitem__)
+        mask = np.zeros(len(self.label), dtype=bool)
+        mask[: len(wanted)] = wanted[: len(mask)]
+        return self._search(source, mask)
 
-    def _search(self, source: int, is_goal: Callable[[int], bool]) -> tuple[list[int], int] | None:
+    def _home_word(self, source: int) -> list[int] | None:
+        """The path to the landmark that :attr:`toward` points along: at each state the first
+        action, in the run's order, to a state one step nearer. It is the word a breadth-first
+        search from ``source`` finds (of the shortest words, the first in that order), in
+        steps as many as its length."""
+        distance, toward = self._guide()
+        if distance[source] >= FAR:
+            return None
+        word: list[int] = []
+        s = source
+        while s != self.landmark:
+            k = int(toward[s])
+            word.append(self.actions[k])
+            s = int(self.next[s, k])
+        return word
+
+    def _search(self, source: int, wanted: BoolArray) -> tuple[list[int], int] | None:
         """Breadth first over the confirmed transitions, the actions in the run's order: the
-        word to the first state reached that ``is_goal``, and that state."""
-        parent: dict[int, tuple[int, int] | None] = {source: None}
-        queue = [source]
-        rows, actions = self._rows(), self._ordered
-        for s in queue:  # (the queue grows as it is read)
-            if is_goal(s):
-                word: list[int] = []
-                step = parent[s]
-                while step is not None:
-                    word.append(step[1])
-                    step = parent[step[0]]
-                word.reverse()
-                return word, s
-            for action, t in zip(actions, rows[s], strict=True):
-                if t >= 0 and t not in parent:
-                    parent[t] = (s, action)
-                    queue.append(t)
-        return None
+        word to the first state reached that is ``wanted``, and that state.
 
-    def _rows(self) -> list[list[int]]:
-        """The confirmed successors as lists, the actions in the run's order (-1: none): kept
-        while :attr:`edits` stays the same, for searches that visit one state at a time."""
-        if self._rows_edits != self._edits:
-            self._rows_cache = self.next[: self.model.next_id, self._columns].tolist()
-            self._rows_edits = self._edits
-        return self._rows_cache
+        One numpy pass per distance from ``source``: each level's successors in the order a
+        first-in first-out search meets them (state by state in the level's order, action by
+        action), each state kept where it is first met; so the state found, and its word, are
+        those of the one-state-at-a-time search."""
+        if wanted[source]:
+            return [], source
+        width = len(self.actions)
+        rows = self.next[:, self._columns]
+        seen = np.zeros(len(self.label), dtype=bool)
+        seen[source] = True
+        level = np.asarray([source], dtype=np.int64)
+        reached: list[IntArray] = []  # per level: where in the level before each state came from
+        while len(level):
+            met = rows[level].ravel()
+            where = np.flatnonzero(met >= 0)
+            where = where[~seen[met[where]]]
+            _, first = np.unique(met[where], return_index=True)
+            where = where[np.sort(first)]  # each state where it was first met, in that order
+            level = met[where]
+            seen[level] = True
+            reached.append(where)
+            goals = np.flatnonzero(wanted[level])
+            if len(goals):
+                at = int(goals[0])
+                found = int(level[at])
+                word: list[int] = []
+                for came in reversed(reached):
+                    word.append(self._ordered[int(came[at]) % width])
+                    at = int(came[at]) // width
+                word.reverse()
+                return word, found
+        return None
 
     def around(self, source: int, radius: int) -> set[int]:
         """The states within ``radius`` confirmed transitions of ``source``, either way."""

@@ -279,13 +279,17 @@ class Walker:
         """With float feedback: climb the closeness to the sensed pose until it is sensed (True)
         or ``steps`` steps are taken (False; None: no limit).
 
-        Coordinate ascent: keep taking an action while the feedback grows; when it falls, undo
-        the action (when the confirmed transitions say which action undoes it) and try another;
-        when no action makes it grow (a local maximum: an obstacle in the way), a random run
-        of one action, then climb again. Met again, a local maximum is left by a random walk
-        (runs of random actions) of :data:`LONGEST_RUN` steps, then twice as many each time: a
-        maximum whose slopes are wider than one run (the far side of an obstacle, the long way
-        round) is left in the end.
+        Coordinate ascent: keep taking an action while the feedback rises; when it does not,
+        undo the action (when the confirmed transitions say which action undoes it) and try
+        another; when no action makes it rise (a local maximum: an obstacle in the way), a
+        random run of one action, then climb again. Only a rise above the best felt since the
+        climb (re)started makes every action worth trying again: without undoing actions, a
+        step down then a step back up would otherwise go round the same few poses for ever.
+        Met again, a local
+        maximum is left by a random walk (runs of random actions) of :data:`LONGEST_RUN` steps,
+        then twice as many each time: a maximum whose slopes are wider than one run (the far
+        side of an obstacle, the long way round) is left in the end, and the walks become the
+        boolean learner's random search.
         """
         memory = self.agent.memory
         inverse = self.h.inverses()
@@ -294,6 +298,7 @@ class Walker:
         tried: set[int] = set()
         action: int | None = None
         escapes = 0
+        best = float(memory.feedback[-1])
         while end is None or self.agent.step < end:
             if action is None:
                 untried = [b for b in actions if b not in tried]
@@ -309,6 +314,7 @@ class Walker:
                             return True
                         self.check_confined()
                     tried.clear()
+                    best = float(memory.feedback[-1])
                     continue
                 action = self.pick(untried)
             before = float(memory.feedback[-1])  # (the memory's arrays are views: read anew)
@@ -317,8 +323,11 @@ class Walker:
             self.check_confined()
             after = float(memory.feedback[-1])
             undo = inverse.get(action)
-            if after > before:
+            if after > best:
+                best = after
                 tried = set() if undo is None else {undo}
+                continue
+            if after > before:  # back up toward the best: keep on, what was tried stays tried
                 continue
             tried.add(action)
             if after < before and undo is not None:
