@@ -204,7 +204,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         loaded = load(recording)  # the steps decoded once for every audit
         bar.to(1)
         bar.stage("auditing")
-        report = run_audits(loaded)
+        report = run_audits(loaded, consistency_steps=args.consistency_steps or None)
         physics = check_physics(recording, loaded.steps())
         bar.to(2)
         truth = None
@@ -421,6 +421,18 @@ def _cmd_export(args: argparse.Namespace) -> int:
     return 0
 
 
+_CONSISTENCY_STEPS = 1 << 21
+"""``rsstp_replay.audits.consistency.MAX_STEPS``, without importing the audits at start-up (a
+test checks they agree)."""
+
+
+def _count(text: str) -> int:
+    value = _integer(text)
+    if value < 0 or value == 1:
+        raise argparse.ArgumentTypeError(f"expected 0 (every step) or at least 2, got {value}")
+    return value
+
+
 def _integer(text: str) -> int:
     try:
         return int(text)
@@ -506,6 +518,14 @@ def _build_parser() -> Parser:
         action="append",
         choices=("contract",),
         help="exit with 0 even when the recording breaks the contract or its physics",
+    )
+    p.add_argument(
+        "--consistency-steps",
+        type=_count,
+        default=_CONSISTENCY_STEPS,
+        metavar="N",
+        help=f"judge contradictions in the last N steps of a longer run, and say so (default "
+        f"{_CONSISTENCY_STEPS:,}; 0: every step, minutes and gigabytes past ten million)",
     )
     add_no_cache(p)
     p.set_defaults(func=_cmd_audit)

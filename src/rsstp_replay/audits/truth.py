@@ -39,7 +39,12 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from rsstp_format.records import ModelRecord
-from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
+from rsstp_replay.audits.consistency import (
+    MAX_STEPS,
+    ConsistencyFindings,
+    Sample,
+    audit_consistency_by_version,
+)
 from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
@@ -150,6 +155,7 @@ class TruthFindings:
     memory's contradictions between two times in the same state of this version) and
     ``equivalent`` (to the truth, where it came into force). ``aliased_step`` says per step
     whether its internal state stood for several true classes under its version.
+    ``consistency_sample``: the steps ``contradictory_states`` was judged in, when not all were.
     """
 
     scenario: str
@@ -166,6 +172,7 @@ class TruthFindings:
     final_redundant: Mapping[int, tuple[int, ...]]
     true_class: NDArray[np.int64] = field(repr=False, compare=False)
     aliased_step: NDArray[np.bool_] = field(repr=False, compare=False)
+    consistency_sample: Sample | None = None
 
     @property
     def learned_at_step(self) -> int | None:
@@ -213,7 +220,10 @@ class TruthFindings:
             ("redundant_classes", "a true class was spread over several states"),
             ("contradictory_states", "the memory contradicts a state"),
         ):
-            lines.append(f"  {what}: {_versions_with(table, column)}")
+            sampled = ""
+            if column == "contradictory_states" and self.consistency_sample is not None:
+                sampled = f" (judged in steps {self.consistency_sample.first_step:,}.. only)"
+            lines.append(f"  {what}: {_versions_with(table, column)}{sampled}")
         for state, classes in sorted(self.final_aliased.items())[:10]:
             lines.append(f"    final version: state {state:,} stood for classes {_short(classes)}")
         for cls, states in sorted(self.final_redundant.items())[:10]:
@@ -268,6 +278,12 @@ class TruthFindings:
             "versions": {
                 column: self.versions[column].tolist() for column in self.versions.columns
             },
+            "consistency_sample": None
+            if self.consistency_sample is None
+            else {
+                "first_step": self.consistency_sample.first_step,
+                "last_step": self.consistency_sample.last_step,
+            },
             "history": {
                 "classes_visited": self.classes_visited,
                 "internal_states_visited": len(self.classes_of_state),
@@ -304,10 +320,12 @@ def audit_truth(
     *,
     truth: GroundTruth | None = None,
     within_versions: ConsistencyFindings | None = None,
+    consistency_steps: int | None = MAX_STEPS,
 ) -> TruthFindings:
     """Run the truth audit. The ground truth is computed unless ``truth`` is given, and the
     consistency audit within versions unless ``within_versions`` is (an
-    :class:`~rsstp_replay.audits.report.AuditReport` has it)."""
+    :class:`~rsstp_replay.audits.report.AuditReport` has it), in the last
+    ``consistency_steps`` steps of a longer memory (None: every step)."""
     truth = load_truth(source.scenario) if truth is None else truth
     loaded = load(source)
     steps = loaded.steps()
@@ -339,7 +357,7 @@ def audit_truth(
     aliased_states = _distinct_per_version(index[aliased_step], states[aliased_step], n)
     redundant_classes = _distinct_per_version(index[redundant_step], true_class[redundant_step], n)
     contradictions = within_versions or audit_consistency_by_version(
-        memory, steps["model_version"].to_numpy(np.int64)
+        memory, steps["model_version"].to_numpy(np.int64), max_steps=consistency_steps
     )
     numbers = [record.version for record in versions]
     contradicted = np.zeros(n, np.int64)
@@ -385,6 +403,7 @@ def audit_truth(
         },
         true_class=true_class,
         aliased_step=aliased_step,
+        consistency_sample=contradictions.sample,
     )
 
 
