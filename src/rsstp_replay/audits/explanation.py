@@ -52,7 +52,7 @@ __all__ = ["Explanation", "Visited", "explain"]
 _IntArray = npt.NDArray[np.int64]
 _TOP = 5
 """The most visited states and classes listed."""
-_BLOCK = 1 << 20
+_BLOCK = 1 << 16
 """Steps whose first occurrences are found together."""
 
 
