@@ -91,7 +91,7 @@ def _check_against_table(explanation: Explanation, table: pd.DataFrame, truth: G
         index=table.index[1:],
     )
     assert explanation.last_new_transition_step == _last_first_seen(taken)
-    sensed = steps.index[steps["sensation"]]
+    sensed = table.index[table["sensation"]]  # the reset's entry too
     assert explanation.sensed_steps == len(sensed)
     assert explanation.first_sensed_step == (int(sensed[0]) if len(sensed) else None)
     assert explanation.best_feedback == table["feedback"].max()
@@ -135,7 +135,7 @@ def test_a_failed_learner_is_explained(tmp_path: Path) -> None:
     text = explanation.to_text()
     assert "target: never sensed; the nearest sensed pose is" in text
     assert any(s.startswith("the target was never sensed") for s in explanation.suggestions)
-    assert any("float feedback it climbs peaked" in s for s in explanation.suggestions)
+    assert any("the float feedback peaked" in s for s in explanation.suggestions)
     document = explanation.to_json()
     assert json.loads(json.dumps(document)) == document
     assert document["stalled_steps"] == 20_000 - document["nothing_new_after"]

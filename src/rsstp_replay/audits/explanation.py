@@ -20,7 +20,8 @@ the ground truth, the explanation measures:
   and ``nothing_new_after``, the largest of the four: from the step after it to the end, the
   model did not change and the run met no internal state, true class or transition it had not
   met before. ``T - nothing_new_after`` steps are the run's tail that taught it nothing;
-- **the target**: the steps that sensed it, the first and the last; the closest the arm came
+- **the target**: the entries ``0 .. T`` that sensed it (the reset's too, as the summary's
+  sensations), the first and the last; the closest the arm came
   (the largest float feedback, 1 at the target, and the first step it was felt); and, when it
   was never sensed, how many moves of the world lie between the classes the run visited and
   the nearest sensed pose (by the truth's transitions);
@@ -220,7 +221,7 @@ def explain(
     sensations = memory.sensations
     first_state = _first_steps(states)
     state_visits = _visits_of(states[1:], steps)
-    sensed = np.flatnonzero(sensations[1:]) + 1
+    sensed = np.flatnonzero(sensations)  # entries 0 .. T, the reset's too, as the summary
     feedback = memory.feedback
     has_feedback = len(feedback) > 0 and not np.isnan(feedback).all()
     best_step = int(np.nanargmax(feedback)) if has_feedback else None
@@ -354,13 +355,14 @@ def _with_suggestions(found: Explanation) -> Explanation:
                 else f" ({counted(found.target_moves, 'move')} beyond every class it visited)"
             )
             out.append(
-                f"the target was never sensed{where}: the learner needs one sensed pose as its "
-                "landmark before it can build a model; put the target where the arm starts or "
-                "explores, or start the arm nearer it"
+                f"the target was never sensed{where}: without a sensation every pose looks the "
+                "same to the agent (the learner needs a sensed pose as its landmark), so "
+                "nothing could be learned; put the target where the arm starts or explores, or "
+                "start the arm nearer it"
             )
             if found.feedback_mode == "float" and found.best_feedback_step is not None:
                 out.append(
-                    f"the float feedback it climbs peaked at {found.best_feedback:.4f} at step "
+                    f"the float feedback peaked at {found.best_feedback:.4f} at step "
                     f"{found.best_feedback_step:,} and never rose after: the climb is held at a "
                     "local maximum (an obstacle between the arm and the target?); with boolean "
                     "feedback the learner searches without climbing"
@@ -371,7 +373,7 @@ def _with_suggestions(found: Explanation) -> Explanation:
             + (" (searching for the sensed pose)" if phase.phase == "home" else "")
         )
     classes, n = found.classes_visited, found.true_classes
-    if classes is not None and n is not None and classes < 0.1 * n:
+    if classes is not None and n is not None and classes < 0.1 * n and found.top_classes:
         top = sum(v.share for v in found.top_classes)
         out.append(
             f"it visited {classes:,} of {n:,} true classes ({_percent(classes / n)}), and its "
