@@ -255,23 +255,23 @@ def _check_blocked_events(
     as decoded JSON (key order and spacing do not count). The events are matched in numpy (a
     long run has millions); the first that differs is named."""
     blocked_steps = np.flatnonzero(blockers)
-    pairs, pair_codes = np.unique(
-        np.stack([actions[blocked_steps], blockers[blocked_steps]], axis=1).astype(np.int64),
-        axis=0,
-        return_inverse=True,
+    width_blocker = int(blockers.max(initial=0)) + 1
+    pair_codes, pairs = _factorized_ints(
+        actions[blocked_steps].astype(np.int64) * width_blocker + blockers[blocked_steps]
     )
-    pair_codes = pair_codes.reshape(-1)
     made: list[tuple[str, object]] = []
-    for action, code in pairs.tolist():
+    for action, code in (divmod(int(pair), width_blocker) for pair in pairs):
         blocker = world.blocker_of(code)
         assert blocker is not None  # a non-zero code always names a blocker
         event = builders.blocked_event(0, action=action, blocker=blocker)
         made.append((event.text, msgspec.to_builtins(event.data)))
     events = recording.events()
-    blocked = events.loc[events["kind"] == "blocked"]
-    found_steps = blocked["step"].to_numpy(np.int64)
-    texts, text_codes = _factorized(blocked["text"])
-    datas, data_codes = _factorized(blocked["data"])
+    # The blocked events' rows by position: no copy of the table's text columns.
+    rows = np.flatnonzero((events["kind"] == "blocked").to_numpy())
+    found_steps = events["step"].to_numpy(np.int64)[rows]
+    texts, text_codes = _factorized(events["text"])
+    datas, data_codes = _factorized(events["data"])
+    text_codes, data_codes = text_codes[rows], data_codes[rows]
     common = min(len(blocked_steps), len(found_steps))
     same = blocked_steps[:common] == found_steps[:common]
     # Each distinct (pair, text, data) among the events at the right steps, judged once.
@@ -279,15 +279,15 @@ def _check_blocked_events(
     triple = (pair_codes[:common] * width_text + text_codes[:common]) * width_data + data_codes[
         :common
     ]
-    distinct, triple_codes = np.unique(triple[same], return_inverse=True)
+    triple_codes, distinct = _factorized_ints(triple[same])
     right = np.ones(len(distinct), np.bool_)
     decode = msgspec.json.decode
-    for index, value in enumerate(distinct.tolist()):
+    for index, value in enumerate(distinct):
         rest, data = divmod(value, width_data)
         pair, text = divmod(rest, width_text)
         right[index] = made[pair][0] == texts[text] and made[pair][1] == decode(datas[data])
     ok = same.copy()
-    ok[same] = right[triple_codes.reshape(-1)]
+    ok[same] = right[triple_codes]
     wrong = np.flatnonzero(~ok)
     if len(wrong):
         at = int(wrong[0])
@@ -316,6 +316,12 @@ def _check_blocked_events(
             "blocked event",
             f"none recorded; the world: {made[int(pair_codes[common])][0]!r}",
         )
+
+
+def _factorized_ints(values: IntArray) -> tuple[IntArray, list[int]]:
+    """Each value's index among the distinct values, and those values (hashing, in C)."""
+    codes, uniques = pd.factorize(values)
+    return np.asarray(codes, np.int64), [int(value) for value in uniques]
 
 
 def _factorized(column: Any) -> tuple[Any, IntArray]:
