@@ -43,6 +43,7 @@ import numpy as np
 import numpy.typing as npt
 
 from rsstp_format.records import ModelRecord
+from rsstp_replay.audits._columns import first_indices
 from rsstp_replay.audits.summary import PhaseShare
 from rsstp_sim.memory import Memory
 from rsstp_sim.truth import GroundTruth
@@ -53,8 +54,6 @@ __all__ = ["Explanation", "Visited", "explain"]
 _IntArray = npt.NDArray[np.int64]
 _TOP = 5
 """The most visited states and classes listed."""
-_BLOCK = 1 << 16
-"""Steps whose first occurrences are found together."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -219,7 +218,7 @@ def explain(
     steps = memory.steps
     states = memory.internal_states
     sensations = memory.sensations
-    first_state = _first_steps(states)
+    first_state = first_indices(states)
     state_visits = _visits_of(states[1:], steps)
     sensed = np.flatnonzero(sensations)  # entries 0 .. T, the reset's too, as the summary
     feedback = memory.feedback
@@ -270,14 +269,14 @@ class _ClassFacts:
         actions: npt.NDArray[np.integer[Any]],
         steps: int,
     ) -> _ClassFacts:
-        first_class = _first_steps(true_class, size=truth.n_classes)
+        first_class = first_indices(true_class, size=truth.n_classes)
         visited = first_class >= 0
         # The transition taken at step t: (class at t - 1, the action's index in truth.actions).
         width = len(truth.actions)
         lookup = np.full(max(truth.actions) + 1, -1, np.int64)
         lookup[list(truth.actions)] = np.arange(width)
         transitions = true_class[:-1].astype(np.int64) * width + lookup[actions[1:]]
-        first_transition = _first_steps(transitions, size=truth.n_classes * width)
+        first_transition = first_indices(transitions, size=truth.n_classes * width)
         taken = first_transition[first_transition >= 0]
         return cls(
             visited=int(np.count_nonzero(visited)),
@@ -286,22 +285,6 @@ class _ClassFacts:
             last_new_transition=int(taken.max()) + 1 if len(taken) else None,
             target_moves=_moves_to_sensed(truth, visited),
         )
-
-
-def _first_steps(values: npt.NDArray[np.integer[Any]], *, size: int | None = None) -> _IntArray:
-    """For every value ``0 .. size - 1`` (default: the largest value + 1) the first index at
-    which ``values`` has it, -1 where it never does; a block of :data:`_BLOCK` values at a
-    time (a block holding nothing new costs one gather)."""
-    if size is None:
-        size = int(values.max(initial=-1)) + 1
-    first = np.full(size, -1, np.int64)
-    for start in range(0, len(values), _BLOCK):
-        block = values[start : start + _BLOCK]
-        new = np.flatnonzero(first[block] < 0)
-        if len(new):
-            found, at = np.unique(block[new], return_index=True)
-            first[found] = new[at] + start
-    return first
 
 
 def _visits_of(

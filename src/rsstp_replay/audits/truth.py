@@ -39,6 +39,7 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from rsstp_format.records import ModelRecord
+from rsstp_replay.audits._columns import first_indices
 from rsstp_replay.audits.consistency import (
     MAX_STEPS,
     ConsistencyFindings,
@@ -120,8 +121,12 @@ def _pairs(keys: NDArray[np.int64], values: NDArray[np.int64]) -> NDArray[np.int
 
 def _first_change(keys: NDArray[np.int64], values: NDArray[np.int64]) -> int | None:
     """First index where a key is seen with a value other than the one it first had."""
-    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
-    differs = values != values[first][inverse]
+    if len(keys) and int(keys.min()) >= 0 and int(keys.max()) < 4 * len(keys) + 2**16:
+        first = first_indices(keys)  # no sort of a long run's steps
+        differs = values != values[first[keys]]
+    else:
+        _, at, inverse = np.unique(keys, return_index=True, return_inverse=True)
+        differs = values != values[at][inverse]
     return int(np.argmax(differs)) if differs.any() else None
 
 
