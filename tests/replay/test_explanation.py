@@ -248,3 +248,16 @@ def test_the_command_lines_default_is_the_audits() -> None:
     from rsstp_replay.audits import MAX_STEPS
 
     assert _CONSISTENCY_STEPS == MAX_STEPS
+
+
+def test_a_consistency_budget_of_one_step_is_refused(tmp_path: Path) -> None:
+    done = subprocess.run(
+        [sys.executable, "-m", "rsstp_cli.replay", "audit", "--consistency-steps", "1", "x.mcap"],
+        capture_output=True,
+        text=True,
+        env={"PYTHONPATH": str(SRC)},
+        cwd=tmp_path,
+    )
+    assert done.returncode == 2
+    assert "--consistency-steps: expected 0 (every step) or at least 2, got 1" in done.stderr
+    assert "Traceback" not in done.stderr
