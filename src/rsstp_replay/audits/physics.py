@@ -152,17 +152,25 @@ def _unknown_action(actions: IntArray, known: tuple[int, ...]) -> PhysicsDiffere
 def _check_agent_view(steps: pd.DataFrame, world: Any, rows: IntArray) -> None:
     """The sensation and the feedback the agent was given are the world's at its pose."""
     all_sensations, all_feedback = world.senses()
-    sensation, feedback = all_sensations[rows], all_feedback[rows]
-    for name, want, got in (
-        ("agent.sensation", sensation, steps["sensation"].to_numpy(bool)),
-        ("agent.feedback", feedback, steps["feedback"].to_numpy(np.float64)),
-    ):
-        wrong = np.flatnonzero(want != got)
-        if wrong.size:
-            t = int(wrong[0])
-            raise PhysicsDifference(
-                t, name, f"recorded {_scalar(got[t])}, the world gives {_scalar(want[t])}"
-            )
+    recorded = (steps["sensation"].to_numpy(bool), steps["feedback"].to_numpy(np.float64))
+    for start in range(0, len(rows), _ROWS_AT_ONCE):  # a long run: a block of steps at a time
+        block = rows[start : start + _ROWS_AT_ONCE]
+        for name, want, got in (
+            ("agent.sensation", all_sensations[block], recorded[0][start : start + len(block)]),
+            ("agent.feedback", all_feedback[block], recorded[1][start : start + len(block)]),
+        ):
+            wrong = np.flatnonzero(want != got)
+            if wrong.size:
+                t = int(wrong[0])
+                raise PhysicsDifference(
+                    start + t,
+                    name,
+                    f"recorded {_scalar(got[t])}, the world gives {_scalar(want[t])}",
+                )
+
+
+_ROWS_AT_ONCE = 1 << 20
+"""Steps whose sensation and feedback :func:`_check_agent_view` compares together."""
 
 
 def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: IntArray) -> None:

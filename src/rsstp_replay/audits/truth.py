@@ -338,8 +338,7 @@ def audit_truth(
     memory = loaded.memory()
     versions = list(loaded.model_versions())
     states = np.asarray(memory.internal_states, dtype=np.int64)
-    step_numbers = np.arange(len(states), dtype=np.int64)
-    index = version_index(versions, step_numbers)
+    index = version_index(versions, np.arange(len(states), dtype=np.int64))
     columns = list(truth.value_names)
     verdict, equivalent = judge_versions(
         versions,
@@ -354,10 +353,9 @@ def audit_truth(
     # Within each version: keys (version index, state) and (version index, class).
     width_state = int(states.max(initial=0)) + 1
     width_class = truth.n_classes
-    state_key = index * width_state + states
-    class_key = index * width_class + true_class
-    aliased_step = _grouped_counts(state_key, true_class) > 1
-    redundant_step = _grouped_counts(class_key, states) > 1
+    # One key column at a time: a long run's columns are the audit's memory.
+    aliased_step = _grouped_counts(index * width_state + states, true_class) > 1
+    redundant_step = _grouped_counts(index * width_class + true_class, states) > 1
     n = len(versions)
     aliased_states = _distinct_per_version(index[aliased_step], states[aliased_step], n)
     redundant_classes = _distinct_per_version(index[redundant_step], true_class[redundant_step], n)
