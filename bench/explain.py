@@ -15,7 +15,8 @@ every step is in its ``home`` phase and the model stays one state. It is recorde
 
 Targets (issue 32, point 5): ``audit --truth`` of a 30,000,000-step failed run in at most 2
 minutes and 2 GiB (before: 844 s and 8.3 GB for 38.6 M steps, most in the consistency audit's
-suffix sort).
+suffix sort). On 2026-11-28, at a load of 5 to 9 on 2 cores: 471 s wall, 231 s CPU, 4.81 GiB
+(the code before this bench: 1,065 s, 365 s CPU, 6.14 GiB): missed, see docs/performance.md.
 """
 
 from __future__ import annotations
