@@ -187,6 +187,7 @@ _NO_MODEL = "none recorded (the agent kept no model; read as the one-state model
 
 def _cmd_audit(args: argparse.Namespace) -> int:
     from rsstp_replay.audits import audit_truth, run_audits
+    from rsstp_replay.audits.explanation import explain
     from rsstp_replay.audits.loaded import load
     from rsstp_replay.audits.physics import check_physics
 
@@ -204,16 +205,22 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         loaded = load(recording)  # the steps decoded once for every audit
         bar.to(1)
         bar.stage("auditing")
-        report = run_audits(loaded)
+        report = run_audits(loaded, consistency_steps=args.consistency_steps or None)
         physics = check_physics(recording, loaded.steps())
         bar.to(2)
-        truth = None
+        truth = explanation = None
         if args.truth:
             bar.stage("comparing with the truth")
-            truth = audit_truth(
-                loaded,
-                truth=recording.ground_truth(cache=not args.no_cache),
-                within_versions=report.within_versions,
+            ground_truth = recording.ground_truth(cache=not args.no_cache)
+            truth = audit_truth(loaded, truth=ground_truth, within_versions=report.within_versions)
+            explanation = explain(
+                loaded.memory(),
+                loaded.model_versions(),
+                phases=report.summary.phases,
+                feedback_mode=recording.scenario.feedback_mode,
+                truth=ground_truth,
+                true_class=truth.true_class,
+                learned=truth.verdict.learned,
             )
             bar.to(3)
     if args.json:
@@ -222,12 +229,18 @@ def _cmd_audit(args: argparse.Namespace) -> int:
             **report.to_json(),
             "physics": physics.to_json(),
         }
-        if truth is not None:
-            document = {"verdict": truth.verdict.to_json(), **document, "truth": truth.to_json()}
+        if truth is not None and explanation is not None:
+            document = {
+                "verdict": truth.verdict.to_json(),
+                "explanation": explanation.to_json(),
+                **document,
+                "truth": truth.to_json(),
+            }
         print(json.dumps(document, indent=2))
     else:
-        if truth is not None:
+        if truth is not None and explanation is not None:
             print(f"{truth.verdict.to_text()}\n")
+            print(f"== where the steps went ==\n{explanation.to_text()}\n")
         if not recording.has_model:
             print(f"model: {_NO_MODEL}\n")
         text = report.to_text()
@@ -421,6 +434,18 @@ def _cmd_export(args: argparse.Namespace) -> int:
     return 0
 
 
+_CONSISTENCY_STEPS = 1 << 21
+"""``rsstp_replay.audits.consistency.MAX_STEPS``, without importing the audits at start-up (a
+test checks they agree)."""
+
+
+def _count(text: str) -> int:
+    value = _integer(text)
+    if value < 0 or value == 1:
+        raise argparse.ArgumentTypeError(f"expected 0 (every step) or at least 2, got {value}")
+    return value
+
+
 def _integer(text: str) -> int:
     try:
         return int(text)
@@ -506,6 +531,14 @@ def _build_parser() -> Parser:
         action="append",
         choices=("contract",),
         help="exit with 0 even when the recording breaks the contract or its physics",
+    )
+    p.add_argument(
+        "--consistency-steps",
+        type=_count,
+        default=_CONSISTENCY_STEPS,
+        metavar="N",
+        help=f"judge contradictions in the last N steps of a longer run, and say so (default "
+        f"{_CONSISTENCY_STEPS:,}; 0: every step, minutes and gigabytes past ten million)",
     )
     add_no_cache(p)
     p.set_defaults(func=_cmd_audit)

@@ -53,6 +53,10 @@ __all__ = [
 ]
 
 
+_POSES_AT_ONCE = 1 << 20
+"""Rows :meth:`GroundTruth.poses_of` turns into pose indices together."""
+
+
 @dataclass(frozen=True, eq=False)
 class GroundTruth:
     """The reachable poses of a scenario as a Moore machine, and its minimisation.
@@ -173,15 +177,20 @@ class GroundTruth:
             big = [v for v in raw.ravel().tolist() if not -(2**62) < v < 2**62]
             if big:
                 raise TruthError(f"{self.scenario_name}: no pose has the value {big[0]}")
-        given = raw.astype(np.int64).reshape(-1, self.n_values)
+        given = raw.reshape(-1, self.n_values)
+        found = np.empty(len(given), np.int64)
+        for start in range(0, len(given), _POSES_AT_ONCE):  # a long run's columns: bounded
+            block = given[start : start + _POSES_AT_ONCE]
+            found[start : start + len(block)] = self._pose_block(block.astype(np.int64))
+        return found
+
+    def _pose_block(self, given: NDArray[np.int64]) -> NDArray[np.int64]:
         units = np.asarray(self.units, np.int64)
         radices = np.asarray(self.radices, np.int64)
         digits = given // units
         if self.wrap:
             digits %= radices
-            shown = digits * units
         else:
-            shown = given
             bad = ((digits < 0) | (digits >= radices) | (given % units != 0)).any(axis=1)
             if bad.any():
                 first = int(np.argmax(bad))
@@ -196,9 +205,9 @@ class GroundTruth:
         unreachable = self.pose_codes[index] != codes
         if unreachable.any():
             first = int(np.argmax(unreachable))
+            shown = digits[first] * units if self.wrap else given[first]
             raise TruthError(
-                f"{self.scenario_name}: the pose {shown[first].tolist()} is not reachable "
-                f"from the start"
+                f"{self.scenario_name}: the pose {shown.tolist()} is not reachable from the start"
             )
         return np.asarray(index, dtype=np.int64)
 
@@ -208,7 +217,11 @@ class GroundTruth:
         return np.asarray(self.true_class[self.poses_of(values)], dtype=np.int64)
 
     def classes_of_table(self, table: Any) -> NDArray[np.int64]:
-        """The class of every row of a steps table (its columns :attr:`value_names`)."""
+        """The class of every row of a steps table (its columns :attr:`value_names`), read a
+        column at a time (no copy of the table's pose columns as one int64 block)."""
+        columns = [table[name].to_numpy() for name in self.value_names]
+        if all(column.dtype.kind in "iu" for column in columns):
+            return self.classes_of(np.stack(columns, axis=1))
         return self.classes_of(table[list(self.value_names)].to_numpy(dtype=np.int64))
 
     def class_of(self, values: Sequence[int]) -> int:

@@ -206,6 +206,8 @@ def test_to_text_and_to_json() -> None:
     assert json.loads(json.dumps(document)) == document
     assert document == {
         "steps": 80,
+        "exact": True,
+        "sample": None,
         "consistent": False,
         "first_contradiction_step": 10,
         "contradictions": [

@@ -11,6 +11,8 @@ Each audit returns a frozen findings object with ``to_text()`` and ``to_json()``
   step (a state id means what its version says);
 - :func:`audit_truth`: the verdict (learned, from which step, or why not), and every model
   version against the ground truth (aliasing, redundancy, contradictions, equivalence);
+- :func:`explain`: where a run's steps went (phases, the states and classes it kept
+  revisiting, the last step it met anything new) and what would have helped;
 - :func:`state_roles`: what each state of each version stood for by the truth (exact,
   redundant, aliased, unvisited);
 - :func:`check_contract`: the step records against the model messages, at every step.
@@ -21,7 +23,9 @@ The audits read a recording through :class:`AuditSource` (``memory()``, ``model_
 
 from rsstp_replay.audits.compare import CompareFindings, HasMemory, compare
 from rsstp_replay.audits.consistency import (
+    MAX_STEPS,
     ConsistencyFindings,
+    Sample,
     StateContradiction,
     Witness,
     audit_consistency,
@@ -35,6 +39,7 @@ from rsstp_replay.audits.determinism import (
     VersionDeterminism,
     audit_determinism,
 )
+from rsstp_replay.audits.explanation import Explanation, Visited, explain
 from rsstp_replay.audits.report import AuditReport, run_audits
 from rsstp_replay.audits.state_roles import ROLE_NAMES, state_roles
 from rsstp_replay.audits.summary import AuditSource, ModelSize, SummaryFindings, audit_summary
@@ -55,16 +60,20 @@ __all__ = [
     "ContractFindings",
     "Counterexample",
     "DeterminismFindings",
+    "Explanation",
     "HasMemory",
+    "MAX_STEPS",
     "HasModelVersions",
     "ModelSize",
     "ROLE_NAMES",
+    "Sample",
     "StateContradiction",
     "SummaryFindings",
     "TruthFindings",
     "TruthSource",
     "Verdict",
     "VersionDeterminism",
+    "Visited",
     "Violation",
     "Witness",
     "audit_consistency",
@@ -74,6 +83,7 @@ __all__ = [
     "audit_truth",
     "check_contract",
     "compare",
+    "explain",
     "find_contradictions",
     "run_audits",
     "state_roles",

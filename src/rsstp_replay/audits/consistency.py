@@ -19,6 +19,16 @@ memory after each time is a suffix of the string ``y_t = (a_t, o_t)``, ``t = 1..
 So every contradicting pair of groups is one boundary between neighbours; its earliest end is
 ``max(first time in the left group, first time in the right group) + k``, and its best witness is
 those two first times. The whole audit is ``O(T log T)`` numpy work.
+
+Two things keep a long memory (tens of millions of steps) within seconds and a bounded memory:
+
+- a memory whose sensation never changes over ``1 .. T`` has no contradiction at all (the two
+  sensations at ``i + k`` and ``j + k`` must differ): that is decided exactly, without sorting
+  (a learner that never sensed its target);
+- otherwise, past ``max_steps`` steps only the last ``max_steps`` are audited, and the findings
+  say so (:attr:`ConsistencyFindings.sample`): every contradiction found there is one of the
+  whole memory (its witness holds as given), but contradictions with a time before the sample
+  are missed, and a state's ``first_step`` and ``pairs`` are counted inside the sample.
 """
 
 from __future__ import annotations
@@ -41,7 +51,9 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.words import counted
 
 __all__ = [
+    "MAX_STEPS",
     "ConsistencyFindings",
+    "Sample",
     "StateContradiction",
     "Witness",
     "audit_consistency",
@@ -51,6 +63,11 @@ __all__ = [
 ]
 
 _IntArray = npt.NDArray[np.int64]
+
+MAX_STEPS = 1 << 21
+"""The steps the audits judge for consistency by default (2,097,152): the last ones of a longer
+memory (``rsstp-replay audit --consistency-steps``). Ranking that many suffixes takes a few
+seconds and under 300 MiB."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -88,16 +105,46 @@ class StateContradiction:
 
 
 @dataclass(frozen=True, slots=True)
+class Sample:
+    """The part of a memory the consistency audit judged: both times of a pair and the
+    continuation after them in steps ``first_step .. last_step`` (the memory's last steps)."""
+
+    first_step: int
+    last_step: int
+
+    @property
+    def steps(self) -> int:
+        """The steps judged: ``last_step - first_step``."""
+        return self.last_step - self.first_step
+
+    def to_text(self) -> str:
+        return (
+            f"sampled: only the last {counted(self.steps, 'step')} (steps "
+            f"{self.first_step:,}..{self.last_step:,}) were judged; a contradiction with a time "
+            f"before step {self.first_step:,} is not seen"
+        )
+
+
+@dataclass(frozen=True, slots=True)
 class ConsistencyFindings:
-    """The result of the consistency audit over a memory of ``steps`` steps (``T``)."""
+    """The result of the consistency audit over a memory of ``steps`` steps (``T``).
+
+    ``sample``: None when every time was judged; else the last steps, which alone were (see
+    the module docstring)."""
 
     contradictions: tuple[StateContradiction, ...]
     steps: int
+    sample: Sample | None = None
 
     @property
     def consistent(self) -> bool:
-        """True when no internal state is contradicted."""
+        """True when no internal state is contradicted (in the :attr:`sample`, if any)."""
         return not self.contradictions
+
+    @property
+    def exact(self) -> bool:
+        """True when every time of the memory was judged (no :attr:`sample`)."""
+        return self.sample is None
 
     @property
     def first_contradiction_step(self) -> int | None:
@@ -109,8 +156,10 @@ class ConsistencyFindings:
     def to_text(self) -> str:
         """Human readable: one line per contradicted state, or one line saying it is consistent."""
         if not self.contradictions:
+            if self.sample is not None:
+                return f"consistent in the sample: no contradiction; {self.sample.to_text()}"
             return f"consistent: no contradiction in {counted(self.steps, 'step')}"
-        lines = []
+        lines = [] if self.sample is None else [self.sample.to_text()]
         for found in self.contradictions:
             witness = found.witness
             version = "" if found.version is None else f" of version {found.version}"
@@ -124,8 +173,13 @@ class ConsistencyFindings:
 
     def to_json(self) -> dict[str, Any]:
         """A JSON-ready dict (plain ints, bools, lists)."""
+        sample = self.sample
         return {
             "steps": self.steps,
+            "exact": self.exact,
+            "sample": None
+            if sample is None
+            else {"first_step": sample.first_step, "last_step": sample.last_step},
             "consistent": self.consistent,
             "first_contradiction_step": self.first_contradiction_step,
             "contradictions": [
@@ -146,13 +200,16 @@ class ConsistencyFindings:
         }
 
 
-def audit_consistency(memory: Memory) -> ConsistencyFindings:
-    """Find every internal state the memory contradicts (see the module docstring)."""
-    return find_contradictions(memory.actions, memory.internal_states, memory.sensations)
+def audit_consistency(memory: Memory, *, max_steps: int | None = None) -> ConsistencyFindings:
+    """Find every internal state the memory contradicts (see the module docstring); past
+    ``max_steps`` steps (None: no limit), in the last ``max_steps`` only."""
+    return find_contradictions(
+        memory.actions, memory.internal_states, memory.sensations, max_steps=max_steps
+    )
 
 
 def audit_consistency_by_version(
-    memory: Memory, model_versions: npt.ArrayLike
+    memory: Memory, model_versions: npt.ArrayLike, *, max_steps: int | None = None
 ) -> ConsistencyFindings:
     """Contradictions judged inside the model version in force at each step.
 
@@ -163,18 +220,18 @@ def audit_consistency_by_version(
     versions: they are what the world did.) Each finding names its version.
     """
     keys = _VersionStates(memory, model_versions)
-    (found,) = _contradictions(memory.actions, [keys.codes], memory.sensations)
+    (found,) = _contradictions(memory.actions, [keys.codes], memory.sensations, max_steps)
     return keys.named(found)
 
 
 def audit_consistency_both(
-    memory: Memory, model_versions: npt.ArrayLike
+    memory: Memory, model_versions: npt.ArrayLike, *, max_steps: int | None = None
 ) -> tuple[ConsistencyFindings, ConsistencyFindings]:
     """:func:`audit_consistency` and :func:`audit_consistency_by_version`, the memory's
     suffixes ranked once for both."""
     keys = _VersionStates(memory, model_versions)
     whole, found = _contradictions(
-        memory.actions, [memory.internal_states, keys.codes], memory.sensations
+        memory.actions, [memory.internal_states, keys.codes], memory.sensations, max_steps
     )
     return whole, keys.named(found)
 
@@ -206,32 +263,55 @@ class _VersionStates:
                 for item in found.contradictions
             ),
             found.steps,
+            found.sample,
         )
 
 
 def find_contradictions(
-    actions: npt.ArrayLike, states: npt.ArrayLike, sensations: npt.ArrayLike
+    actions: npt.ArrayLike,
+    states: npt.ArrayLike,
+    sensations: npt.ArrayLike,
+    *,
+    max_steps: int | None = None,
 ) -> ConsistencyFindings:
     """The consistency audit over memory columns, as in :class:`~rsstp_sim.memory.Memory`.
 
     ``actions[0]`` (the reset's, -1 in a memory) is ignored; actions and states may be any
     integers, sensations must be booleans. ``O(T log T)`` time, ``O(T log T)`` memory.
     Raises :class:`MemoryRangeError` for columns of different lengths, of the wrong kind, or
-    empty (the audit needs at least the reset entry).
+    empty (the audit needs at least the reset entry), and for a ``max_steps`` below 2. Past
+    ``max_steps`` steps (None: no limit) only the last ``max_steps`` are judged, and the
+    findings say so (:attr:`ConsistencyFindings.sample`).
     """
-    return _contradictions(actions, [states], sensations)[0]
+    return _contradictions(actions, [states], sensations, max_steps)[0]
 
 
 def _contradictions(
-    actions: npt.ArrayLike, labellings: list[npt.ArrayLike], sensations: npt.ArrayLike
+    actions: npt.ArrayLike,
+    labellings: list[npt.ArrayLike],
+    sensations: npt.ArrayLike,
+    max_steps: int | None = None,
 ) -> list[ConsistencyFindings]:
     """:func:`find_contradictions` of each labelling of one memory's times (internal states,
     or states of a version), its suffixes ranked once."""
+    if max_steps is not None and max_steps < 2:
+        raise MemoryRangeError(f"max_steps: expected at least 2 steps to judge, got {max_steps}")
     checked = [_validated(actions, states, sensations) for states in labellings]
     action_column, _, sensation_column = checked[0]
     steps = len(action_column) - 1
     if steps < 2:  # a contradiction needs i < j and j + k <= T with k >= 1
         return [ConsistencyFindings((), steps) for _ in labellings]
+    if not (sensation_column[1:] != sensation_column[1]).any():
+        # o_{i+k} != o_{j+k} is impossible: decided exactly, whatever the memory's length.
+        return [ConsistencyFindings((), steps) for _ in labellings]
+    if max_steps is not None and steps > max_steps:
+        first = steps - max_steps
+        window = _contradictions(
+            action_column[first:],
+            [np.asarray(states)[first:] for states in labellings],
+            sensation_column[first:] != 0,
+        )
+        return [_shifted(found, first, steps) for found in window]
     # Columns of one value per step in int32 where they fit (positions, ranks, codes): the
     # audit of ten million steps is bounded by its memory.
     positions = index_type(steps + 1)
@@ -303,6 +383,23 @@ def _contradictions_of(
     return ConsistencyFindings(
         _per_state(state_ids, boundary_state, witness_i, witness_j, k, pairs, action_column),
         steps,
+    )
+
+
+def _shifted(found: ConsistencyFindings, first: int, steps: int) -> ConsistencyFindings:
+    """Findings over the memory's entries ``first ..`` as findings over the whole memory of
+    ``steps`` steps, judged in that sample."""
+    return ConsistencyFindings(
+        tuple(
+            replace(
+                item,
+                witness=replace(item.witness, i=item.witness.i + first, j=item.witness.j + first),
+                first_step=item.first_step + first,
+            )
+            for item in found.contradictions
+        ),
+        steps,
+        Sample(first, steps),
     )
 
 

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 import msgspec
 import numpy as np
+import pandas as pd
 from numpy.typing import NDArray
 
 from rsstp_format import records
@@ -151,17 +152,25 @@ def _unknown_action(actions: IntArray, known: tuple[int, ...]) -> PhysicsDiffere
 def _check_agent_view(steps: pd.DataFrame, world: Any, rows: IntArray) -> None:
     """The sensation and the feedback the agent was given are the world's at its pose."""
     all_sensations, all_feedback = world.senses()
-    sensation, feedback = all_sensations[rows], all_feedback[rows]
-    for name, want, got in (
-        ("agent.sensation", sensation, steps["sensation"].to_numpy(bool)),
-        ("agent.feedback", feedback, steps["feedback"].to_numpy(np.float64)),
-    ):
-        wrong = np.flatnonzero(want != got)
-        if wrong.size:
-            t = int(wrong[0])
-            raise PhysicsDifference(
-                t, name, f"recorded {_scalar(got[t])}, the world gives {_scalar(want[t])}"
-            )
+    recorded = (steps["sensation"].to_numpy(bool), steps["feedback"].to_numpy(np.float64))
+    for start in range(0, len(rows), _ROWS_AT_ONCE):  # a long run: a block of steps at a time
+        block = rows[start : start + _ROWS_AT_ONCE]
+        for name, want, got in (
+            ("agent.sensation", all_sensations[block], recorded[0][start : start + len(block)]),
+            ("agent.feedback", all_feedback[block], recorded[1][start : start + len(block)]),
+        ):
+            wrong = np.flatnonzero(want != got)
+            if wrong.size:
+                t = int(wrong[0])
+                raise PhysicsDifference(
+                    start + t,
+                    name,
+                    f"recorded {_scalar(got[t])}, the world gives {_scalar(want[t])}",
+                )
+
+
+_ROWS_AT_ONCE = 1 << 20
+"""Steps whose sensation and feedback :func:`_check_agent_view` compares together."""
 
 
 def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: IntArray) -> None:
@@ -250,48 +259,80 @@ def _check_blocked_events(
     """A ``blocked`` event at exactly the blocked steps, with the action and the blocker.
 
     An event's text and data depend only on the action and the blocker, so each pair's are
-    built once; data are compared as decoded JSON (key order and spacing do not count)."""
-    made: dict[tuple[int, int], tuple[str, object]] = {}
-    expected = []
-    for step in np.flatnonzero(blockers).tolist():
-        key = (int(actions[step]), int(blockers[step]))
-        if key not in made:
-            blocker = world.blocker_of(key[1])
-            assert blocker is not None  # a non-zero code always names a blocker
-            event = builders.blocked_event(step, action=key[0], blocker=blocker)
-            made[key] = (event.text, msgspec.to_builtins(event.data))
-        expected.append((step, *made[key]))
+    built once, and each distinct (pair, recorded text, recorded data) is compared once: data
+    as decoded JSON (key order and spacing do not count). The events are matched in numpy (a
+    long run has millions); the first that differs is named."""
+    blocked_steps = np.flatnonzero(blockers)
+    width_blocker = int(blockers.max(initial=0)) + 1
+    pair_codes, pairs = _factorized_ints(
+        actions[blocked_steps].astype(np.int64) * width_blocker + blockers[blocked_steps]
+    )
+    made: list[tuple[str, object]] = []
+    for action, code in (divmod(int(pair), width_blocker) for pair in pairs):
+        blocker = world.blocker_of(code)
+        assert blocker is not None  # a non-zero code always names a blocker
+        event = builders.blocked_event(0, action=action, blocker=blocker)
+        made.append((event.text, msgspec.to_builtins(event.data)))
     events = recording.events()
-    blocked = events.loc[events["kind"] == "blocked"]
+    # The blocked events' rows by position: no copy of the table's text columns.
+    rows = np.flatnonzero((events["kind"] == "blocked").to_numpy())
+    found_steps = events["step"].to_numpy(np.int64)[rows]
+    texts, text_codes = _factorized(events["text"])
+    datas, data_codes = _factorized(events["data"])
+    text_codes, data_codes = text_codes[rows], data_codes[rows]
+    common = min(len(blocked_steps), len(found_steps))
+    same = blocked_steps[:common] == found_steps[:common]
+    # Each distinct (pair, text, data) among the events at the right steps, judged once.
+    width_text, width_data = max(len(texts), 1), max(len(datas), 1)
+    triple = (pair_codes[:common] * width_text + text_codes[:common]) * width_data + data_codes[
+        :common
+    ]
+    triple_codes, distinct = _factorized_ints(triple[same])
+    right = np.ones(len(distinct), np.bool_)
     decode = msgspec.json.decode
-    found = [
-        (int(step), str(text), data)
-        for step, text, data in zip(
-            blocked["step"].tolist(), blocked["text"].tolist(), blocked["data"].tolist(),
-            strict=True,
-        )
-    ]  # fmt: skip
-    for want, got in zip(expected, found, strict=False):
-        if want[:2] == got[:2] and want[2] == decode(got[2]):  # the data as JSON text
-            continue
-        if want[0] < got[0]:
+    for index, value in enumerate(distinct):
+        rest, data = divmod(value, width_data)
+        pair, text = divmod(rest, width_text)
+        right[index] = made[pair][0] == texts[text] and made[pair][1] == decode(datas[data])
+    ok = same.copy()
+    ok[same] = right[triple_codes]
+    wrong = np.flatnonzero(~ok)
+    if len(wrong):
+        at = int(wrong[0])
+        want_step, want_text = int(blocked_steps[at]), made[int(pair_codes[at])][0]
+        got_step, got_text = int(found_steps[at]), str(texts[text_codes[at]])
+        if want_step < got_step:
             raise PhysicsDifference(
-                want[0], "blocked event", f"none recorded; the world: {want[1]!r}"
+                want_step, "blocked event", f"none recorded; the world: {want_text!r}"
             )
-        if got[0] < want[0]:
+        if got_step < want_step:
             raise PhysicsDifference(
-                got[0], "blocked event", f"recorded {got[1]!r}; the world moves"
+                got_step, "blocked event", f"recorded {got_text!r}; the world moves"
             )
         raise PhysicsDifference(
-            want[0], "blocked event", f"recorded {got[1]!r}; the world: {want[1]!r}"
+            want_step, "blocked event", f"recorded {got_text!r}; the world: {want_text!r}"
         )
-    if len(found) > len(expected):
-        extra = found[len(expected)]
+    if len(found_steps) > common:
         raise PhysicsDifference(
-            extra[0], "blocked event", f"recorded {extra[1]!r}; the world moves"
+            int(found_steps[common]),
+            "blocked event",
+            f"recorded {str(texts[text_codes[common]])!r}; the world moves",
         )
-    if len(expected) > len(found):
-        missing = expected[len(found)]
+    if len(blocked_steps) > common:
         raise PhysicsDifference(
-            missing[0], "blocked event", f"none recorded; the world: {missing[1]!r}"
+            int(blocked_steps[common]),
+            "blocked event",
+            f"none recorded; the world: {made[int(pair_codes[common])][0]!r}",
         )
+
+
+def _factorized_ints(values: IntArray) -> tuple[IntArray, list[int]]:
+    """Each value's index among the distinct values, and those values (hashing, in C)."""
+    codes, uniques = pd.factorize(values)
+    return np.asarray(codes, np.int64), [int(value) for value in uniques]
+
+
+def _factorized(column: Any) -> tuple[Any, IntArray]:
+    """A text column's distinct values and each row's index among them (hashing, in C)."""
+    codes, uniques = pd.factorize(column)
+    return np.asarray(uniques, dtype=object), np.asarray(codes, np.int64)

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from rsstp_replay.audits.consistency import (
+    MAX_STEPS,
     ConsistencyFindings,
     audit_consistency,
     audit_consistency_both,
@@ -87,6 +88,7 @@ class AuditReport:
         within, history = self.within_versions, self.consistency
         final = self.determinism.final.version
         in_final = [f for f in within.contradictions if f.version == final]
+        sampled = [] if within.sample is None else [within.sample.to_text()]
         if within.consistent:
             steps = counted(within.steps, "step")
             lines = [f"within each model version: no contradictory state in {steps}"]
@@ -105,6 +107,7 @@ class AuditReport:
             ]
             shown = in_final or list(within.contradictions[-_TEXT_LIMIT:])
             lines += [f"  {line}" for line in _short_text(ConsistencyFindings(tuple(shown), 0))]
+        lines = sampled + lines
         if history.consistent:
             lines.append(
                 "accumulated over the whole history: no contradictory state in "
@@ -133,24 +136,27 @@ class AuditReport:
         }
 
 
-def run_audits(source: AuditSource) -> AuditReport:
+def run_audits(source: AuditSource, *, consistency_steps: int | None = MAX_STEPS) -> AuditReport:
     """Run the consistency, determinism, summary and contract audits over ``source`` (a
     recording, or a :class:`~rsstp_replay.audits.loaded.LoadedRecording` of one).
 
     The memory, the model messages and the steps table are read once, and the memory is
-    audited once for consistency (the summary reuses that audit).
+    audited once for consistency (the summary reuses that audit): in its last
+    ``consistency_steps`` steps when it is longer (None: every step), which the findings say
+    (:attr:`ConsistencyFindings.sample`).
     """
     loaded = load(source)
     steps, memory = loaded.steps(), loaded.memory()
     versions = steps["model_version"].to_numpy(np.int64)
     if len(versions) and (versions == versions[0]).all():  # one version: the same audit
-        consistency = audit_consistency(memory)
+        consistency = audit_consistency(memory, max_steps=consistency_steps)
         within = ConsistencyFindings(
             tuple(replace(found, version=int(versions[0])) for found in consistency.contradictions),
             consistency.steps,
+            consistency.sample,
         )
     else:
-        consistency, within = audit_consistency_both(memory, versions)
+        consistency, within = audit_consistency_both(memory, versions, max_steps=consistency_steps)
     return AuditReport(
         summary=audit_summary(loaded, consistency=consistency),
         consistency=consistency,

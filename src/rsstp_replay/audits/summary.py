@@ -33,7 +33,7 @@ import pandas as pd
 
 from rsstp_format.records import ModelRecord
 from rsstp_replay.audits.compare import HasMemory
-from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency
+from rsstp_replay.audits.consistency import ConsistencyFindings, Sample, audit_consistency
 from rsstp_replay.audits.determinism import HasModelVersions
 from rsstp_sim.errors import ModelError
 from rsstp_sim.runner import stop_text
@@ -111,7 +111,8 @@ class SummaryFindings:
     which the memory contradicted any state, ``last_contradiction_step`` the latest step at
     which a state became contradictory (the largest ``first_step`` of the consistency audit).
     ``phases``: the steps per phase the strategy recorded, in the order first entered (empty if
-    it recorded none); ``stop``: how the strategy ended the run, or None.
+    it recorded none); ``stop``: how the strategy ended the run, or None;
+    ``consistency_sample``: the steps the contradictions were judged in, when not all were.
     """
 
     steps: int
@@ -130,6 +131,7 @@ class SummaryFindings:
     final_deterministic: bool
     phases: tuple[PhaseShare, ...] = ()
     stop: Stop | None = None
+    consistency_sample: Sample | None = None
 
     @property
     def final_size(self) -> ModelSize:
@@ -162,6 +164,11 @@ class SummaryFindings:
                 f"{_plural(self.contradictory_states, 'contradictory state')}, first at step "
                 f"{self.first_contradiction_step}, last new one at step "
                 f"{self.last_contradiction_step}"
+            )
+        if self.consistency_sample is not None:
+            contradictions += (
+                f" (judged in the last {self.consistency_sample.steps:,} steps only, from step "
+                f"{self.consistency_sample.first_step:,})"
             )
         phases = ", ".join(
             f"{p.phase} {100 * p.share:.1f} % ({p.steps:,} steps)" for p in self.phases
@@ -209,6 +216,12 @@ class SummaryFindings:
                 "states": self.contradictory_states,
                 "first_step": self.first_contradiction_step,
                 "last_step": self.last_contradiction_step,
+                "sample": None
+                if self.consistency_sample is None
+                else {
+                    "first_step": self.consistency_sample.first_step,
+                    "last_step": self.consistency_sample.last_step,
+                },
             },
             "phases": {p.phase: {"steps": p.steps, "share": p.share} for p in self.phases},
             "stopped": None
@@ -272,6 +285,7 @@ def audit_summary(
         final_deterministic=final_model.is_deterministic(),
         phases=phase_shares(events, memory.steps),
         stop=strategy_stop(events),
+        consistency_sample=consistency.sample,
     )
 
 

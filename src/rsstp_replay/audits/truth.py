@@ -39,7 +39,13 @@ import pandas as pd
 from numpy.typing import NDArray
 
 from rsstp_format.records import ModelRecord
-from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
+from rsstp_replay.audits._columns import first_indices
+from rsstp_replay.audits.consistency import (
+    MAX_STEPS,
+    ConsistencyFindings,
+    Sample,
+    audit_consistency_by_version,
+)
 from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
@@ -115,8 +121,12 @@ def _pairs(keys: NDArray[np.int64], values: NDArray[np.int64]) -> NDArray[np.int
 
 def _first_change(keys: NDArray[np.int64], values: NDArray[np.int64]) -> int | None:
     """First index where a key is seen with a value other than the one it first had."""
-    _, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
-    differs = values != values[first][inverse]
+    if len(keys) and int(keys.min()) >= 0 and int(keys.max()) < 4 * len(keys) + 2**16:
+        first = first_indices(keys)  # no sort of a long run's steps
+        differs = values != values[first[keys]]
+    else:
+        _, at, inverse = np.unique(keys, return_index=True, return_inverse=True)
+        differs = values != values[at][inverse]
     return int(np.argmax(differs)) if differs.any() else None
 
 
@@ -150,6 +160,7 @@ class TruthFindings:
     memory's contradictions between two times in the same state of this version) and
     ``equivalent`` (to the truth, where it came into force). ``aliased_step`` says per step
     whether its internal state stood for several true classes under its version.
+    ``consistency_sample``: the steps ``contradictory_states`` was judged in, when not all were.
     """
 
     scenario: str
@@ -166,6 +177,7 @@ class TruthFindings:
     final_redundant: Mapping[int, tuple[int, ...]]
     true_class: NDArray[np.int64] = field(repr=False, compare=False)
     aliased_step: NDArray[np.bool_] = field(repr=False, compare=False)
+    consistency_sample: Sample | None = None
 
     @property
     def learned_at_step(self) -> int | None:
@@ -213,7 +225,10 @@ class TruthFindings:
             ("redundant_classes", "a true class was spread over several states"),
             ("contradictory_states", "the memory contradicts a state"),
         ):
-            lines.append(f"  {what}: {_versions_with(table, column)}")
+            sampled = ""
+            if column == "contradictory_states" and self.consistency_sample is not None:
+                sampled = f" (judged in steps {self.consistency_sample.first_step:,}.. only)"
+            lines.append(f"  {what}: {_versions_with(table, column)}{sampled}")
         for state, classes in sorted(self.final_aliased.items())[:10]:
             lines.append(f"    final version: state {state:,} stood for classes {_short(classes)}")
         for cls, states in sorted(self.final_redundant.items())[:10]:
@@ -268,6 +283,12 @@ class TruthFindings:
             "versions": {
                 column: self.versions[column].tolist() for column in self.versions.columns
             },
+            "consistency_sample": None
+            if self.consistency_sample is None
+            else {
+                "first_step": self.consistency_sample.first_step,
+                "last_step": self.consistency_sample.last_step,
+            },
             "history": {
                 "classes_visited": self.classes_visited,
                 "internal_states_visited": len(self.classes_of_state),
@@ -304,10 +325,12 @@ def audit_truth(
     *,
     truth: GroundTruth | None = None,
     within_versions: ConsistencyFindings | None = None,
+    consistency_steps: int | None = MAX_STEPS,
 ) -> TruthFindings:
     """Run the truth audit. The ground truth is computed unless ``truth`` is given, and the
     consistency audit within versions unless ``within_versions`` is (an
-    :class:`~rsstp_replay.audits.report.AuditReport` has it)."""
+    :class:`~rsstp_replay.audits.report.AuditReport` has it), in the last
+    ``consistency_steps`` steps of a longer memory (None: every step)."""
     truth = load_truth(source.scenario) if truth is None else truth
     loaded = load(source)
     steps = loaded.steps()
@@ -315,8 +338,7 @@ def audit_truth(
     memory = loaded.memory()
     versions = list(loaded.model_versions())
     states = np.asarray(memory.internal_states, dtype=np.int64)
-    step_numbers = np.arange(len(states), dtype=np.int64)
-    index = version_index(versions, step_numbers)
+    index = version_index(versions, np.arange(len(states), dtype=np.int64))
     columns = list(truth.value_names)
     verdict, equivalent = judge_versions(
         versions,
@@ -331,15 +353,14 @@ def audit_truth(
     # Within each version: keys (version index, state) and (version index, class).
     width_state = int(states.max(initial=0)) + 1
     width_class = truth.n_classes
-    state_key = index * width_state + states
-    class_key = index * width_class + true_class
-    aliased_step = _grouped_counts(state_key, true_class) > 1
-    redundant_step = _grouped_counts(class_key, states) > 1
+    # One key column at a time: a long run's columns are the audit's memory.
+    aliased_step = _grouped_counts(index * width_state + states, true_class) > 1
+    redundant_step = _grouped_counts(index * width_class + true_class, states) > 1
     n = len(versions)
     aliased_states = _distinct_per_version(index[aliased_step], states[aliased_step], n)
     redundant_classes = _distinct_per_version(index[redundant_step], true_class[redundant_step], n)
     contradictions = within_versions or audit_consistency_by_version(
-        memory, steps["model_version"].to_numpy(np.int64)
+        memory, steps["model_version"].to_numpy(np.int64), max_steps=consistency_steps
     )
     numbers = [record.version for record in versions]
     contradicted = np.zeros(n, np.int64)
@@ -385,6 +406,7 @@ def audit_truth(
         },
         true_class=true_class,
         aliased_step=aliased_step,
+        consistency_sample=contradictions.sample,
     )
 
 

@@ -275,6 +275,19 @@ class _Visits:
     @classmethod
     def of(cls, index: _Ints, states: _Ints, true_class: _Ints, n_versions: int) -> _Visits:
         keep = index >= 0
+        width_state = int(states.max(initial=0)) + 1
+        width_class = int(true_class.max(initial=0)) + 1
+        if (
+            int(states.min(initial=0)) >= 0
+            and int(true_class.min(initial=0)) >= 0
+            and n_versions * width_state * width_class < 2**62
+        ):  # one integer per triple: a hashed unique, no sort of a long run's steps
+            packed = (index[keep] * width_state + states[keep]) * width_class + true_class[keep]
+            distinct = np.unique(packed)
+            del packed
+            rest, c = np.divmod(distinct, width_class)
+            v, s = np.divmod(rest, width_state)
+            return cls(s, c, np.searchsorted(v, np.arange(n_versions + 1, dtype=np.int64)))
         order = np.lexsort((true_class[keep], states[keep], index[keep]))
         v, s, c = index[keep][order], states[keep][order], true_class[keep][order]
         first = np.ones(len(v), np.bool_)

@@ -261,27 +261,20 @@ class Recording:
         (``blocked_kind`` and its indices; ``blocked`` stays): no audit reads them, and
         they are a third of the table's memory without the geometry."""
         self._check_open()
-        events: list[Any] | None = [] if self._events is None else None
+        events = _EventParts() if self._events is None else None
         columns = self._step_columns(truth=True, events=events, numbers=geometry)
         self._log_times = columns.log_time
         if events is not None:
-            self._events = self._event_table(events)
+            self._events = events.table()
         steps = columns.frame(geometry=geometry, blockers=blockers)
         return steps, self.events()
 
-    def _event_table(self, events: list[Any] | None = None) -> pd.DataFrame:
-        if events is None:
-            events = self._records("/rsstp/event")
-        return pd.DataFrame(
-            {
-                "step": np.array([e.step for e in events], np.int64),
-                "kind": pd.Categorical([e.kind for e in events], categories=EVENT_KINDS),
-                "text": pd.array([e.text for e in events], dtype="str"),
-                "data": pd.array(
-                    [msgspec.json.encode(e.data).decode() for e in events], dtype="str"
-                ),
-            }
-        )
+    def _event_table(self) -> pd.DataFrame:
+        events = _EventParts()
+        for ref, _, views, times in self._chunks("/rsstp/event"):
+            events.add(self._chunk_records("/rsstp/event", ref, views, times))
+        self._counted("/rsstp/event", events.count)
+        return events.table()
 
     def verify_chunks(self) -> int:
         """Read, decompress and CRC-check every chunk; the number of chunks. Raises
@@ -473,11 +466,11 @@ class Recording:
             ) from None
 
     def _step_columns(
-        self, *, truth: bool, events: list[Any] | None = None, numbers: bool = True
+        self, *, truth: bool, events: _EventParts | None = None, numbers: bool = True
     ) -> StepColumns:
-        """Decode and check every step message; with ``events``, add every event's record
-        to it, read in the same pass over the chunks; ``numbers``: an arm's joint positions
-        and distances too (the table's geometry)."""
+        """Decode and check every step message; with ``events``, add each chunk's events to
+        it, read in the same pass over the chunks; ``numbers``: an arm's joint positions and
+        distances too (the table's geometry)."""
         columns = self._new_step_columns(truth=truth, numbers=numbers)
         for _ in self._decoding(columns, events):
             pass
@@ -516,20 +509,22 @@ class Recording:
         return StepColumns(n_rows, truth=pose, kinds=reader.kinds)
 
     def _decoding(
-        self, columns: StepColumns, events: list[Any] | None
+        self, columns: StepColumns, events: _EventParts | None
     ) -> Generator[None, None, None]:
         """Decode the step messages into ``columns`` chunk by chunk (pausing after each);
-        with ``events``, add every event's record to it from the same chunks."""
+        with ``events``, add to it each chunk's events as a part of the events table."""
         topics = ("/rsstp/step",) if events is None else ("/rsstp/step", "/rsstp/event")
         with gc_paused():
             for ref, data, found in self._chunks_of(topics):
                 self._decode_steps(columns, ref, data, found[0].views(data), found[0].times)
                 if events is not None:
                     event_parts = found[1].views(data)
-                    events += self._chunk_records("/rsstp/event", ref, event_parts, found[1].times)
+                    events.add(
+                        self._chunk_records("/rsstp/event", ref, event_parts, found[1].times)
+                    )
                 yield
         if events is not None:
-            self._counted("/rsstp/event", len(events))
+            self._counted("/rsstp/event", events.count)
 
     def _check_steps(self, columns: StepColumns) -> None:
         try:
@@ -584,3 +579,48 @@ def _row(columns: StepColumns, step: int) -> _AgentRow | None:
         int(columns.internal_state[index]),
         int(columns.model_version[index]),
     )
+
+
+_EVENT_KIND_DTYPE = pd.CategoricalDtype(list(EVENT_KINDS))
+
+
+class _EventParts:
+    """The events table built as its records are read, a part of at least :attr:`ROWS` rows
+    at a time, its text in Arrow strings: a long run has millions of events, and kept as
+    records until the end they took most of the memory of reading it."""
+
+    ROWS = 1 << 16
+
+    def __init__(self) -> None:
+        self.count = 0
+        self._parts: list[pd.DataFrame] = []
+        self._pending: list[Any] = []
+
+    def add(self, records: list[Any]) -> None:
+        self.count += len(records)
+        self._pending += records
+        if len(self._pending) >= self.ROWS:
+            self._flush()
+
+    def _flush(self) -> None:
+        events, self._pending = self._pending, []
+        self._parts.append(
+            pd.DataFrame(
+                {
+                    "step": np.array([e.step for e in events], np.int64),
+                    "kind": pd.Categorical([e.kind for e in events], dtype=_EVENT_KIND_DTYPE),
+                    "text": pd.array([e.text for e in events], dtype="str"),
+                    "data": pd.array(
+                        [msgspec.json.encode(e.data).decode() for e in events], dtype="str"
+                    ),
+                }
+            )
+        )
+
+    def table(self) -> pd.DataFrame:
+        """One row per event, in order, indexed ``0 .. n - 1``."""
+        if self._pending or not self._parts:
+            self._flush()
+        if len(self._parts) == 1:
+            return self._parts[0]
+        return pd.concat(self._parts, ignore_index=True)
