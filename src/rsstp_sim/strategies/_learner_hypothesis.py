@@ -30,6 +30,10 @@ FloatArray = NDArray[np.float64]
 FAR = np.iinfo(np.int64).max // 4
 """The distance to the landmark of a state with no confirmed path to it."""
 
+EVIDENCE = 4
+"""The confirmed moves by an action, from states known whole, that :meth:`Hypothesis.irreversible`
+needs before it finds that no action undoes it."""
+
 
 class Hypothesis:
     """Labels, confirmed successors and the landmark, over the model's state ids.
@@ -387,6 +391,28 @@ class Hypothesis:
         """Whether the confirmed transitions show an action undoing each action
         (:meth:`inverses`): then no move leads into a part of the world the agent cannot leave."""
         return len(self.inverses()) == len(self.actions)
+
+    def irreversible(self) -> bool:
+        """Whether the confirmed transitions show an action that no action undoes: one with
+        at least :data:`EVIDENCE` confirmed moves ``s -a-> t`` (``t != s``) from states ``t``
+        whose every transition is confirmed, and no action taking most of those ``t`` back
+        to their ``s``. Too few such moves prove nothing: a world the agent has seen little
+        of is not taken as one it cannot return from."""
+        states = np.flatnonzero(self.alive)
+        whole = states[(self.next[states] >= 0).all(axis=1)]
+        known = np.zeros(len(self.label), dtype=bool)
+        known[whole] = True
+        for ka in range(len(self.actions)):
+            t = self.next[states, ka]
+            moved = (t >= 0) & (t != states)
+            moved[moved] = known[t[moved]]
+            sources, targets = states[moved], t[moved]
+            if len(sources) < EVIDENCE:
+                continue
+            back = self.next[targets] == sources[:, None]
+            if not (2 * back.sum(axis=0) >= len(sources)).any():
+                return True
+        return False
 
     def reachable(self) -> set[int]:
         """The states reachable from the landmark over confirmed transitions."""

@@ -14,7 +14,16 @@ import numpy as np
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR, Hypothesis
 
-__all__ = ["CONFINED_STEPS", "LONGEST_RUN", "PHASES", "Confined", "Plan", "Refuted", "Walker"]
+__all__ = [
+    "CONFINED_STEPS",
+    "LONGEST_RUN",
+    "PHASES",
+    "UNPROVEN",
+    "Confined",
+    "Plan",
+    "Refuted",
+    "Walker",
+]
 
 LONGEST_RUN = 16
 """The longest run of one action in a random search."""
@@ -39,6 +48,10 @@ PHASES = {
 CONFINED_STEPS = 16_384
 """The shortest search for the landmark after which the agent may conclude it is confined (a
 world of a thousand classes, lost early, can take thousands of steps to find it again)."""
+
+UNPROVEN = 16
+"""How many times longer the search lasts before the agent takes itself as confined when its
+confirmed transitions show no move that cannot be undone (:meth:`Walker.check_confined`)."""
 
 Plan = Generator[int, bool, None]
 """A plan: yields the next action, receives the sensation that followed it."""
@@ -259,11 +272,15 @@ class Walker:
     def check_confined(self) -> None:
         """After a step of a search for the landmark: raise :class:`Confined` when the search
         has lasted 16 times as long as the run before it, :data:`CONFINED_STEPS`, and a run of
-        :data:`LONGEST_RUN` steps per state and action of the hypothesis, unless the confirmed
-        transitions show an action undoing each action (:meth:`Hypothesis.reversible`): where
-        every move can be undone no part of the world is a trap, and the search goes on. A
-        heuristic: from sensations alone, a part of the world that never senses cannot be told
-        from a search that has not yet found the sensed pose."""
+        :data:`LONGEST_RUN` steps per state and action of the hypothesis, and the confirmed
+        transitions show an action that no action undoes (:meth:`Hypothesis.irreversible`).
+        When they show neither that nor an action undoing each action
+        (:meth:`Hypothesis.reversible`), the search lasts :data:`UNPROVEN` times as long first
+        (a generated two-link world between two obstacles, its landmark found by luck at step
+        107, took more than 16,384 steps to find again); when they show every move undone, no
+        part of the world is a trap and the search goes on. A heuristic: from sensations alone,
+        a part of the world that never senses cannot be told from a search that has not yet
+        found the sensed pose."""
         searched = self.agent.step - self.last_seen
         if searched < self._confinement or self.confined is not None or not self.seen:
             return
@@ -271,7 +288,9 @@ class Walker:
         bound = max(
             CONFINED_STEPS, 16 * self.last_seen, LONGEST_RUN * len(h.labels) * len(h.actions)
         )
-        if searched >= bound and not h.reversible():
+        if searched >= bound and h.irreversible():
+            raise Confined(self.last_seen)
+        if searched >= UNPROVEN * bound and not h.reversible():
             raise Confined(self.last_seen)
         self._confinement = max(bound, searched + CONFINED_STEPS)
 
