@@ -21,13 +21,16 @@ def view_frame(scenario: AnyScenario) -> ViewFrame:
     return body_view(scenario.body).frame(scenario)
 
 
-def default_blueprint(scenario: AnyScenario, *, first: int, last: int) -> rrb.Blueprint:
+def default_blueprint(
+    scenario: AnyScenario, *, first: int, last: int, with_map: bool = False
+) -> rrb.Blueprint:
     """Two 2D views side by side, both framing the arm's reach and the obstacles: the world
     (the arm, obstacles, feedback points, sensor, blocked moves) and the model drawn on the
     world (its states where the arm was, its transitions, the current state, over the
-    obstacles); below them the plots (sensation and feedback, obstacle distances, model size,
-    their time axes linked and showing steps ``first .. last``) and the audit log; the
-    ``step`` timeline selected."""
+    obstacles); ``with_map``, a third: the model map of the joint space
+    (:mod:`~rsstp_replay.viewer._map`); below them the plots (sensation and feedback,
+    obstacle distances, model size, their time axes linked and showing steps ``first ..
+    last``) and the audit log; the ``step`` timeline selected."""
     (cx, cy), half, _ = view_frame(scenario)
     # The world's entity mirrors y (Rerun draws y downwards): the bounds are the mirror's.
     bounds = rrb.VisualBounds2D(x_range=[cx - half, cx + half], y_range=[-cy - half, -cy + half])
@@ -43,27 +46,30 @@ def default_blueprint(scenario: AnyScenario, *, first: int, last: int) -> rrb.Bl
             axis_x=rrb.TimeAxis(link="LinkToGlobal", view_range=steps),
         )
 
+    views: list[rrb.View] = [
+        rrb.Spatial2DView(
+            name="World",
+            origin="/",
+            contents=["+ /world/**", "- /world/model/**"],
+            visual_bounds=bounds,
+        ),
+        rrb.Spatial2DView(
+            name="Model on the world",
+            origin="/",
+            contents=[
+                "+ /world",
+                "+ /world/obstacles",
+                "+ /world/feedback_points",
+                "+ /world/model/**",
+            ],
+            visual_bounds=bounds,
+        ),
+    ]
+    if with_map:
+        views.append(rrb.Spatial2DView(name="Model map (joint space)", origin="/map"))
     return rrb.Blueprint(
         rrb.Vertical(
-            rrb.Horizontal(
-                rrb.Spatial2DView(
-                    name="World",
-                    origin="/",
-                    contents=["+ /world/**", "- /world/model/**"],
-                    visual_bounds=bounds,
-                ),
-                rrb.Spatial2DView(
-                    name="Model on the world",
-                    origin="/",
-                    contents=[
-                        "+ /world",
-                        "+ /world/obstacles",
-                        "+ /world/feedback_points",
-                        "+ /world/model/**",
-                    ],
-                    visual_bounds=bounds,
-                ),
-            ),
+            rrb.Horizontal(*views),
             rrb.Horizontal(
                 plot("Sensation and feedback", "/plots/agent"),
                 plot("Obstacle distances", "/plots/distance"),
