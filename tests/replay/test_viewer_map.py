@@ -15,7 +15,7 @@ from test_viewer import LEARNER, Rrd, _rgb
 
 from rsstp_replay.audits.state_roles import ALIASED, EXACT, REDUNDANT, UNVISITED
 from rsstp_replay.reader.recording import Recording, open_recording
-from rsstp_replay.viewer import _near, view
+from rsstp_replay.viewer import _large, view
 from rsstp_replay.viewer._map import (
     NO_POSE,
     TILE_GAP,
@@ -192,17 +192,19 @@ def test_the_current_pose_ring_follows_the_arm(learner: tuple[Recording, Rrd]) -
 
 
 def test_the_map_is_a_view_of_the_blueprint(learner: tuple[Recording, Rrd]) -> None:
-    """The saved blueprint has a 2D view whose origin is the map."""
+    """The saved blueprint has a 2D view named for the map, whose contents are the map."""
     _, rrd = learner
     chunks = RrdReader(rrd.path).stream(store=rrd.blueprints[0]).to_chunks()
-    origins = [
-        value
+    values = [
+        str(value)
         for chunk in chunks
         for batch in [chunk.to_record_batch()]
-        if "ViewBlueprint:space_origin" in batch.schema.names
-        for value in batch.column("ViewBlueprint:space_origin").to_pylist()
+        for name in batch.schema.names
+        if name in ("ViewBlueprint:display_name", "ViewContents:query")
+        for value in batch.column(name).to_pylist()
     ]
-    assert ["/map"] in origins or "/map" in origins
+    assert any("Model map (joint space)" in value for value in values)
+    assert any("/map/**" in value for value in values)
 
 
 # ------------------------------------------------------------------ three joints: tiles
@@ -271,46 +273,101 @@ def _bfs(model: object, state: int, depth: int) -> list[tuple[int, int, int]]:
     return found
 
 
-def test_a_large_model_draws_only_the_current_states_neighbourhood(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """Over ALL_ARROWS_MAX_STATES states, no state entity has arrows; ``world/model/near``
-    has, at each of its rows, one arrow per transition out of the current state and out of
-    the states it reaches in fewer than NEAR_STEPS steps, coloured by action, and a row
-    wherever the current state changed."""
-    monkeypatch.setattr(_near, "ALL_ARROWS_MAX_STATES", 2)
+@pytest.fixture(scope="module")
+def large(
+    tmp_path_factory: pytest.TempPathFactory,
+) -> Iterator[tuple[Recording, Rrd, Rrd]]:
+    """A random refiner's run viewed twice: as a large model (the threshold patched to 2
+    states) and as a small one (an entity per state, tested in test_viewer.py)."""
+    folder = tmp_path_factory.mktemp("large")
     record(
-        tmp_path / "r.mcap",
+        folder / "r.mcap",
         load_scenario("three-joint"),
         RandomRefiner(split=0.05, max_states=6),
         steps=300,
         seed=7,
     )
-    with open_recording(tmp_path / "r.mcap") as recording:
-        view(recording, save=tmp_path / "r.rrd", spawn=False, serve_web=False, start=None, end=None)
-        rrd = Rrd(tmp_path / "r.rrd")
-        assert not any(
-            "Arrows2D:vectors" in chunk.to_record_batch().schema.names
-            for path, chunks in rrd.temporal.items()
-            if path.startswith("world/model/state/")
-            for chunk in chunks
+    with open_recording(folder / "r.mcap") as recording:
+        view(
+            recording, save=folder / "small.rrd", spawn=False, serve_web=False, start=None, end=None
         )
-        rows = rrd.column(_near.NEAR, "Arrows2D:colors")
-        states = recording.steps()["internal_state"].to_numpy()
-        changed = np.flatnonzero(np.r_[True, states[1:] != states[:-1]]).tolist()
-        assert set(changed) <= {step for step, _ in rows}
-        checked = 0
-        for step, colours in rows[:: max(1, len(rows) // 40)]:
-            expected = _bfs(recording.model_at(step), int(states[step]), _near.NEAR_STEPS)
-            assert sorted(_rgb(c) for c in colours) == sorted(
-                ACTION_COLORS[a % len(ACTION_COLORS)] for _, a, _ in expected
-            ), step
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(_large, "ALL_ARROWS_MAX_STATES", 2)
+            view(
+                recording,
+                save=folder / "large.rrd",
+                spawn=False,
+                serve_web=False,
+                start=None,
+                end=None,
+            )
+        yield recording, Rrd(folder / "large.rrd"), Rrd(folder / "small.rrd")
+
+
+def test_a_large_model_draws_only_the_current_states_neighbourhood(
+    large: tuple[Recording, Rrd, Rrd],
+) -> None:
+    """Over ALL_ARROWS_MAX_STATES states, no entity per state; ``world/model/near`` has, at
+    each of its rows, one arrow per transition out of the current state (and out of the
+    states it reaches in fewer than NEAR_STEPS steps), coloured by action, and a row wherever
+    the current state changed."""
+    recording, rrd, _ = large
+    assert not any(path.startswith("world/model/state/") for path in rrd.temporal)
+    rows = rrd.column(_large.NEAR, "Arrows2D:colors")
+    states = recording.steps()["internal_state"].to_numpy()
+    changed = np.flatnonzero(np.r_[True, states[1:] != states[:-1]]).tolist()
+    assert set(changed) <= {step for step, _ in rows}
+    checked = 0
+    for step, colours in rows[:: max(1, len(rows) // 40)]:
+        expected = _bfs(recording.model_at(step), int(states[step]), _large.NEAR_STEPS)
+        assert sorted(_rgb(c) for c in colours) == sorted(
+            ACTION_COLORS[a % len(ACTION_COLORS)] for _, a, _ in expected
+        ), step
+        checked += 1
+    assert checked >= 20
+
+
+def test_a_large_models_states_in_blocks_look_as_on_a_small_model(
+    large: tuple[Recording, Rrd, Rrd],
+) -> None:
+    """Each block: its states' places (static) and, at every step where a state of the small
+    model's view has a row or a clear, the same colour (transparent where the small view has
+    none) and the label of a labelled state as its class id."""
+    recording, rrd, small = large
+    blocks = sorted(p for p in rrd.static if p.startswith(_large.STATE_BLOCKS + "/"))
+    assert blocks
+    ids = sorted(
+        int(p.rsplit("/", 1)[1]) for p in small.temporal if p.startswith("world/model/state/")
+    )
+    size = _large.block_size(len(ids))
+    steps = sorted(
+        {s for p in small.temporal if p.startswith("world/model/state/")
+         for s, _ in small.column(p, "Points2D:colors")}
+        | {s for p in small.temporal for s in small.cleared_at(p)}
+    )  # fmt: skip
+    checked = 0
+    for k, state in enumerate(ids):
+        path = f"{_large.STATE_BLOCKS}/{k // size}"
+        [places] = rrd.static[path][0].to_record_batch().column("Points2D:positions").to_pylist()
+        [small_place] = small.column(f"world/model/state/{state}", "Points2D:positions")[0][1]
+        np.testing.assert_allclose(places[k % size], small_place, atol=1e-6)
+        for step in steps:
+            cleared = [s for s in small.cleared_at(f"world/model/state/{state}") if s <= step]
+            rows = [
+                (s, c) for s, c in small.column(f"world/model/state/{state}", "Points2D:colors")
+                if s <= step
+            ]  # fmt: skip
+            alive = rows and (not cleared or rows[-1][0] > cleared[-1])
+            colour = rrd.at(path, "Points2D:colors", step)[k % size]
+            assert colour == (rows[-1][1][0] if alive else 0), (state, step)
             checked += 1
-        assert checked >= 20
+    assert checked > 100
+    assert recording.n_steps > 0
 
 
 def test_a_small_model_keeps_every_arrow(learner: tuple[Recording, Rrd]) -> None:
     """The learner's 119 states: every state its arrows, no neighbourhood entity."""
     _, rrd = learner
-    assert _near.NEAR not in rrd.temporal
+    assert _large.NEAR not in rrd.temporal
+    assert not any(path.startswith(_large.STATE_BLOCKS) for path in rrd.temporal)
     assert rrd.column("world/model/state/0", "Arrows2D:vectors")

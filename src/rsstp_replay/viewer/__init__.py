@@ -39,9 +39,9 @@ from rsstp_replay.audits.determinism import DeterminismFindings, audit_determini
 from rsstp_replay.audits.truth import step_true_classes
 from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
 from rsstp_replay.reader import body_reader
+from rsstp_replay.viewer import _large as large_part
 from rsstp_replay.viewer import _map as map_part
 from rsstp_replay.viewer import _model as model_part
-from rsstp_replay.viewer import _near as near_part
 from rsstp_replay.viewer import _plots as plots_part
 from rsstp_replay.viewer import _world as world_part
 from rsstp_replay.viewer._blueprint import default_blueprint, view_frame
@@ -107,7 +107,8 @@ ENTITY_PATHS: tuple[str, ...] = (
     model_part.STATES + "/{id}",
     model_part.CURRENT,
     model_part.LEGEND,
-    near_part.NEAR,
+    large_part.STATE_BLOCKS + "/{block}",
+    large_part.NEAR,
     map_part.MAP,
     map_part.CELLS + "/{block}",
     map_part.NO_POSE,
@@ -120,8 +121,8 @@ ENTITY_PATHS: tuple[str, ...] = (
     plots_part.MODEL_TRANSITIONS,
     plots_part.LOG,
 )
-"""Every entity path the viewer writes (``{id}``: a state id; ``{block}``: a block of the
-map's cells)."""
+"""Every entity path the viewer writes (``{id}``: a state id; ``{block}``: a block of a
+large model's states, or of the map's cells)."""
 
 
 class ViewSource(Protocol):
@@ -455,15 +456,10 @@ def _log(
         frame = view_frame(scenario)
         model_part.log_legend(stream, reach=frame.half, center=frame.center)
     shown, times = _versions_in(loaded.versions, first, last)
-    large = max(len(record.states) for record in shown) > near_part.ALL_ARROWS_MAX_STATES
-    rows = model_part.log_model(
-        stream,
-        shown,
-        times,
-        loaded.places,
-        roles=loaded.roles,
-        labelled=loaded.labelled,
-        arrows=not large,
+    large = max(len(record.states) for record in shown) > large_part.ALL_ARROWS_MAX_STATES
+    log_model = large_part.log_large_model if large else model_part.log_model
+    rows = log_model(
+        stream, shown, times, loaded.places, roles=loaded.roles, labelled=loaded.labelled
     )
     grid = map_part.joint_grid(scenario)
     if grid is not None and loaded.truth is not None and loaded.map_changes is not None:
@@ -497,7 +493,7 @@ def _log(
         stream, sampled_steps, sampled_states, loaded.places
     )
     if large:
-        rows[near_part.NEAR] = near_part.log_near(
+        rows[large_part.NEAR] = large_part.log_near(
             stream, shown, times, sampled_steps, sampled_states, loaded.places
         )
     if grid is not None and loaded.truth is not None:

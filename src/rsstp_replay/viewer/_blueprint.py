@@ -5,6 +5,7 @@ from __future__ import annotations
 import rerun.blueprint as rrb
 
 from rsstp_replay.viewer._chunks import TIMELINE
+from rsstp_replay.viewer._map import joint_grid, map_bounds
 from rsstp_replay.viewer._world import ViewFrame, body_view
 from rsstp_sim.scenario import AnyScenario
 
@@ -65,8 +66,18 @@ def default_blueprint(
             visual_bounds=bounds,
         ),
     ]
-    if with_map:
-        views.append(rrb.Spatial2DView(name="Model map (joint space)", origin="/map"))
+    grid = joint_grid(scenario)
+    if with_map and grid is not None:
+        # Origin "/": the map's own y-up transform applies (a view's origin is its frame).
+        x0, x1, y0, y1 = map_bounds(grid)
+        views.append(
+            rrb.Spatial2DView(
+                name="Model map (joint space)",
+                origin="/",
+                contents=["+ /map/**"],
+                visual_bounds=rrb.VisualBounds2D(x_range=[x0, x1], y_range=[-y1, -y0]),
+            )
+        )
     return rrb.Blueprint(
         rrb.Vertical(
             rrb.Horizontal(*views),

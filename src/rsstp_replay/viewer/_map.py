@@ -45,7 +45,7 @@ from rsstp_replay.audits.state_roles import (
     UNVISITED,
     state_roles,
 )
-from rsstp_replay.viewer._chunks import send_rows
+from rsstp_replay.viewer._chunks import latest_rows, send_rows
 from rsstp_sim import palette
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.arm.table import lattice_sizes
@@ -67,6 +67,7 @@ __all__ = [
     "joint_grid",
     "log_map",
     "log_map_pose",
+    "map_bounds",
 ]
 
 MAP = "map"
@@ -163,6 +164,15 @@ class JointGrid:
             if self.n_tiles * -(-n1 // rows) <= MAX_BLOCKS:
                 return rows
         return n1
+
+
+def map_bounds(grid: JointGrid) -> tuple[float, float, float, float]:
+    """``x_min, x_max, y_min, y_max`` (map coordinates, y up) of the tiles, their axes' names
+    and the legend."""
+    n0, n1 = grid.sizes[:2]
+    width = grid.columns * (n0 + TILE_GAP)
+    bottom = -(grid.tile_rows - 1) * (n1 + TILE_GAP)
+    return -0.1 * width - 2.0, 1.45 * width + 2.0, bottom - 4.0, n1 + 3.0
 
 
 def tile_columns(n_tiles: int) -> int:
@@ -281,8 +291,13 @@ def log_map(
     bounds = np.searchsorted(cell_block[order], np.arange(len(blocks) + 1))
     for k, b in enumerate(blocks.tolist()):
         mine = order[bounds[k] : bounds[k + 1]]
-        colors, times = _block_colors(
-            cells[mine] - starts[k], cell_steps[mine], cell_roles[mine], int(widths[k]), first
+        colors, times = latest_rows(
+            cells[mine] - starts[k],
+            cell_steps[mine],
+            cell_roles[mine].astype(np.int64),
+            width=int(widths[k]),
+            first=first,
+            initial=UNVISITED,
         )
         path = block_path(b)
         lo, hi = int(starts[k]), int(starts[k] + widths[k])
@@ -314,29 +329,10 @@ def _color_columns(
     return columns
 
 
-def _block_colors(
-    cells: _Ints, steps: _Ints, roles: npt.NDArray[np.int8], width: int, first: int
-) -> tuple[npt.NDArray[np.int8], _Ints]:
-    """One block's rows: its cells' roles at ``first`` and at every later step where one
-    changed, shape ``(rows, width)``, and the steps. ``cells``, ``steps``, ``roles``: the
-    block's changes (cell index within the block), in order."""
-    times = np.unique(np.r_[first, steps])
-    row = np.searchsorted(times, steps)
-    table = np.full((len(times), width), UNVISITED, np.int8)
-    set_at = np.zeros((len(times), width), np.bool_)
-    table[row, cells] = roles  # in change order: a cell's last change at a step wins
-    set_at[row, cells] = True
-    # Each cell holds the value of the last row that set it (unvisited before any).
-    source = np.maximum.accumulate(np.where(set_at, np.arange(len(times))[:, None], 0), axis=0)
-    filled = table[source, np.arange(width)[None, :]]
-    # A row only where something changed (the first row always).
-    differs = np.r_[True, (filled[1:] != filled[:-1]).any(axis=1)]
-    return filled[differs].astype(np.int8), times[differs]
-
-
 def _log_static(stream: rr.RecordingStream, grid: JointGrid) -> None:
     """The y-up transform, each tile's background (labelled with joint 2's angle for three
-    joints), the axes named and the legend."""
+    joints), the axes named (under and over the first tile) and the legend (right of the
+    tiles)."""
     stream.log(MAP, rr.Transform3D(scale=[1.0, -1.0, 1.0]), static=True)
     n0, n1 = grid.sizes[:2]
     tiles = np.arange(grid.n_tiles)
@@ -362,15 +358,15 @@ def _log_static(stream: rr.RecordingStream, grid: JointGrid) -> None:
     width = grid.columns * (n0 + TILE_GAP)
     texts = [
         f"joint 0: {grid.initial_deg[0]}° + {grid.spacing_deg}° a cell →",
-        f"joint 1: {grid.initial_deg[1]}° + {grid.spacing_deg}° a cell ↑",
+        f"↑ joint 1: {grid.initial_deg[1]}° + {grid.spacing_deg}° a cell",
     ]
-    spots = [(0.0, -1.5), (-1.5, n1 - 1.0)]
+    spots = [(n0 / 2, -2.0), (n0 / 2, n1 + 1.0)]  # under and over the first tile
     colors = [(90, 90, 90), (90, 90, 90)]
     for k, role in enumerate((EXACT, REDUNDANT, ALIASED, UNVISITED)):
-        spots.append((width, n1 - 1.0 - 2.0 * k))
+        spots.append((width + 0.1 * width, n1 - 1.0 - 2.0 * k))
         colors.append(_unpacked(int(_ROLE_PACKED[role])))
         texts.append(f"{ROLE_NAMES[role]} class")
-    spots.append((width, n1 - 9.0))
+    spots.append((width + 0.1 * width, n1 - 9.0))
     colors.append(NO_POSE_COLOR)
     texts.append("no pose")
     stream.log(

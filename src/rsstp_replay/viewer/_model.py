@@ -80,6 +80,7 @@ __all__ = [
     "log_legend",
     "log_model",
     "roles_by_version",
+    "state_rows",
     "state_path",
     "state_places",
 ]
@@ -291,14 +292,39 @@ def log_model(
     *,
     roles: Roles | None = None,
     labelled: set[int] | None = None,
-    arrows: bool = True,
 ) -> dict[str, int]:
     """Every state of ``versions[0]`` at ``steps[0]``, then each later version's changes (and
     role changes, with ``roles``: a state keeps the role of the last version that was in it,
-    unvisited until one was) at its step; labels on the ``labelled`` states (default: all);
-    without ``arrows``, the states alone (a row where one appears, changes role or goes: the
-    arrows of a large model are :mod:`~rsstp_replay.viewer._near`'s). Returns rows per entity
-    path (the per-state paths summed under :data:`STATES`)."""
+    unvisited until one was) at its step, an entity per state; labels on the ``labelled``
+    states (default: all). Returns rows per entity path (the per-state paths summed under
+    :data:`STATES`). (A large model is :mod:`~rsstp_replay.viewer._large`'s.)"""
+    rows = state_rows(versions, steps, roles=roles, arrows=True)
+    count = 0
+    ids = np.array(sorted(places.places), np.int64)
+    xy = np.array([places.places[s] for s in ids.tolist()], np.float64).reshape(-1, 2)
+    for state, changes in sorted(rows.items()):
+        count += _log_state(
+            stream,
+            state,
+            changes,
+            places,
+            (ids, xy),
+            labelled=labelled is None or state in labelled,
+        )
+    return {STATES: count}
+
+
+def state_rows(
+    versions: Sequence[ModelRecord],
+    steps: Sequence[int],
+    *,
+    roles: Roles | None,
+    arrows: bool,
+) -> dict[int, list[_Row]]:
+    """Each state's rows: at ``steps[0]`` every state of ``versions[0]``, then at each later
+    version's step the states whose transitions out changed (with ``arrows``; else only those
+    that appeared or went), whose role changed, and a row with no transitions (None) where one
+    was deleted."""
     rows: dict[int, list[_Row]] = defaultdict(list)
     model = TransitionSystem.from_snapshot(versions[0].snapshot(), version=versions[0].version)
     # A state's role is what it stood for in the last version that was in it: a version of a
@@ -324,20 +350,7 @@ def log_model(
                 rows[state].append((step, outs, _role(roles, known, state)))
             elif state in touched:
                 rows[state].append((step, None, None))
-    count = 0
-    ids = np.array(sorted(places.places), np.int64)
-    xy = np.array([places.places[s] for s in ids.tolist()], np.float64).reshape(-1, 2)
-    for state, changes in sorted(rows.items()):
-        count += _log_state(
-            stream,
-            state,
-            changes,
-            places,
-            (ids, xy),
-            labelled=labelled is None or state in labelled,
-            arrows=arrows,
-        )
-    return {STATES: count}
+    return rows
 
 
 def _role(roles: Roles | None, known: dict[int, int], state: int) -> int | None:
@@ -377,10 +390,9 @@ def _log_state(
     place_table: tuple[npt.NDArray[np.int64], _Floats],
     *,
     labelled: bool,
-    arrows: bool,
 ) -> int:
-    """The rows of one state's entity (its arrows with ``arrows``), a clear where it was
-    deleted; ``place_table`` is every state id, sorted, and its place."""
+    """The rows of one state's entity, a clear where it was deleted; ``place_table`` is
+    every state id, sorted, and its place."""
     path = state_path(state)
     x, y = places.places[state]
     alive = [(step, outs, role) for step, outs, role in changes if outs is not None]
@@ -390,20 +402,22 @@ def _log_state(
             [palette.STATE if role is None else ROLE_COLORS[role] for _, _, role in alive],
             np.uint8,
         )
-        columns = list(
-            rr.Points2D.columns(
-                positions=np.tile([x, y], (len(times), 1)),
-                colors=state_colors,
-                labels=[str(state)] * len(times) if labelled else None,
-            )
-        )
-        if arrows:
-            drawn = _drawn_transitions(state, [outs for _, outs, _ in alive], places, place_table)
-            columns += rr.Arrows2D.columns(
-                origins=drawn.origins, vectors=drawn.vectors, colors=drawn.colors
-            ).partition(drawn.counts)
+        drawn = _drawn_transitions(state, [outs for _, outs, _ in alive], places, place_table)
         index = [rr.TimeColumn(TIMELINE, sequence=times)]
-        stream.send_columns(path, indexes=index, columns=columns)
+        stream.send_columns(
+            path,
+            indexes=index,
+            columns=[
+                *rr.Points2D.columns(
+                    positions=np.tile([x, y], (len(times), 1)),
+                    colors=state_colors,
+                    labels=[str(state)] * len(times) if labelled else None,
+                ),
+                *rr.Arrows2D.columns(
+                    origins=drawn.origins, vectors=drawn.vectors, colors=drawn.colors
+                ).partition(drawn.counts),
+            ],
+        )
         poses = places.poses.get(state)
         if poses is not None:  # in the state's entity too, once: a path less per state
             strips = np.stack([np.broadcast_to([x, y], poses.shape), poses], axis=1)
