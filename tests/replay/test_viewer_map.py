@@ -359,7 +359,9 @@ def test_a_large_models_states_in_blocks_look_as_on_a_small_model(
             ]  # fmt: skip
             alive = rows and (not cleared or rows[-1][0] > cleared[-1])
             colour = rrd.at(path, "Points2D:colors", step)[k % size]
+            radius = rrd.at(path, "Points2D:radii", step)[k % size]
             assert colour == (rows[-1][1][0] if alive else 0), (state, step)
+            assert (radius != 0) == bool(alive), (state, step)
             checked += 1
     assert checked > 100
     assert recording.n_steps > 0

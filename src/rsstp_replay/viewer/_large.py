@@ -11,8 +11,9 @@ circle they were all on; the same points in one entity did not; issue 32). Over
 - **The states**, ``world/model/states/{block}``: the state ids, sorted, in blocks of
   :func:`block_size` (at most :data:`MAX_BLOCKS` blocks). A block's places are static (a
   state never moves); its rows, at the first step and where a state of the block appeared,
-  changed role or went, hold every member's colour (its role's, as on a small model;
-  transparent while it is not in the model) and class id (its label, from a static
+  changed role or went, hold every member's colour (its role's, as on a small model), radius
+  (:data:`STATE_RADIUS_UI`; 0 while it is not in the model: a transparent colour alone was
+  drawn black) and class id (its label, from a static
   annotation context, for the states whose label fits). No lines to the poses.
 - **The arrows**, ``world/model/near``: the transitions out of the current state (and out of
   every state reached from it in fewer than :data:`NEAR_STEPS` steps), in the version in
@@ -62,6 +63,8 @@ __all__ = [
 STATE_BLOCKS = "world/model/states"
 MAX_BLOCKS = 128
 """At most this many entities hold a large model's states."""
+STATE_RADIUS_UI = 2.5
+"""A state's point, in UI points (a small model's states have Rerun's default size)."""
 NEAR = "world/model/near"
 NEAR_STEPS = 1
 """The transitions out of the current state and out of the states it reaches in fewer than
@@ -149,17 +152,23 @@ def log_large_model(
         labels = np.isin(members, named)
         classes = np.where(labels & (values != _ABSENT), members, _MAX_CLASS_ID - 1)
         packed = colours[np.searchsorted(codes, values)]
-        count += send_rows(stream, path, times, _block_columns(packed, classes.astype(np.uint16)))
+        # An absent state: radius 0 (a transparent colour alone is drawn black).
+        radii = np.where(values == _ABSENT, 0.0, -STATE_RADIUS_UI).astype(np.float32)
+        count += send_rows(
+            stream, path, times, _block_columns(packed, classes.astype(np.uint16), radii)
+        )
     return {STATE_BLOCKS: count}
 
 
 def _block_columns(
-    colours: npt.NDArray[np.uint32], classes: npt.NDArray[np.uint16]
+    colours: npt.NDArray[np.uint32],
+    classes: npt.NDArray[np.uint16],
+    radii: npt.NDArray[np.float32],
 ) -> Callable[[slice], rr.ComponentColumnList]:
     def columns(rows: slice) -> rr.ComponentColumnList:
         chosen = colours[rows]
         return rr.Points2D.columns(
-            colors=chosen.ravel(), class_ids=classes[rows].ravel()
+            colors=chosen.ravel(), class_ids=classes[rows].ravel(), radii=radii[rows].ravel()
         ).partition(np.full(len(chosen), chosen.shape[1]))
 
     return columns
