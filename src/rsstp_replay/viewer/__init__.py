@@ -647,7 +647,10 @@ def _roles(
         return None, None, None
     step_versions = steps["model_version"].to_numpy(np.int64)
     step_states = steps["internal_state"].to_numpy(np.int64)
+    roles = model_part.roles_by_version(step_versions, step_states, classes)
     changes = None
     if map_part.joint_grid(scenario) is not None:
-        changes = map_part.class_role_changes(step_versions, step_states, classes)
-    return truth, model_part.roles_by_version(step_versions, step_states, classes), changes
+        changes = map_part.class_role_changes(
+            step_versions, step_states, classes, state_roles=roles
+        )
+    return truth, roles, changes

@@ -30,7 +30,7 @@ versions times cells. The current pose is a ring, ``map/pose``, with a row where
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -199,12 +199,16 @@ def joint_grid(scenario: object) -> JointGrid | None:
 
 
 def class_roles(
-    step_versions: npt.ArrayLike, step_states: npt.ArrayLike, step_classes: npt.ArrayLike
+    step_versions: npt.ArrayLike,
+    step_states: npt.ArrayLike,
+    step_classes: npt.ArrayLike,
+    *,
+    roles: Mapping[int, Mapping[int, int]] | None = None,
 ) -> tuple[_Ints, _Ints, npt.NDArray[np.int8]]:
     """Every ``(version, class)`` pair seen at a step, and the class's role in that version:
     the worst role (aliased over redundant over exact) of the version's states that stood for
-    the class (:func:`~rsstp_replay.audits.state_roles.state_roles`). Sorted by version, then
-    class."""
+    the class (:func:`~rsstp_replay.audits.state_roles.state_roles`; ``roles``: those roles
+    already at hand, per version and state). Sorted by version, then class."""
     v = np.asarray(step_versions, np.int64).ravel()
     s = np.asarray(step_states, np.int64).ravel()
     c = np.asarray(step_classes, np.int64).ravel()
@@ -216,9 +220,14 @@ def class_roles(
     pair_starts = np.r_[True, (tv[1:] != tv[:-1]) | (tc[1:] != tc[:-1])]
     distinct = pair_starts | np.r_[True, ts[1:] != ts[:-1]]
     tv, tc, ts, pair_starts = tv[distinct], tc[distinct], ts[distinct], pair_starts[distinct]
-    roles = state_roles(v, s, c, versions=tv, states=ts)
+    if roles is None:
+        found = state_roles(v, s, c, versions=tv, states=ts)
+    else:
+        found = np.array(
+            [roles[a][b] for a, b in zip(tv.tolist(), ts.tolist(), strict=True)], np.int8
+        )
     starts = np.flatnonzero(pair_starts)
-    worst = np.maximum.reduceat(roles, starts)
+    worst = np.maximum.reduceat(found, starts)
     return tv[starts], tc[starts], worst.astype(np.int8)
 
 
@@ -233,11 +242,17 @@ class RoleChanges:
 
 
 def class_role_changes(
-    step_versions: npt.ArrayLike, step_states: npt.ArrayLike, step_classes: npt.ArrayLike
+    step_versions: npt.ArrayLike,
+    step_states: npt.ArrayLike,
+    step_classes: npt.ArrayLike,
+    *,
+    state_roles: Mapping[int, Mapping[int, int]] | None = None,
 ) -> RoleChanges:
     """The changes of :func:`class_roles` over versions, a class keeping the role of the last
     version that visited it (unvisited before)."""
-    versions, classes, roles = class_roles(step_versions, step_states, step_classes)
+    versions, classes, roles = class_roles(
+        step_versions, step_states, step_classes, roles=state_roles
+    )
     order = np.lexsort((versions, classes))  # by class, then version
     c, r = classes[order], roles[order]  # every role is a visit's (never unvisited)
     changed = np.r_[True, c[1:] != c[:-1]] | np.r_[True, r[1:] != r[:-1]]

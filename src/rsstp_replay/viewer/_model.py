@@ -165,8 +165,10 @@ def state_places(
     # state of a long run at the mean of everything it once stood for).
     in_force = version_index(versions, steps.index.to_numpy(np.int64))
     ids, where = np.unique(states, return_inverse=True)
-    latest = np.full(len(ids), -1, np.int64)
-    np.maximum.at(latest, where, in_force)
+    # Versions only grow with the steps: a state's latest is the one at its last step.
+    by_state = np.argsort(where, kind="stable")
+    ends = np.r_[np.flatnonzero(np.diff(where[by_state])), len(by_state) - 1]
+    latest = in_force[by_state[ends]] if len(states) else np.empty(0, np.int64)
     chosen = in_force == latest[where]
     kept_states, kept_tips = states[chosen], tips[chosen]
     sums = np.zeros((len(ids), 2))
@@ -189,8 +191,11 @@ def state_places(
                         x + 3 * scale * math.cos(angle),
                         y + 3 * scale * math.sin(angle),
                     )
-        for state in record.states:
-            places.setdefault(int(state), (0.0, 0.0))
+    every: set[int] = set()
+    for record in versions:  # a set's update is C's loop: 6,836 versions of 1,200 states
+        every.update(record.states)
+    for state in every - places.keys():
+        places[int(state)] = (0.0, 0.0)
     poses = steps[list(pose_columns)].to_numpy(np.int64)[chosen]
     return StatePlaces(places, _poses(kept_states, poses, kept_tips), scale)
 
