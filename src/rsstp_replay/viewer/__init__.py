@@ -518,12 +518,14 @@ def _log(
     )
 
 
-OVERVIEW_MAX_STEPS = 100_000
+OVERVIEW_MAX_STEPS = 25_000
 """Over this many steps shown, the arm, its blocked marker and the current state are an
 overview: shown every k-th step (and at the last), k the least that keeps them within this
 many rows, and the obstacle sensor is left out (the distances stay as plots); a
 ``--from``/``--to`` window of at most this many steps shows every step. (A
-million-step run has a row per step in each; the web viewer needs minutes to take them in.)"""
+million-step run has a row per step in each; the web viewer needs minutes to take them in.
+100,000 until issue 32: the web viewer took 240 s to settle on a 643,244-step learner run's
+overview on the 2-core development machine, 87 s at 25,000.)"""
 
 
 def _overview_text(every: int) -> str:
