@@ -12,13 +12,14 @@ Each audit returns a frozen findings object with ``to_text()`` and ``to_json()``
 - :func:`audit_truth`: the verdict (learned, from which step, or why not), and every model
   version against the ground truth (aliasing, redundancy, contradictions, equivalence);
 - :func:`state_roles`: what each state of each version stood for by the truth (exact,
-  redundant, aliased, unvisited);
+  redundant, aliased, unvisited); :func:`class_roles`, the same per true class;
 - :func:`check_contract`: the step records against the model messages, at every step.
 
 The audits read a recording through :class:`AuditSource` (``memory()``, ``model_versions()``,
 ``steps()``), so anything with those methods can be audited.
 """
 
+from rsstp_replay.audits.class_roles import RoleChanges, class_role_changes, class_roles
 from rsstp_replay.audits.compare import CompareFindings, HasMemory, compare
 from rsstp_replay.audits.consistency import (
     ConsistencyFindings,
@@ -59,6 +60,7 @@ __all__ = [
     "HasModelVersions",
     "ModelSize",
     "ROLE_NAMES",
+    "RoleChanges",
     "StateContradiction",
     "SummaryFindings",
     "TruthFindings",
@@ -73,6 +75,8 @@ __all__ = [
     "audit_summary",
     "audit_truth",
     "check_contract",
+    "class_role_changes",
+    "class_roles",
     "compare",
     "find_contradictions",
     "run_audits",

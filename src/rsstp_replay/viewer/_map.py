@@ -14,10 +14,11 @@ stood for its pose's *true class* in the model version at the time cursor, over 
 version was in force: **exact** (one state stood for the class, and for it alone), **redundant**
 (several states stood for it, none for another class too), **aliased** (a state that stood for
 it stood for another class too); the worst of these when several states stood for it
-(:func:`class_roles`). As on the model drawn on the world, a class keeps the colour of the
-last version that visited it (a version of a few hundred steps visits few classes), and is
-**unvisited** (grey) until one did. So a learned model is a green map, and the places where
-it is still wrong show where they are in joint space.
+(:func:`~rsstp_replay.audits.class_roles.class_roles`). As on the model drawn on the world,
+a class keeps the colour of the last version that visited it (a version of a few hundred
+steps visits few classes), and is **unvisited** (grey) until one did. So a model that learned,
+on a run that went on visiting, is a green map, and the places where it is still wrong show
+where they are in joint space.
 
 Logging: the cells are cut into *blocks* (a row of a tile, or several rows when there would be
 more than :data:`MAX_BLOCKS` blocks), one entity each, ``map/cells/{b}``: the cells' places
@@ -30,20 +31,20 @@ versions times cells. The current pose is a ring, ``map/pose``, with a row where
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 import numpy.typing as npt
 import rerun as rr
 
+from rsstp_replay.audits.class_roles import RoleChanges, class_role_changes, class_roles
 from rsstp_replay.audits.state_roles import (
     ALIASED,
     EXACT,
     REDUNDANT,
     ROLE_NAMES,
     UNVISITED,
-    state_roles,
 )
 from rsstp_replay.viewer._chunks import latest_rows, send_rows
 from rsstp_sim import palette
@@ -193,71 +194,6 @@ def joint_grid(scenario: object) -> JointGrid | None:
         initial_deg=tuple(scenario.initial_deg),
         columns=tile_columns(n_tiles),
     )
-
-
-# ------------------------------------------------------------------------------ roles
-
-
-def class_roles(
-    step_versions: npt.ArrayLike,
-    step_states: npt.ArrayLike,
-    step_classes: npt.ArrayLike,
-    *,
-    roles: Mapping[int, Mapping[int, int]] | None = None,
-) -> tuple[_Ints, _Ints, npt.NDArray[np.int8]]:
-    """Every ``(version, class)`` pair seen at a step, and the class's role in that version:
-    the worst role (aliased over redundant over exact) of the version's states that stood for
-    the class (:func:`~rsstp_replay.audits.state_roles.state_roles`; ``roles``: those roles
-    already at hand, per version and state). Sorted by version, then class."""
-    v = np.asarray(step_versions, np.int64).ravel()
-    s = np.asarray(step_states, np.int64).ravel()
-    c = np.asarray(step_classes, np.int64).ravel()
-    if not len(v):
-        empty = np.empty(0, np.int64)
-        return empty, empty, np.empty(0, np.int8)
-    order = np.lexsort((s, c, v))  # by version, class, state
-    tv, tc, ts = v[order], c[order], s[order]
-    pair_starts = np.r_[True, (tv[1:] != tv[:-1]) | (tc[1:] != tc[:-1])]
-    distinct = pair_starts | np.r_[True, ts[1:] != ts[:-1]]
-    tv, tc, ts, pair_starts = tv[distinct], tc[distinct], ts[distinct], pair_starts[distinct]
-    if roles is None:
-        found = state_roles(v, s, c, versions=tv, states=ts)
-    else:
-        found = np.array(
-            [roles[a][b] for a, b in zip(tv.tolist(), ts.tolist(), strict=True)], np.int8
-        )
-    starts = np.flatnonzero(pair_starts)
-    worst = np.maximum.reduceat(found, starts)
-    return tv[starts], tc[starts], worst.astype(np.int8)
-
-
-@dataclass(frozen=True, slots=True)
-class RoleChanges:
-    """Where a class's colour changes: at version ``versions[k]``, class ``classes[k]`` takes
-    role ``roles[k]`` (sorted by version). A class keeps its role until it changes."""
-
-    versions: _Ints
-    classes: _Ints
-    roles: npt.NDArray[np.int8]
-
-
-def class_role_changes(
-    step_versions: npt.ArrayLike,
-    step_states: npt.ArrayLike,
-    step_classes: npt.ArrayLike,
-    *,
-    state_roles: Mapping[int, Mapping[int, int]] | None = None,
-) -> RoleChanges:
-    """The changes of :func:`class_roles` over versions, a class keeping the role of the last
-    version that visited it (unvisited before)."""
-    versions, classes, roles = class_roles(
-        step_versions, step_states, step_classes, roles=state_roles
-    )
-    order = np.lexsort((versions, classes))  # by class, then version
-    c, r = classes[order], roles[order]  # every role is a visit's (never unvisited)
-    changed = np.r_[True, c[1:] != c[:-1]] | np.r_[True, r[1:] != r[:-1]]
-    keep = np.sort(order[changed])  # back to (version, class) order
-    return RoleChanges(versions[keep], classes[keep], roles[keep])
 
 
 # ------------------------------------------------------------------------------ logging
