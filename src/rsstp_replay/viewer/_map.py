@@ -3,7 +3,7 @@ stood for there.
 
 For an arm of two joints, the map is a grid: joint 0's angle index across (left to right),
 joint 1's up (bottom to top), one cell per pose of the arm's lattice
-(:func:`rsstp_sim.arm.table.lattice_sizes`: ``360 / gcd(step, 360)`` angles a joint, counted
+(``360 / gcd(step, 360)`` angles a joint that an action turns, one for another, counted
 from its initial angle). For three joints, the same grid for each angle of joint 2 (a
 *tile*), the tiles in rows of :func:`tile_columns`, joint 2's angle growing left to right,
 then down. A pose the arm cannot be in from its start (a collision, a fold, behind an
@@ -49,7 +49,6 @@ from rsstp_replay.audits.state_roles import (
 from rsstp_replay.viewer._chunks import latest_rows, send_rows
 from rsstp_sim import palette
 from rsstp_sim.arm.scenario import Scenario
-from rsstp_sim.arm.table import lattice_sizes
 from rsstp_sim.truth import GroundTruth
 
 __all__ = [
@@ -186,11 +185,13 @@ def joint_grid(scenario: object) -> JointGrid | None:
     of other than two or three joints)."""
     if not isinstance(scenario, Scenario) or scenario.n_joints not in (2, 3):
         return None
-    sizes = tuple(lattice_sizes(scenario))
+    spacing = math.gcd(scenario.step_deg, 360)
+    turned = {action // 2 for action in scenario.actions}
+    sizes = tuple(360 // spacing if k in turned else 1 for k in range(scenario.n_joints))
     n_tiles = sizes[2] if len(sizes) > 2 else 1
     return JointGrid(
         sizes=sizes,
-        spacing_deg=math.gcd(scenario.step_deg, 360),
+        spacing_deg=spacing,
         initial_deg=tuple(scenario.initial_deg),
         columns=tile_columns(n_tiles),
     )
