@@ -14,13 +14,14 @@ Each audit returns a frozen findings object with ``to_text()`` and ``to_json()``
 - :func:`explain`: where a run's steps went (phases, the states and classes it kept
   revisiting, the last step it met anything new) and what would have helped;
 - :func:`state_roles`: what each state of each version stood for by the truth (exact,
-  redundant, aliased, unvisited);
+  redundant, aliased, unvisited); :func:`class_roles`, the same per true class;
 - :func:`check_contract`: the step records against the model messages, at every step.
 
 The audits read a recording through :class:`AuditSource` (``memory()``, ``model_versions()``,
 ``steps()``), so anything with those methods can be audited.
 """
 
+from rsstp_replay.audits.class_roles import RoleChanges, class_role_changes, class_roles
 from rsstp_replay.audits.compare import CompareFindings, HasMemory, compare
 from rsstp_replay.audits.consistency import (
     MAX_STEPS,
@@ -66,6 +67,7 @@ __all__ = [
     "HasModelVersions",
     "ModelSize",
     "ROLE_NAMES",
+    "RoleChanges",
     "Sample",
     "StateContradiction",
     "SummaryFindings",
@@ -82,6 +84,8 @@ __all__ = [
     "audit_summary",
     "audit_truth",
     "check_contract",
+    "class_role_changes",
+    "class_roles",
     "compare",
     "explain",
     "find_contradictions",

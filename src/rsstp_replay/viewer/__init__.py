@@ -39,6 +39,8 @@ from rsstp_replay.audits.determinism import DeterminismFindings, audit_determini
 from rsstp_replay.audits.truth import step_true_classes
 from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
 from rsstp_replay.reader import body_reader
+from rsstp_replay.viewer import _large as large_part
+from rsstp_replay.viewer import _map as map_part
 from rsstp_replay.viewer import _model as model_part
 from rsstp_replay.viewer import _plots as plots_part
 from rsstp_replay.viewer import _world as world_part
@@ -61,6 +63,7 @@ from rsstp_sim.files import side_file, write_whole
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.truth import GroundTruth
 from rsstp_sim.truth_cache import load_truth
 from rsstp_sim.words import counted
 
@@ -104,6 +107,13 @@ ENTITY_PATHS: tuple[str, ...] = (
     model_part.STATES + "/{id}",
     model_part.CURRENT,
     model_part.LEGEND,
+    large_part.STATE_BLOCKS + "/{block}",
+    large_part.NEAR,
+    map_part.MAP,
+    map_part.CELLS + "/{block}",
+    map_part.NO_POSE,
+    map_part.POSE,
+    map_part.MAP_LEGEND,
     plots_part.SENSATION,
     plots_part.FEEDBACK,
     plots_part.DISTANCE,
@@ -111,7 +121,8 @@ ENTITY_PATHS: tuple[str, ...] = (
     plots_part.MODEL_TRANSITIONS,
     plots_part.LOG,
 )
-"""Every entity path the viewer writes (``{id}``: a state id)."""
+"""Every entity path the viewer writes (``{id}``: a state id; ``{block}``: a block of a
+large model's states, or of the map's cells)."""
 
 
 class ViewSource(Protocol):
@@ -260,7 +271,9 @@ def view(
     writing = None if target is None else side_file(target)
     loaded = _load(recording)
     stream = rr.RecordingStream(APPLICATION_ID, recording_id=uuid.uuid4())
-    blueprint = default_blueprint(recording.scenario, first=first, last=last)
+    blueprint = default_blueprint(
+        recording.scenario, first=first, last=last, with_map=loaded.map_changes is not None
+    )
     spawned = False
     in_memory: rr.BinaryStream | None = None
     if target is not None and not spawn:
@@ -386,6 +399,8 @@ class _Loaded:
     within: ConsistencyFindings | None
     determinism: DeterminismFindings | None
     roles: model_part.Roles | None
+    truth: GroundTruth | None
+    map_changes: map_part.RoleChanges | None
     places: model_part.StatePlaces
     labelled: set[int]
     seconds_read: float
@@ -409,13 +424,16 @@ def _load(recording: ViewSource) -> _Loaded:
         reach=scale,
     )
     labelled = model_part.labelled_states(places.places, room=model_part.LABEL_ROOM * scale)
+    truth, roles, map_changes = _roles(scenario, steps)
     return _Loaded(
         steps,
         versions,
         events,
         within,
         determinism,
-        _roles(scenario, steps),
+        roles,
+        truth,
+        map_changes,
         places,
         labelled,
         seconds_read=read - began,
@@ -438,9 +456,21 @@ def _log(
         frame = view_frame(scenario)
         model_part.log_legend(stream, reach=frame.half, center=frame.center)
     shown, times = _versions_in(loaded.versions, first, last)
-    rows = model_part.log_model(
+    large = max(len(record.states) for record in shown) > large_part.ALL_ARROWS_MAX_STATES
+    log_model = large_part.log_large_model if large else model_part.log_model
+    rows = log_model(
         stream, shown, times, loaded.places, roles=loaded.roles, labelled=loaded.labelled
     )
+    grid = map_part.joint_grid(scenario)
+    if grid is not None and loaded.truth is not None and loaded.map_changes is not None:
+        rows |= map_part.log_map(
+            stream,
+            grid,
+            loaded.truth,
+            loaded.map_changes,
+            version_steps={r.version: r.step for r in loaded.versions if r.step <= last},
+            first=first,
+        )
     rows |= plots_part.log_model_size(stream, shown, times, last)
     rows |= plots_part.log_phases(stream, loaded.events, first, last)
     every_line = plots_part.audit_lines(
@@ -457,12 +487,18 @@ def _log(
     if lines:
         rows[plots_part.LOG] = plots_part.log_lines(stream, lines)
     sampled = window.iloc[np.unique(np.r_[0 : len(window) : every, len(window) - 1])]
+    sampled_steps = sampled.index.to_numpy(np.int64)
+    sampled_states = sampled["internal_state"].to_numpy(np.int64)
     rows[model_part.CURRENT] = model_part.log_current_state(
-        stream,
-        sampled.index.to_numpy(np.int64),
-        sampled["internal_state"].to_numpy(np.int64),
-        loaded.places,
+        stream, sampled_steps, sampled_states, loaded.places
     )
+    if large:
+        rows[large_part.NEAR] = large_part.log_near(
+            stream, shown, times, sampled_steps, sampled_states, loaded.places
+        )
+    if grid is not None and loaded.truth is not None:
+        angles = sampled[list(loaded.truth.value_names)].to_numpy(np.int64)
+        rows[map_part.POSE] = map_part.log_map_pose(stream, grid, sampled_steps, angles)
     rows |= body.log_steps(stream, sampled, scenario, sensor=every == 1)
     series, thinned = plots_part.log_series(
         stream, window, distances=body.distance_series(scenario)
@@ -482,12 +518,14 @@ def _log(
     )
 
 
-OVERVIEW_MAX_STEPS = 100_000
+OVERVIEW_MAX_STEPS = 25_000
 """Over this many steps shown, the arm, its blocked marker and the current state are an
 overview: shown every k-th step (and at the last), k the least that keeps them within this
 many rows, and the obstacle sensor is left out (the distances stay as plots); a
 ``--from``/``--to`` window of at most this many steps shows every step. (A
-million-step run has a row per step in each; the web viewer needs minutes to take them in.)"""
+million-step run has a row per step in each; the web viewer needs minutes to take them in.
+100,000 until issue 32: the web viewer took 240 s to settle on a 643,244-step learner run's
+overview on the 2-core development machine, 87 s at 25,000.)"""
 
 
 def _overview_text(every: int) -> str:
@@ -597,17 +635,24 @@ def _audits(
     return within, determinism
 
 
-def _roles(scenario: AnyScenario, steps: pd.DataFrame) -> model_part.Roles | None:
-    """Every visited state's role per version by the truth audit, or None (with a warning)
-    when the truth cannot be computed (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
+def _roles(
+    scenario: AnyScenario, steps: pd.DataFrame
+) -> tuple[GroundTruth | None, model_part.Roles | None, map_part.RoleChanges | None]:
+    """The truth, every visited state's role per version by the truth audit and (for an arm
+    the map draws) where each true class's role changes; Nones (with a warning) when the
+    truth cannot be computed (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
     try:
         truth = load_truth(scenario, max_poses=TRUTH_MAX_POSES)
         classes = step_true_classes(steps, truth)
     except RsstpError as exc:
         warnings.warn(ViewerWarning(f"states not coloured by the truth audit: {exc}"), stacklevel=3)
-        return None
-    return model_part.roles_by_version(
-        steps["model_version"].to_numpy(np.int64),
-        steps["internal_state"].to_numpy(np.int64),
-        classes,
-    )
+        return None, None, None
+    step_versions = steps["model_version"].to_numpy(np.int64)
+    step_states = steps["internal_state"].to_numpy(np.int64)
+    roles = model_part.roles_by_version(step_versions, step_states, classes)
+    changes = None
+    if map_part.joint_grid(scenario) is not None:
+        changes = map_part.class_role_changes(
+            step_versions, step_states, classes, state_roles=roles
+        )
+    return truth, roles, changes

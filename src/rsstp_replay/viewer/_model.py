@@ -2,11 +2,11 @@
 in it, its transitions as arrows coloured by action, the current state highlighted.
 
 Placement: a state sits at the mean position of the arm's tip over the steps at which it was
-the current state in the last model version it belongs to (its final meaning: before a split
-the same id stood for more; when it was never current in that version, over all its steps),
-whatever range is shown; so a model that learned the world looks like the arm's workspace,
-and a state id (never reused) never moves. A state that was never current sits beside the
-state it was split from (states of the initial model that were never current: at the base).
+the current state in the last model version that was in it (its latest meaning seen: before a
+split the same id stood for more), whatever range is shown; so a model that learned the world
+looks like the arm's workspace, and a state id (never reused) never moves. A state that was
+never current sits beside the state it was split from (states of the initial model that were
+never current: at the base).
 A state current at several distinct poses over those steps (aliasing, or a true class of
 several poses) gets a thin line to the tip of each, the :data:`POSE_LINES` most visited.
 
@@ -80,6 +80,7 @@ __all__ = [
     "log_legend",
     "log_model",
     "roles_by_version",
+    "state_rows",
     "state_path",
     "state_places",
 ]
@@ -158,19 +159,17 @@ def state_places(
     offsets."""
     tips = steps[list(columns)].to_numpy(np.float64)
     states = steps["internal_state"].to_numpy(np.int64)
-    # A state means what its last version says: its steps in that version place it (the
-    # same id stood for more before a split), all its steps when it was not current there.
-    last_version: dict[int, int] = {}
-    for index, record in enumerate(versions):
-        for state in record.states:
-            last_version[state] = index
+    # A state means what the last version that was in it says: its steps in that version
+    # place it (the same id stood for more before a split; the last version it belongs to
+    # may have been in force for a few steps, and its earlier steps would draw a learned
+    # state of a long run at the mean of everything it once stood for).
     in_force = version_index(versions, steps.index.to_numpy(np.int64))
-    ids = np.unique(states)
-    final = np.array([last_version.get(int(s), -1) for s in ids.tolist()], np.int64)
-    own = in_force == final[np.searchsorted(ids, states)]
-    has_own = np.zeros(len(ids), np.bool_)
-    has_own[np.searchsorted(ids, states[own])] = True
-    chosen = own | ~has_own[np.searchsorted(ids, states)]
+    ids, where = np.unique(states, return_inverse=True)
+    # Versions only grow with the steps: a state's latest is the one at its last step.
+    by_state = np.argsort(where, kind="stable")
+    ends = np.r_[np.flatnonzero(np.diff(where[by_state])), len(by_state) - 1]
+    latest = in_force[by_state[ends]] if len(states) else np.empty(0, np.int64)
+    chosen = in_force == latest[where]
     kept_states, kept_tips = states[chosen], tips[chosen]
     sums = np.zeros((len(ids), 2))
     where = np.searchsorted(ids, kept_states)
@@ -192,8 +191,11 @@ def state_places(
                         x + 3 * scale * math.cos(angle),
                         y + 3 * scale * math.sin(angle),
                     )
-        for state in record.states:
-            places.setdefault(int(state), (0.0, 0.0))
+    every: set[int] = set()
+    for record in versions:  # a set's update is C's loop: 6,836 versions of 1,200 states
+        every.update(record.states)
+    for state in every - places.keys():
+        places[int(state)] = (0.0, 0.0)
     poses = steps[list(pose_columns)].to_numpy(np.int64)[chosen]
     return StatePlaces(places, _poses(kept_states, poses, kept_tips), scale)
 
@@ -298,31 +300,10 @@ def log_model(
 ) -> dict[str, int]:
     """Every state of ``versions[0]`` at ``steps[0]``, then each later version's changes (and
     role changes, with ``roles``: a state keeps the role of the last version that was in it,
-    unvisited until one was) at its step; labels on the ``labelled`` states (default: all).
-    Returns rows per entity path (the per-state paths summed under :data:`STATES`)."""
-    rows: dict[int, list[_Row]] = defaultdict(list)
-    model = TransitionSystem.from_snapshot(versions[0].snapshot(), version=versions[0].version)
-    # A state's role is what it stood for in the last version that was in it: a version of a
-    # few hundred steps visits few of a thousand states, and "unvisited" in each would make
-    # every state flicker (a row each time) without telling anything new.
-    known: dict[int, int] = {} if roles is None else dict(roles.get(versions[0].version, {}))
-    for state in model.states:
-        rows[state].append((steps[0], _outs(model, state), _role(roles, known, state)))
-    for record, step in zip(versions[1:], steps[1:], strict=True):
-        touched = _touched(model, record)
-        candidates = touched
-        if roles is not None:  # and the states whose role changed
-            seen = roles.get(record.version, {})
-            changed = {s for s, role in seen.items() if known.get(s, UNVISITED) != role}
-            known.update(seen)
-            candidates = touched | changed
-        for state in sorted(candidates):
-            if state in model:
-                # A state whose role alone changed keeps its transitions: the last row's.
-                outs = _outs(model, state) if state in touched else rows[state][-1][1]
-                rows[state].append((step, outs, _role(roles, known, state)))
-            elif state in touched:
-                rows[state].append((step, None, None))
+    unvisited until one was) at its step, an entity per state; labels on the ``labelled``
+    states (default: all). Returns rows per entity path (the per-state paths summed under
+    :data:`STATES`). (A large model is :mod:`~rsstp_replay.viewer._large`'s.)"""
+    rows = state_rows(versions, steps, roles=roles, arrows=True)
     count = 0
     ids = np.array(sorted(places.places), np.int64)
     xy = np.array([places.places[s] for s in ids.tolist()], np.float64).reshape(-1, 2)
@@ -336,6 +317,45 @@ def log_model(
             labelled=labelled is None or state in labelled,
         )
     return {STATES: count}
+
+
+def state_rows(
+    versions: Sequence[ModelRecord],
+    steps: Sequence[int],
+    *,
+    roles: Roles | None,
+    arrows: bool,
+) -> dict[int, list[_Row]]:
+    """Each state's rows: at ``steps[0]`` every state of ``versions[0]``, then at each later
+    version's step the states whose transitions out changed (with ``arrows``; else only those
+    that appeared or went), whose role changed, and a row with no transitions (None) where one
+    was deleted."""
+    rows: dict[int, list[_Row]] = defaultdict(list)
+    model = TransitionSystem.from_snapshot(versions[0].snapshot(), version=versions[0].version)
+    # A state's role is what it stood for in the last version that was in it: a version of a
+    # few hundred steps visits few of a thousand states, and "unvisited" in each would make
+    # every state flicker (a row each time) without telling anything new.
+    known: dict[int, int] = {} if roles is None else dict(roles.get(versions[0].version, {}))
+    for state in model.states:
+        rows[state].append((steps[0], _outs(model, state), _role(roles, known, state)))
+    for record, step in zip(versions[1:], steps[1:], strict=True):
+        touched = _touched(model, record)
+        if not arrows:  # a state's transitions are not drawn: only its coming and going
+            touched = {s for s in touched if s not in model or s not in rows}
+        candidates = touched
+        if roles is not None:  # and the states whose role changed
+            seen = roles.get(record.version, {})
+            changed = {s for s, role in seen.items() if known.get(s, UNVISITED) != role}
+            known.update(seen)
+            candidates = touched | changed
+        for state in sorted(candidates):
+            if state in model:
+                # A state whose role alone changed keeps its transitions: the last row's.
+                outs = _outs(model, state) if state in touched else rows[state][-1][1]
+                rows[state].append((step, outs, _role(roles, known, state)))
+            elif state in touched:
+                rows[state].append((step, None, None))
+    return rows
 
 
 def _role(roles: Roles | None, known: dict[int, int], state: int) -> int | None:
@@ -376,8 +396,8 @@ def _log_state(
     *,
     labelled: bool,
 ) -> int:
-    """The rows of one state's entity, a clear where it was deleted;
-    ``place_table`` is every state id, sorted, and its place."""
+    """The rows of one state's entity, a clear where it was deleted; ``place_table`` is
+    every state id, sorted, and its place."""
     path = state_path(state)
     x, y = places.places[state]
     alive = [(step, outs, role) for step, outs, role in changes if outs is not None]
@@ -387,7 +407,7 @@ def _log_state(
             [palette.STATE if role is None else ROLE_COLORS[role] for _, _, role in alive],
             np.uint8,
         )
-        arrows = _drawn_transitions(state, [outs for _, outs, _ in alive], places, place_table)
+        drawn = _drawn_transitions(state, [outs for _, outs, _ in alive], places, place_table)
         index = [rr.TimeColumn(TIMELINE, sequence=times)]
         stream.send_columns(
             path,
@@ -399,8 +419,8 @@ def _log_state(
                     labels=[str(state)] * len(times) if labelled else None,
                 ),
                 *rr.Arrows2D.columns(
-                    origins=arrows.origins, vectors=arrows.vectors, colors=arrows.colors
-                ).partition(arrows.counts),
+                    origins=drawn.origins, vectors=drawn.vectors, colors=drawn.colors
+                ).partition(drawn.counts),
             ],
         )
         poses = places.poses.get(state)
@@ -471,17 +491,19 @@ def _drawn_transitions(
 
 
 def _arrows(
-    source: tuple[float, float],
+    source: tuple[float, float] | _Floats,
     targets: _Floats,
     slot: npt.NDArray[np.int64],
     slots: npt.NDArray[np.int64],
     scale: float,
 ) -> tuple[_Floats, _Floats]:
-    """Arrows from ``source`` towards each of ``targets``, shortened at both ends, shifted
-    sideways by their slot so that arrows of several actions (and the way back) stay apart;
-    an arrow between two states at one place is a short one to the right."""
-    x0, y0 = source
-    delta = targets - np.array([x0, y0])
+    """Arrows from ``source`` (one place, or one per arrow) towards each of ``targets``,
+    shortened at both ends, shifted sideways by their slot so that arrows of several actions
+    (and the way back) stay apart; an arrow between two states at one place is a short one to
+    the right."""
+    sources = np.broadcast_to(np.asarray(source, np.float64), targets.shape)
+    x0, y0 = sources[:, 0], sources[:, 1]
+    delta = targets - sources
     length = np.hypot(delta[:, 0], delta[:, 1])
     apart = length > 0.0
     unit = np.divide(delta, length[:, None], out=np.zeros_like(delta), where=apart[:, None])
@@ -492,7 +514,7 @@ def _arrows(
         axis=1,
     )
     vectors = delta - 2 * unit * gap[:, None]
-    origins[~apart] = (x0, y0)
+    origins[~apart] = sources[~apart]
     vectors[~apart] = (2 * scale, 0.0)
     return origins, vectors
 

@@ -105,9 +105,10 @@ def log_series(
     return logged, thinned
 
 
-SERIES_MAX_ROWS = 100_000
+SERIES_MAX_ROWS = 25_000
 """A series with more changes than this in the steps shown (a closeness or a distance that
-changes with every pose of a long run) keeps only its extremes: :func:`_extremes`."""
+changes with every pose of a long run) keeps only its extremes: :func:`_extremes` (100,000
+until issue 32: the web viewer's load, as :data:`~rsstp_replay.viewer.OVERVIEW_MAX_STEPS`)."""
 
 
 def _extremes(

@@ -1,0 +1,87 @@
+"""What the model stood for, per true class: the role of the states that stood for each class.
+
+Over the steps a version was in force, the states that stood for a true class (the version's
+states current at a pose of that class) give the class a role: the worst of theirs
+(:mod:`rsstp_replay.audits.state_roles`), **aliased** over **redundant** over **exact**. So a
+class stood for by one state that stood for it alone is exact; by several states, none of
+them for another class too, redundant; by a state that stood for another class too, aliased.
+The viewer's model map colours each pose by its class's role
+(:mod:`rsstp_replay.viewer._map`), a class keeping the role of the last version that visited
+it (:func:`class_role_changes`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+import numpy.typing as npt
+
+from rsstp_replay.audits.state_roles import state_roles
+
+__all__ = ["RoleChanges", "class_role_changes", "class_roles"]
+
+_Ints = npt.NDArray[np.int64]
+
+
+def class_roles(
+    step_versions: npt.ArrayLike,
+    step_states: npt.ArrayLike,
+    step_classes: npt.ArrayLike,
+    *,
+    roles: Mapping[int, Mapping[int, int]] | None = None,
+) -> tuple[_Ints, _Ints, npt.NDArray[np.int8]]:
+    """Every ``(version, class)`` pair seen at a step, and the class's role in that version:
+    the worst role (aliased over redundant over exact) of the version's states that stood for
+    the class (:func:`~rsstp_replay.audits.state_roles.state_roles`; ``roles``: those roles
+    already at hand, per version and state). Sorted by version, then class."""
+    v = np.asarray(step_versions, np.int64).ravel()
+    s = np.asarray(step_states, np.int64).ravel()
+    c = np.asarray(step_classes, np.int64).ravel()
+    if not len(v):
+        empty = np.empty(0, np.int64)
+        return empty, empty, np.empty(0, np.int8)
+    order = np.lexsort((s, c, v))  # by version, class, state
+    tv, tc, ts = v[order], c[order], s[order]
+    pair_starts = np.r_[True, (tv[1:] != tv[:-1]) | (tc[1:] != tc[:-1])]
+    distinct = pair_starts | np.r_[True, ts[1:] != ts[:-1]]
+    tv, tc, ts, pair_starts = tv[distinct], tc[distinct], ts[distinct], pair_starts[distinct]
+    if roles is None:
+        found = state_roles(v, s, c, versions=tv, states=ts)
+    else:
+        found = np.array(
+            [roles[a][b] for a, b in zip(tv.tolist(), ts.tolist(), strict=True)], np.int8
+        )
+    starts = np.flatnonzero(pair_starts)
+    worst = np.maximum.reduceat(found, starts)
+    return tv[starts], tc[starts], worst.astype(np.int8)
+
+
+@dataclass(frozen=True, slots=True)
+class RoleChanges:
+    """Where a class's colour changes: at version ``versions[k]``, class ``classes[k]`` takes
+    role ``roles[k]`` (sorted by version). A class keeps its role until it changes."""
+
+    versions: _Ints
+    classes: _Ints
+    roles: npt.NDArray[np.int8]
+
+
+def class_role_changes(
+    step_versions: npt.ArrayLike,
+    step_states: npt.ArrayLike,
+    step_classes: npt.ArrayLike,
+    *,
+    state_roles: Mapping[int, Mapping[int, int]] | None = None,
+) -> RoleChanges:
+    """The changes of :func:`class_roles` over versions, a class keeping the role of the last
+    version that visited it (unvisited before)."""
+    versions, classes, roles = class_roles(
+        step_versions, step_states, step_classes, roles=state_roles
+    )
+    order = np.lexsort((versions, classes))  # by class, then version
+    c, r = classes[order], roles[order]  # every role is a visit's (never unvisited)
+    changed = np.r_[True, c[1:] != c[:-1]] | np.r_[True, r[1:] != r[:-1]]
+    keep = np.sort(order[changed])  # back to (version, class) order
+    return RoleChanges(versions[keep], classes[keep], roles[keep])
