@@ -27,7 +27,8 @@ world (S seconds each, in a subprocess; bench/learning.py).
 Prints a table (one line per world: N, joints, step, obstacles, one-way, and per feedback the
 steps, steps / N^2 and whether the model is exact, for each seed; the float's steps as a share
 of the boolean's) and writes ``--out`` (default ``bench-worlds/``): ``runs.csv`` and
-``steps-per-n2.png`` (steps / N^2 against N, boolean and float). Targets (issue 32): every
+``steps-per-n2.png`` (steps / N^2 against N, boolean and float); ``runs.csv`` is rewritten as
+each run ends, so a bench stopped early keeps what it measured. Targets (issue 32): every
 run exact within 4 N^2; the float twin within half the boolean's steps on each world.
 """
 
@@ -244,6 +245,15 @@ def _table(worlds: Sequence[World], runs: Sequence[Run], seeds: int) -> str:
     return "\n".join(lines)
 
 
+def _write_runs(runs: Sequence[Run], hw: dict[str, dict[str, Any]], path: Path) -> None:
+    """``runs.csv``: one row per run, smallest world first, AALpy's result beside (if run)."""
+    with path.open("w", newline="", encoding="utf-8") as f:
+        writer = csv.DictWriter(f, fieldnames=[*Run.__dataclass_fields__, "hw"])
+        writer.writeheader()
+        for r in sorted(runs, key=lambda r: (r.n, r.world, r.seed, r.mode)):
+            writer.writerow({**asdict(r), "hw": hw.get(r.world, {}).get("result", "")})
+
+
 def _plot(runs: Sequence[Run], path: Path) -> None:
     import matplotlib
 
@@ -264,7 +274,13 @@ def _plot(runs: Sequence[Run], path: Path) -> None:
                     label=f"{mode}, {'exact' if exact else 'not learned'}",
                 )
     axes.axhline(4, color="grey", linestyle="--", linewidth=1, label="budget 4 N²")
-    axes.set_xscale("log")
+    from matplotlib.ticker import FuncFormatter, NullFormatter
+
+    sizes = [r.n for r in runs]
+    if max(sizes) >= 10 * min(sizes):  # (a narrow range reads better on a linear axis)
+        axes.set_xscale("log")
+        axes.xaxis.set_minor_formatter(NullFormatter())
+    axes.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:,.0f}"))
     axes.set_yscale("log")
     axes.set_xlabel("N (classes of the boolean world)")
     axes.set_ylabel("steps / N²")
@@ -334,10 +350,12 @@ def main(argv: Sequence[str] | None = None) -> int:
         # The largest first, so that the longest runs do not start last.
         tasks.sort(key=lambda t: -t[0].n)
         futures = [client.submit(learn, w, s, m, args.budget_cap, pure=False) for w, s, m in tasks]
+        args.out.mkdir(parents=True, exist_ok=True)
         runs: list[Run] = []
         for future in _as_completed(futures):
             run = future.result()
             runs.append(run)
+            _write_runs(runs, {}, args.out / "runs.csv")  # (kept if the bench is stopped)
             print(
                 f"  {run.world:12s} seed {run.seed} {run.mode:5s} {run.steps:>11,} steps "
                 f"({run.steps / run.n**2:.3f} N^2) {'exact' if run.exact else 'NOT exact'} "
@@ -353,12 +371,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                 hw[w.name] = _hw_on(w.name, scenario, args.aalpy_seconds, 0, 8.0)
                 print(f"  AALpy hW on {w.name}: {hw[w.name]}", flush=True)
         print(_table(worlds, runs, args.seeds))
-        args.out.mkdir(parents=True, exist_ok=True)
-        with (args.out / "runs.csv").open("w", newline="", encoding="utf-8") as f:
-            writer = csv.DictWriter(f, fieldnames=[*asdict(runs[0]), "hw"])
-            writer.writeheader()
-            for r in sorted(runs, key=lambda r: (r.n, r.world, r.seed, r.mode)):
-                writer.writerow({**asdict(r), "hw": hw.get(r.world, {}).get("result", "")})
+        _write_runs(runs, hw, args.out / "runs.csv")
         _plot(runs, args.out / "steps-per-n2.png")
         print(f"wrote {args.out / 'runs.csv'} and {args.out / 'steps-per-n2.png'}")
         return 0 if all(r.exact for r in runs) else 1
