@@ -93,6 +93,7 @@ class Hypothesis:
         self._toward: IntArray | None = None
         self._edits = 0
         self._inverse: tuple[int, dict[int, int]] = (-1, {})
+        self._matched: tuple[tuple[int, bool], IntArray] = ((-1, False), np.zeros(0, np.int64))
 
     # ----------------------------------------------------------------- queries
 
@@ -148,8 +149,20 @@ class Hypothesis:
 
     def matching(self, sensation: bool, feel: float) -> list[int]:
         """The states agreeing with what was sensed (and felt), by id."""
+        return self.matching_ids(sensation, feel).tolist()
+
+    def matching_ids(self, sensation: bool, feel: float) -> IntArray:
+        """:meth:`matching` as an array (read-only). Without feels it is kept while the
+        :attr:`edits` stay the same: a search for the landmark asks for it at every step."""
+        key = (self._edits, sensation)
+        if not self.feels and self._matched[0] == key:
+            return self._matched[1]
         states = np.flatnonzero(self.alive)
-        return [int(s) for s in states[self.agree(states, sensation, feel)]]
+        found = states[self.agree(states, sensation, feel)]
+        found.flags.writeable = False
+        if not self.feels:
+            self._matched = (key, found)
+        return found
 
     def step(
         self, start: IntArray, position: IntArray, action: int, via: tuple[int, int]

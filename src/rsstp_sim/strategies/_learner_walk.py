@@ -222,7 +222,7 @@ class Walker:
         ids = np.asarray([s for s in near if h.agrees(s, sensation, feel)], dtype=np.int64)
         widened = not len(ids)
         if widened:
-            ids = np.asarray(h.matching(sensation, feel), dtype=np.int64)
+            ids = h.matching_ids(sensation, feel)
         failed = wander = 0
         while True:
             usable = np.flatnonzero(h.distance[ids] < FAR)
@@ -242,7 +242,7 @@ class Walker:
                 wander = LONGEST_RUN << min(failed, 20)
                 failed += 1
                 widened = True
-                ids = np.asarray(h.matching(False, self.feel()), dtype=np.int64)
+                ids = h.matching_ids(False, self.feel())
                 continue
             else:
                 action = self.random_action()
@@ -267,7 +267,7 @@ class Walker:
                         wander = LONGEST_RUN << min(failed, 20)
                         failed += 1
                 widened = True
-                ids = np.asarray(h.matching(sensation, feel), dtype=np.int64)
+                ids = h.matching_ids(sensation, feel)
 
     def check_confined(self) -> None:
         """After a step of a search for the landmark: raise :class:`Confined` when the search
