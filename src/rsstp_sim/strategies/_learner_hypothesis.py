@@ -149,7 +149,8 @@ class Hypothesis:
 
     def matching(self, sensation: bool, feel: float) -> list[int]:
         """The states agreeing with what was sensed (and felt), by id."""
-        return self.matching_ids(sensation, feel).tolist()
+        found: list[int] = self.matching_ids(sensation, feel).tolist()
+        return found
 
     def matching_ids(self, sensation: bool, feel: float) -> IntArray:
         """:meth:`matching` as an array (read-only). Without feels it is kept while the
