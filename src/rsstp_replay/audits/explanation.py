@@ -343,7 +343,9 @@ def _with_suggestions(found: Explanation) -> Explanation:
                 "nothing could be learned; put the target where the arm starts or explores, or "
                 "start the arm nearer it"
             )
-            if found.feedback_mode == "float" and found.best_feedback_step is not None:
+            peak = found.best_feedback_step
+            if found.feedback_mode == "float" and peak is not None and peak <= steps // 2:
+                # (a peak in the run's second half is no evidence of being held there)
                 out.append(
                     f"the float feedback peaked at {found.best_feedback:.4f} at step "
                     f"{found.best_feedback_step:,} and never rose after: the climb is held at a "
