@@ -309,7 +309,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("bench-worlds"))
     args = parser.parse_args(argv)
 
-    from distributed import Client, LocalCluster
+    from distributed import Client, LocalCluster, as_completed
 
     cluster = None
     if args.scheduler:
@@ -352,7 +352,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         futures = [client.submit(learn, w, s, m, args.budget_cap, pure=False) for w, s, m in tasks]
         args.out.mkdir(parents=True, exist_ok=True)
         runs: list[Run] = []
-        for future in _as_completed(futures):
+        for future in as_completed(futures):
             run = future.result()
             runs.append(run)
             _write_runs(runs, {}, args.out / "runs.csv")  # (kept if the bench is stopped)
@@ -379,12 +379,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         client.close()
         if cluster is not None:
             cluster.close()
-
-
-def _as_completed(futures: list[Any]) -> Any:
-    from distributed import as_completed
-
-    return as_completed(futures)
 
 
 if __name__ == "__main__":

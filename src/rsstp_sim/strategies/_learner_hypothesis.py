@@ -336,13 +336,13 @@ class Hypothesis:
         if wanted[source]:
             return [], source
         width = len(self.actions)
-        rows = self.next[:, self._columns]
+        columns = np.asarray(self._columns, dtype=np.int64)
         seen = np.zeros(len(self.label), dtype=bool)
         seen[source] = True
         level = np.asarray([source], dtype=np.int64)
         reached: list[IntArray] = []  # per level: where in the level before each state came from
         while len(level):
-            met = rows[level].ravel()
+            met = self.next[level[:, None], columns].ravel()  # (the level's rows only)
             where = np.flatnonzero(met >= 0)
             where = where[~seen[met[where]]]
             _, first = np.unique(met[where], return_index=True)
