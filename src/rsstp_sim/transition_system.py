@@ -111,6 +111,7 @@ class TransitionSystem:
         "_version",
         "_next_id",
         "_n_nondeterministic",
+        "_n_transitions",
         "_ops",
         "_states_sorted",
         "_index",
@@ -132,6 +133,7 @@ class TransitionSystem:
         self._version = 0
         self._next_id = n
         self._n_nondeterministic = 0
+        self._n_transitions = 0
         self._ops: list[Operation] = []
         self._states_sorted: tuple[int, ...] | None = None
         self._index: dict[int, int] | None = None
@@ -218,6 +220,11 @@ class TransitionSystem:
             return {u for sources in self._in[s].values() for u in sources}
         except KeyError:
             raise ModelError(f"predecessors: unknown state {s!r}") from None
+
+    @property
+    def n_transitions(self) -> int:
+        """How many transitions there are (kept as they change: no count)."""
+        return self._n_transitions
 
     def is_deterministic(self) -> bool:
         """Every (state, action) has at most one successor (O(1), kept incrementally)."""
@@ -487,6 +494,7 @@ class TransitionSystem:
         other._version = self._version
         other._next_id = self._next_id
         other._n_nondeterministic = self._n_nondeterministic
+        other._n_transitions = self._n_transitions
         other._ops = []
         other._states_sorted = self._states_sorted
         other._index = self._index
@@ -571,6 +579,7 @@ class TransitionSystem:
             into[t].setdefault(a, set()).add(s)
         model._out, model._in = out, into
         model._n_nondeterministic = nondeterministic
+        model._n_transitions = len(columns[0])
         model._states_sorted = tuple(states)
         model._current = current
         model._next_id = next_id
@@ -607,6 +616,7 @@ class TransitionSystem:
             return False
         out[a] = targets[:i] + (t,) + targets[i:]
         self._rows.pop(s, None)
+        self._n_transitions += 1
         if len(targets) == 1:
             self._n_nondeterministic += 1
         self._in[t].setdefault(a, set()).add(s)
@@ -618,6 +628,7 @@ class TransitionSystem:
         if t not in targets:
             return False
         self._rows.pop(s, None)
+        self._n_transitions -= 1
         if len(targets) == 1:
             del out[a]
         else:

@@ -1,6 +1,6 @@
-"""What an operation changes, used twice: the model chain's fast check (the previous snapshot
-with the touched states' rows replaced is the model the operations make) and the truth audit's
-tracked successor table (kept through the touched states, equal to one built afresh)."""
+"""The model versions kept as changes (every version rebuilt whole from them is the model its
+operations made), and what an operation changes: the truth audit's tracked successor table
+(kept through the touched states, equal to one built afresh)."""
 
 from __future__ import annotations
 
@@ -12,8 +12,9 @@ from hypothesis import strategies as st
 from rsstp_format.records import TransitionsRecord
 from rsstp_replay.audits._equivalence import ModelTable, TrackedTable
 from rsstp_replay.audits.determinism import audit_determinism
-from rsstp_replay.reader._models import _patched
+from rsstp_replay.reader._models import ModelHistory
 from rsstp_sim import load_scenario
+from rsstp_sim.recording.builders import model_record
 from rsstp_sim.transition_system import TransitionSystem
 
 
@@ -26,44 +27,77 @@ def as_record(model: TransitionSystem) -> TransitionsRecord:
     )
 
 
-@pytest.mark.slow
-@settings(max_examples=300, deadline=None)
-@given(st.data())
-def test_touched_rows_patched_onto_the_previous_snapshot_give_the_new_model(
-    data: st.DataObject,
-) -> None:
+def random_operations(data: st.DataObject, model: TransitionSystem) -> set[int]:
+    """One to four random operations on ``model``; the states whose transitions they touched."""
+    touched: set[int] = set()
+    for _ in range(data.draw(st.integers(1, 4))):
+        states = model.states
+        kind = data.draw(st.sampled_from(["add", "delete", "split", "merge"]))
+        if kind == "merge" and len(states) < 2:
+            continue
+        s = data.draw(st.sampled_from(states))
+        if kind == "split":
+            touched |= model.sources_changed_by(kind, (s,))
+            model.split(s)
+        elif kind == "merge":
+            t = data.draw(st.sampled_from([x for x in states if x != s]))
+            touched |= model.sources_changed_by(kind, (s, t))
+            model.merge(s, t)
+        else:
+            t, a = data.draw(st.sampled_from(states)), data.draw(st.sampled_from((0, 1)))
+            touched |= model.sources_changed_by(kind, (s, t, a))
+            getattr(model, kind)(s, t, a)
+    return touched
+
+
+def start_model(data: st.DataObject) -> TransitionSystem:
     model = TransitionSystem(data.draw(st.integers(1, 4)), actions=(0, 1))
     for _ in range(data.draw(st.integers(0, 12))):  # some transitions to start from
         states = model.states
         model.add(data.draw(st.sampled_from(states)), data.draw(st.sampled_from(states)),
                   data.draw(st.sampled_from((0, 1))))  # fmt: skip
+    model.drain_operations()
+    return model
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.data())
+def test_a_history_of_changes_gives_every_version_whole_in_any_order(data: st.DataObject) -> None:
+    model = start_model(data)
+    history = ModelHistory(share=data.draw(st.sampled_from([1, 8])))
+    copies = [model.copy()]
+    history.add(model_record(model, step=0, operations=()), model)
+    for step in range(1, data.draw(st.integers(1, 30))):
+        random_operations(data, model)
+        model.current = data.draw(st.sampled_from(model.states))
+        change = model_record(model, step=step, operations=model.drain_operations(), keyframe=False)
+        history.add(change, model)
+        copies.append(model.copy())
+    for k in data.draw(st.permutations(range(len(copies)))):
+        record, expected = history[k], copies[k]
+        assert record.keyframe == (k == 0)
+        assert tuple(record.states) == expected.states
+        assert record.triples() == tuple(expected.transitions())
+        assert (record.version, record.current) == (expected.version, expected.current)
+        assert history.heads[k].step == k
+    states, transitions = history.sizes()
+    assert states.tolist() == [len(m) for m in copies]
+    assert transitions.tolist() == [len(m.transitions()) for m in copies]
+    pairs = [(k, s) for k in range(len(copies)) for s in range(copies[-1].next_id + 1)]
+    alive = history.alive([k for k, _ in pairs], [s for _, s in pairs])
+    assert alive.tolist() == [s in copies[k] for k, s in pairs]
+
+
+@pytest.mark.slow
+@settings(max_examples=300, deadline=None)
+@given(st.data())
+def test_the_tracked_table_kept_through_touched_states_is_built_afresh(
+    data: st.DataObject,
+) -> None:
+    model = start_model(data)
     tracked = TrackedTable(model, (0, 1))
     for _ in range(data.draw(st.integers(1, 6))):  # one version: several operations
-        before = as_record(model)
-        touched: set[int] = set()
-        for _ in range(data.draw(st.integers(1, 4))):
-            states = model.states
-            kind = data.draw(st.sampled_from(["add", "delete", "split", "merge"]))
-            if kind == "merge" and len(states) < 2:
-                continue
-            s = data.draw(st.sampled_from(states))
-            if kind == "split":
-                touched |= model.sources_changed_by(kind, (s,))
-                model.split(s)
-            elif kind == "merge":
-                t = data.draw(st.sampled_from([x for x in states if x != s]))
-                touched |= model.sources_changed_by(kind, (s, t))
-                model.merge(s, t)
-            else:
-                t, a = data.draw(st.sampled_from(states)), data.draw(st.sampled_from((0, 1)))
-                touched |= model.sources_changed_by(kind, (s, t, a))
-                getattr(model, kind)(s, t, a)
-        after = as_record(model)
-        patched = _patched(before, model, touched)
-        columns = (patched.source, patched.action, patched.target)
-        assert tuple(map(tuple, columns)) == (after.source, after.action, after.target)
-        assert patched.holds(after)
-        assert all(column.itemsize == 2 for column in columns)  # type: ignore[attr-defined]
+        touched = random_operations(data, model)
         tracked.update(model, touched)
         labels = {s: bool(s % 2) for s in model.states}
         fresh, kept = ModelTable.of(model, labels, (0, 1)), tracked.table(labels)
@@ -89,9 +123,9 @@ def test_the_determinism_audit_kept_through_touched_states_is_every_versions_own
         assert (version.nondeterministic, version.empty) == (own.nondeterministic, own.empty)
 
 
-def test_a_version_that_outgrows_two_byte_ids_is_patched_whole() -> None:
-    """Columns of 2-byte ids carried into a version whose new state needs 4 bytes: the patch
-    holds every transition, the new state's included, in the wider type."""
+def test_a_version_that_outgrows_two_byte_ids_is_rebuilt_in_wider_columns() -> None:
+    """A split that makes state 32,767 (no longer a 2-byte id, as the kept models' columns
+    first held them): the version rebuilt holds every transition, the new state's included."""
     first = TransitionSystem.from_snapshot(
         {
             "states": [0, 32_766],
@@ -101,17 +135,11 @@ def test_a_version_that_outgrows_two_byte_ids_is_patched_whole() -> None:
             "transitions": [[0, 0, 32_766], [32_766, 1, 0], [32_766, 0, 32_766]],
         }
     )
-    narrow = _patched(as_record(first), first, set())  # the previous version, compacted
-    assert narrow.source.itemsize == 2  # type: ignore[attr-defined]
-    touched = first.sources_changed_by("split", (32_766,))
-    created = first.split(32_766)
-    assert created == 32_767
-    wide = _patched(narrow, first, touched)
-    after = as_record(first)
-    assert (tuple(wide.source), tuple(wide.action), tuple(wide.target)) == (
-        after.source,
-        after.action,
-        after.target,
-    )
-    assert wide.holds(after)
-    assert wide.source.itemsize == 4  # type: ignore[attr-defined]
+    history = ModelHistory(share=1)
+    history.add(model_record(first, step=0, operations=()), first)
+    assert history[0].triples() == tuple(first.transitions())
+    assert first.split(32_766) == 32_767
+    history.add(model_record(first, step=1, operations=first.drain_operations()), first)
+    wide = history[1]
+    assert wide.triples() == tuple(first.transitions())
+    assert 32_767 in wide.states

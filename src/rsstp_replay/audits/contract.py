@@ -39,6 +39,7 @@ import pandas as pd
 
 from rsstp_format.records import ModelRecord
 from rsstp_format.schemas import STEP_NS
+from rsstp_replay.reader import version_alive, version_heads
 from rsstp_sim.words import counted
 
 __all__ = ["ContractFindings", "ContractSource", "Violation", "check_contract", "version_index"]
@@ -114,7 +115,8 @@ def version_index(versions: Sequence[ModelRecord], steps: _Ints) -> _Ints:
 def check_contract(source: ContractSource) -> ContractFindings:
     """Check every step against the model messages (see the module docstring)."""
     table = source.steps(geometry=False)
-    versions = list(source.model_versions())
+    history = source.model_versions()
+    versions = version_heads(history)
     step = table.index.to_numpy(np.int64)
     state = table["internal_state"].to_numpy(np.int64)
     named = table["model_version"].to_numpy(np.int64)
@@ -146,17 +148,10 @@ def check_contract(source: ContractSource) -> ContractFindings:
         ),
     )
 
-    sizes = np.fromiter((len(record.states) for record in versions), np.int64, len(versions))
-    members = np.fromiter(
-        (s for record in versions for s in record.states), np.int64, int(sizes.sum())
-    )
-    base = int(max(members.max(initial=0), state.max(initial=0))) + 1
-    keys = np.sort(np.repeat(np.arange(len(versions), dtype=np.int64), sizes) * base + members)
-    wanted = np.maximum(index, 0) * base + state
-    where = np.minimum(np.searchsorted(keys, wanted), max(len(keys) - 1, 0))
+    member = version_alive(history, index, state)
     found += _first_of(
         "state-in-model",
-        np.flatnonzero((index < 0) | (state < 0) | (keys[where] != wanted)),
+        np.flatnonzero(~member),
         step,
         lambda t: (
             f"step {step[t]} is in internal state {state[t]}, which is not a state of "

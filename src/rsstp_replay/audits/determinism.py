@@ -37,6 +37,7 @@ from typing import Any, Protocol
 import pandas as pd
 
 from rsstp_format.records import ModelRecord
+from rsstp_replay.reader import version_heads, version_sizes
 from rsstp_sim.errors import ModelError
 from rsstp_sim.transition_system import DeterminismReport, TransitionSystem
 from rsstp_sim.words import counted
@@ -219,14 +220,17 @@ def audit_determinism(
     themselves, in order. Raises :class:`~rsstp_sim.errors.ModelError` when there is no model
     message, or when a message's operations do not lead from the previous model to its own.
     """
-    records = source if isinstance(source, Sequence) else source.model_versions()
-    if not records:
+    history = source if isinstance(source, Sequence) else source.model_versions()
+    if not history:
         raise ModelError("determinism audit: no model message (a recording has one at step 0)")
     found = []
     model: TransitionSystem | None = None
     rows: dict[int, tuple[list[tuple[int, int, tuple[int, ...]]], list[tuple[int, int]]]] = {}
+    flagged: set[int] = set()  # the states with a pair of several successors or of none
+    report = DeterminismReport((), ())
     actions: tuple[int, ...] = ()
-    for record in records:
+    sizes = zip(*(column.tolist() for column in version_sizes(history)), strict=True)
+    for record, (n_states, n_transitions) in zip(version_heads(history), sizes, strict=True):
         if model is None:
             model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
             changed: set[int] = set(model.states)
@@ -234,15 +238,28 @@ def audit_determinism(
             changed = _advance(model, record)
         if model.actions != actions:  # a new action: every state's empty pairs change
             actions, changed = model.actions, set(model.states)
+        touched = False
         for s in changed:  # each state's part kept, redone only where an operation touched it
             if s in model:
-                rows[s] = model.determinism_of(s)
+                rows[s] = part = model.determinism_of(s)
+                if part[0] or part[1]:
+                    touched = True
+                    flagged.add(s)
+                elif s in flagged:
+                    flagged.discard(s)
+                    touched = True
+            elif s in flagged:
+                rows.pop(s, None)
+                flagged.discard(s)
+                touched = True
             else:
                 rows.pop(s, None)
-        report = DeterminismReport(
-            tuple(pair for s in model.states for pair in rows[s][0]),
-            tuple(pair for s in model.states for pair in rows[s][1]),
-        )
+        if touched:  # (states in order, as the model's own report lists them)
+            ordered = sorted(flagged)
+            report = DeterminismReport(
+                tuple(pair for s in ordered for pair in rows[s][0]),
+                tuple(pair for s in ordered for pair in rows[s][1]),
+            )
         if len(report.nondeterministic) != record.nondeterministic_pairs:
             raise ModelError(
                 f"model version {record.version} (step {record.step}) has "
@@ -253,8 +270,8 @@ def audit_determinism(
             VersionDeterminism(
                 version=record.version,
                 step=record.step,
-                states=len(record.states),
-                transitions=len(record.transitions),
+                states=n_states,
+                transitions=n_transitions,
                 nondeterministic=report.nondeterministic,
                 empty=report.empty,
             )
@@ -280,7 +297,7 @@ def _advance(model: TransitionSystem, record: ModelRecord) -> set[int]:
             f"{where}: its operations lead from the previous version to version "
             f"{model.version}, not {record.version}"
         )
-    if model.states != record.states:
+    if record.states and model.states != record.states:  # (a change's message has none)
         raise ModelError(
             f"{where}: its operations give states {_short(model.states)}, the message says "
             f"{_short(record.states)}"

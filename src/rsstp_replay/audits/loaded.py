@@ -50,7 +50,7 @@ class LoadedRecording:
         else:
             table = source.steps(geometry=False)
         table = table.drop(columns=["blocked_kind", *detail], errors="ignore")
-        self._models = tuple(source.model_versions())
+        self._models = source.model_versions()
         self._memory = memory = Memory.from_arrays(
             table["action"].to_numpy(np.int64, na_value=-1),
             table["internal_state"].to_numpy(np.int64),

@@ -35,6 +35,7 @@ from rsstp_format.records import ModelRecord
 from rsstp_replay.audits.compare import HasMemory
 from rsstp_replay.audits.consistency import ConsistencyFindings, Sample, audit_consistency
 from rsstp_replay.audits.determinism import HasModelVersions
+from rsstp_replay.reader import version_heads, version_sizes
 from rsstp_sim.errors import ModelError
 from rsstp_sim.runner import stop_text
 from rsstp_sim.transition_system import TransitionSystem
@@ -249,7 +250,8 @@ def audit_summary(
     model message.
     """
     memory = source.memory()
-    records: Sequence[ModelRecord] = source.model_versions()
+    history: Sequence[ModelRecord] = source.model_versions()
+    records = version_heads(history)
     if not records:
         raise ModelError("summary: no model message (a recording has one at step 0)")
     if consistency is None:
@@ -259,15 +261,17 @@ def audit_summary(
         operation.kind for record in records for operation in record.operations if operation.changed
     )
     sensations_true = int(np.count_nonzero(memory.sensations))
-    final = records[-1]
+    final = history[-1]
     final_model = TransitionSystem.from_snapshot(final.snapshot(), version=final.version)
     contradictions = consistency.contradictions
     events = source.events()
     return SummaryFindings(
         steps=memory.steps,
         sizes=tuple(
-            ModelSize(record.version, record.step, len(record.states), len(record.transitions))
-            for record in records
+            ModelSize(record.version, record.step, n_states, n_transitions)
+            for record, n_states, n_transitions in zip(
+                records, *(column.tolist() for column in version_sizes(history)), strict=True
+            )
         ),
         splits=kinds["split"],
         merges=kinds["merge"],

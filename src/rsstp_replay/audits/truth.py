@@ -49,6 +49,7 @@ from rsstp_replay.audits.consistency import (
 from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
+from rsstp_replay.reader import version_heads, version_sizes
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.truth import GroundTruth
@@ -336,12 +337,13 @@ def audit_truth(
     steps = loaded.steps()
     true_class = step_true_classes(steps, truth)
     memory = loaded.memory()
-    versions = list(loaded.model_versions())
+    history = loaded.model_versions()
+    versions = version_heads(history)
     states = np.asarray(memory.internal_states, dtype=np.int64)
     index = version_index(versions, np.arange(len(states), dtype=np.int64))
     columns = list(truth.value_names)
     verdict, equivalent = judge_versions(
-        versions,
+        history,
         truth=truth,
         states=states,
         sensations=np.asarray(memory.sensations, np.bool_),
@@ -370,6 +372,7 @@ def audit_truth(
         contradicted[position[found.version]] += 1
 
     starts = np.fromiter((record.step for record in versions), np.int64, n)
+    n_states, n_transitions = version_sizes(history)
     ends = np.r_[starts[1:], len(states)] - 1
     table = pd.DataFrame(
         {
@@ -377,8 +380,8 @@ def audit_truth(
             "step": starts,
             "last_step": ends,
             "steps_in_force": np.maximum(ends - starts + 1, 0),
-            "states": np.fromiter((len(r.states) for r in versions), np.int64, n),
-            "transitions": np.fromiter((len(r.transitions) for r in versions), np.int64, n),
+            "states": n_states,
+            "transitions": n_transitions,
             "deterministic": np.fromiter((r.deterministic for r in versions), np.bool_, n),
             "aliased_states": aliased_states,
             "redundant_classes": redundant_classes,

@@ -42,6 +42,7 @@ from rsstp_replay.audits._equivalence import (
     closure,
     equivalent_classes,
 )
+from rsstp_replay.reader import version_heads, version_sizes
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence
 from rsstp_sim.words import counted
@@ -342,6 +343,7 @@ def judge_versions(
     ``actions``, ``angles`` to name the move that confined the run) are per step
     (``0 .. T``).
     """
+    history, versions = versions, version_heads(versions)  # each message, not rebuilt
     steps = len(states) - 1
     labels = _Labels.of(states, sensations)
     starts = np.fromiter((record.step for record in versions), np.int64, len(versions))
@@ -419,9 +421,9 @@ def judge_versions(
             learned=learned,
             learned_at_step=learned_at,
             steps=steps,
-            final_states=len(final.states),
+            final_states=len(model),
             minimal_states=n_classes,
-            growth_per_step=_growth(versions, steps),
+            growth_per_step=_growth(history, steps),
             last_change_step=final.step,
             counterexample=counterexample,
             learned_reachable=learned_reachable,
@@ -539,8 +541,9 @@ def _growth(versions: Sequence[ModelRecord], steps: int) -> float:
     if steps < 2:
         return 0.0
     middle = steps // 2
-    at = np.fromiter((record.step for record in versions), np.int64, len(versions))
-    sizes = np.fromiter((len(record.states) for record in versions), np.int64, len(versions))
+    heads = version_heads(versions)
+    at = np.fromiter((record.step for record in heads), np.int64, len(heads))
+    sizes = version_sizes(versions)[0]
     size_middle = int(sizes[int(np.searchsorted(at, middle, side="right")) - 1])
     return round((int(sizes[-1]) - size_middle) / (steps - middle), 4)
 

@@ -13,5 +13,21 @@ from rsstp_replay.reader._decode import (
     blocker_texts,
     body_reader,
 )
+from rsstp_replay.reader._models import (
+    ModelHistory,
+    version_alive,
+    version_heads,
+    version_sizes,
+)
 
-__all__ = ["BLOCKED_COLUMNS", "BodyReader", "blocker_label", "blocker_texts", "body_reader"]
+__all__ = [
+    "BLOCKED_COLUMNS",
+    "BodyReader",
+    "ModelHistory",
+    "blocker_label",
+    "blocker_texts",
+    "body_reader",
+    "version_alive",
+    "version_heads",
+    "version_sizes",
+]

@@ -45,7 +45,13 @@ from rsstp_replay.reader._chunks import Messages, gc_paused, message_times
 from rsstp_replay.reader._container import ChunkRef, open_container
 from rsstp_replay.reader._contract import CheckedFile, check_file
 from rsstp_replay.reader._decode import StepColumns, body_reader
-from rsstp_replay.reader._models import HEADS, ChainCheck, ModelHead
+from rsstp_replay.reader._models import (
+    HEADS,
+    ChainCheck,
+    ModelHead,
+    ModelHistory,
+    version_heads,
+)
 from rsstp_sim.errors import MemoryRangeError
 from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
@@ -123,7 +129,7 @@ class Recording:
         self._agent_cache: dict[int, StepColumns] = {}
         self._agent: StepColumns | None = None
         self._log_times: _Ints | None = None
-        self._models: tuple[ModelRecord, ...] | None = None
+        self._models: Sequence[ModelRecord] | None = None
         self._events: pd.DataFrame | None = None
 
     # -- properties ------------------------------------------------------------------------
@@ -295,7 +301,7 @@ class Recording:
         0, and the recording is read as having the one-state model (a self-loop per action)."""
         return "/rsstp/model" in self._file.channels
 
-    def model_versions(self) -> tuple[ModelRecord, ...]:
+    def model_versions(self) -> Sequence[ModelRecord]:
         """The ``/rsstp/model`` messages in order, the chain between them checked (without a
         model channel, the one-state model at step 0: :attr:`has_model`)."""
         self._check_open()
@@ -307,13 +313,12 @@ class Recording:
             self._models = self._checked_models()
         return self._models
 
-    def _checked_models(self) -> tuple[ModelRecord, ...]:
+    def _checked_models(self) -> ModelHistory:
         """The model messages, each checked against the chain as it is read: a message that
         is byte for byte what its operations make is read without parsing its transitions
         (:meth:`~rsstp_replay.reader._models.ChainCheck.head`)."""
         topic = "/rsstp/model"
         chain = ChainCheck(self.path, last_step=self.n_steps)
-        found: list[ModelRecord] = []
         for ref, _, parts, times in self._chunks(topic):
             try:
                 heads = HEADS.decode(json_array(parts))
@@ -322,15 +327,15 @@ class Recording:
             if heads is None or len(heads) != len(parts):
                 records = self._file.decode_many(topic, parts, times, ref)
                 for record, log_time in zip(records, times.tolist(), strict=True):
-                    found.append(chain(self._timed(topic, record, log_time, ref)))
+                    chain(self._timed(topic, record, log_time, ref))
                 continue
             for head, part, log_time in zip(heads, parts, times.tolist(), strict=True):
                 self._timed(topic, head, log_time, ref)
                 decode = partial(self._file.decode_one, topic, part, log_time, ref)
-                found.append(chain.head(head, part.tobytes(), decode))
-        chain.finish()
+                chain.head(head, part.tobytes(), decode)
+        found = chain.finish()
         self._counted(topic, len(found))
-        return tuple(found)
+        return found
 
     def _timed(self, topic: str, record: _Stepped, log_time: int, ref: ChunkRef) -> _Stepped:
         """``record``, a ``topic`` message, checked to be logged at its step's time."""
@@ -351,7 +356,7 @@ class Recording:
         """
         step = self._check_step(step)
         models = self.model_versions()
-        index = bisect.bisect_right([m.step for m in models], step) - 1
+        index = bisect.bisect_right([m.step for m in version_heads(models)], step) - 1
         record = models[index]
         transitions = record.transitions  # (the chain check rebuilt and checked them)
         model = TransitionSystem.from_columns(
