@@ -18,6 +18,7 @@ from rsstp_replay.reader._models import (
     version_alive,
     version_heads,
     version_sizes,
+    version_state_ids,
 )
 
 __all__ = [
@@ -30,4 +31,5 @@ __all__ = [
     "version_alive",
     "version_heads",
     "version_sizes",
+    "version_state_ids",
 ]

@@ -35,6 +35,7 @@ __all__ = [
     "version_alive",
     "version_heads",
     "version_sizes",
+    "version_state_ids",
 ]
 
 
@@ -260,6 +261,10 @@ class ModelHistory(Sequence[ModelRecord]):
         transitions), but the first, whole."""
         return self._heads
 
+    def state_ids(self) -> list[int]:
+        """Every state id any version has, sorted."""
+        return sorted(self._born)
+
     def sizes(self) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
         """Each version's number of states and of transitions."""
         return (
@@ -337,6 +342,16 @@ def version_sizes(
         np.fromiter((len(r.states) for r in versions), np.int64, n),
         np.fromiter((len(r.transitions) for r in versions), np.int64, n),
     )
+
+
+def version_state_ids(versions: Sequence[ModelRecord]) -> list[int]:
+    """Every state id any of ``versions`` has, sorted."""
+    if isinstance(versions, ModelHistory):
+        return versions.state_ids()
+    every: set[int] = set()
+    for record in versions:  # a set's update is C's loop
+        every.update(record.states)
+    return sorted(every)
 
 
 def version_alive(

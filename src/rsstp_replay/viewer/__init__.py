@@ -30,6 +30,7 @@ from pathlib import Path
 from typing import Protocol
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 import rerun as rr
 
@@ -38,7 +39,7 @@ from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consisten
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.audits.truth import step_true_classes
 from rsstp_replay.errors import ReplayError, StepOutOfRange, ViewerWarning
-from rsstp_replay.reader import body_reader
+from rsstp_replay.reader import body_reader, version_heads, version_sizes
 from rsstp_replay.viewer import _large as large_part
 from rsstp_replay.viewer import _map as map_part
 from rsstp_replay.viewer import _model as model_part
@@ -394,7 +395,7 @@ class _Loaded:
     """A recording read once, audited, its states placed on the world."""
 
     steps: pd.DataFrame
-    versions: list[ModelRecord]
+    versions: Sequence[ModelRecord]
     events: pd.DataFrame
     within: ConsistencyFindings | None
     determinism: DeterminismFindings | None
@@ -410,7 +411,7 @@ class _Loaded:
 def _load(recording: ViewSource) -> _Loaded:
     began = time.perf_counter()
     steps = recording.steps()
-    versions = list(recording.model_versions())
+    versions = recording.model_versions()  # (rebuilt whole only where indexed)
     events = recording.events()
     read = time.perf_counter()
     within, determinism = _audits(steps, versions)
@@ -455,8 +456,8 @@ def _log(
     if loaded.roles is not None:
         frame = view_frame(scenario)
         model_part.log_legend(stream, reach=frame.half, center=frame.center)
-    shown, times = _versions_in(loaded.versions, first, last)
-    large = max(len(record.states) for record in shown) > large_part.ALL_ARROWS_MAX_STATES
+    shown, times, sizes = _versions_in(loaded.versions, first, last)
+    large = int(sizes[0].max()) > large_part.ALL_ARROWS_MAX_STATES
     log_model = large_part.log_large_model if large else model_part.log_model
     rows = log_model(
         stream, shown, times, loaded.places, roles=loaded.roles, labelled=loaded.labelled
@@ -468,13 +469,15 @@ def _log(
             grid,
             loaded.truth,
             loaded.map_changes,
-            version_steps={r.version: r.step for r in loaded.versions if r.step <= last},
+            version_steps={
+                r.version: r.step for r in version_heads(loaded.versions) if r.step <= last
+            },
             first=first,
         )
-    rows |= plots_part.log_model_size(stream, shown, times, last)
+    rows |= plots_part.log_model_size(stream, sizes, times, last)
     rows |= plots_part.log_phases(stream, loaded.events, first, last)
     every_line = plots_part.audit_lines(
-        loaded.versions,
+        version_heads(loaded.versions),
         loaded.within,
         loaded.determinism,
         loaded.events,
@@ -599,14 +602,18 @@ def _step_range(recording: ViewSource, start: int | None, end: int | None) -> tu
 
 def _versions_in(
     versions: Sequence[ModelRecord], first: int, last: int
-) -> tuple[list[ModelRecord], list[int]]:
-    """The versions to show for steps ``first .. last`` and the step of each: the version in
-    force at ``first`` (at ``first``), then every later one up to ``last``."""
-    steps = [record.step for record in versions]
+) -> tuple[list[ModelRecord], list[int], tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]]:
+    """The versions to show for steps ``first .. last``, the step of each and their sizes
+    (states, transitions): the version in force at ``first`` (at ``first``, whole), then
+    every later one up to ``last`` (its message: the operations that made it)."""
+    heads = version_heads(versions)
+    steps = [record.step for record in heads]
     begin = max(0, bisect.bisect_right(steps, first) - 1)
     stop = bisect.bisect_right(steps, last)
-    shown = list(versions[begin:stop])
-    return shown, [max(record.step, first) for record in shown]
+    shown = [versions[begin], *heads[begin + 1 : stop]]
+    n_states, n_transitions = version_sizes(versions)
+    sizes = (n_states[begin:stop], n_transitions[begin:stop])
+    return shown, [max(record.step, first) for record in shown], sizes
 
 
 def _audits(

@@ -59,6 +59,7 @@ from rsstp_replay.audits.state_roles import (
     UNVISITED,
     state_roles,
 )
+from rsstp_replay.reader import version_heads, version_state_ids
 from rsstp_replay.viewer._chunks import TIMELINE, send_rows
 from rsstp_sim import palette
 from rsstp_sim.transition_system import TransitionSystem
@@ -180,7 +181,7 @@ def state_places(
         for s, (x, y) in zip(ids.tolist(), (sums / counts[:, None]).tolist(), strict=True)
     }
     scale = reach / 40.0
-    for record in versions:  # states never current: beside the state they came from
+    for record in version_heads(versions):  # states never current: beside their origin
         for operation in record.operations:
             if operation.kind == "split" and operation.result is not None:
                 child = int(operation.result)
@@ -191,10 +192,7 @@ def state_places(
                         x + 3 * scale * math.cos(angle),
                         y + 3 * scale * math.sin(angle),
                     )
-    every: set[int] = set()
-    for record in versions:  # a set's update is C's loop: 6,836 versions of 1,200 states
-        every.update(record.states)
-    for state in every - places.keys():
+    for state in set(version_state_ids(versions)) - places.keys():
         places[int(state)] = (0.0, 0.0)
     poses = steps[list(pose_columns)].to_numpy(np.int64)[chosen]
     return StatePlaces(places, _poses(kept_states, poses, kept_tips), scale)

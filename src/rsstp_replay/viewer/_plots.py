@@ -152,18 +152,18 @@ def _changes(values: npt.NDArray[np.float64]) -> npt.NDArray[np.int64]:
 
 def log_model_size(
     stream: rr.RecordingStream,
-    versions: Sequence[ModelRecord],
+    sizes: tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]],
     steps: Sequence[int],
     last_step: int,
 ) -> dict[str, int]:
-    """States and transitions of each version at its step, and once more at ``last_step`` so
-    the step function reaches the end; returns rows per path."""
+    """States and transitions (``sizes``: one per version) of each version at its step, and
+    once more at ``last_step`` so the step function reaches the end; returns rows per path."""
     times = [*steps, last_step] if steps[-1] != last_step else list(steps)
-    sizes = [*versions, versions[-1]][: len(times)]
     index = rr.TimeColumn(TIMELINE, sequence=np.asarray(times, np.int64))
+    n_states, n_transitions = (np.r_[column, column[-1:]][: len(times)] for column in sizes)
     counts = {
-        MODEL_STATES: ("states", [len(record.states) for record in sizes]),
-        MODEL_TRANSITIONS: ("transitions", [len(record.transitions) for record in sizes]),
+        MODEL_STATES: ("states", n_states),
+        MODEL_TRANSITIONS: ("transitions", n_transitions),
     }
     for path, (name, values) in counts.items():
         stream.log(path, rr.SeriesLines(names=name, interpolation_mode="StepAfter"), static=True)
