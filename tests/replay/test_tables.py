@@ -13,14 +13,22 @@ import pytest
 
 from rsstp_cli.replay import main
 from rsstp_replay import Recording, open_recording, read_table
-from rsstp_replay.export.tables import TABLES, model_table, recording_table, scenario_table
+from rsstp_replay.export.tables import (
+    TABLES,
+    changes_table,
+    model_table,
+    recording_table,
+    scenario_table,
+)
 from rsstp_sim import Runner, make_strategy, parse_scenario
 from rsstp_sim.arm.geometry import Blocker
 from rsstp_sim.recording.recorder import record
+from rsstp_sim.transition_system import TransitionSystem
 
 REFERENCE = Path(__file__).resolve().parents[2] / "recordings"
 ROULETTE = REFERENCE / "thesis-roulette-roulette.mcap"  # many model versions and events
 THREE_JOINT = REFERENCE / "three-joint-random.mcap"  # blocked moves
+LEARNER = REFERENCE / "two-joint-30-learner.mcap"  # splits, merges, adds and deletes
 BLOCKED_COLUMNS = {
     "fold": ["blocked_joint"],
     "obstacle": ["blocked_link", "blocked_obstacle"],
@@ -146,6 +154,36 @@ def test_the_model_table_has_every_transition_of_every_version() -> None:
         triples = rows[["source", "action", "target"]].to_numpy(np.int64).tolist()
         assert triples == [list(t) for t in record_.triples()]
         assert set(rows["step"]) == {record_.step} and set(rows["states"]) == {len(record_.states)}
+
+
+@pytest.mark.parametrize("path", [ROULETTE, LEARNER], ids=lambda p: p.stem)
+def test_the_changes_table_replayed_from_the_first_version_gives_every_version(path: Path) -> None:
+    with open_recording(path) as recording:
+        versions = recording.model_versions()
+        changes = changes_table(recording)
+        events = recording.events()
+    assert list(changes.columns) == [
+        "version", "step", "kind", "changed", "source", "target", "action", "result"
+    ]  # fmt: skip
+    assert [str(t) for t in changes.dtypes] == ["int64", "int64", "str", "bool"] + ["Int64"] * 4
+    assert {"split"} <= set(changes["kind"]) <= {"split", "merge", "add", "delete"}
+    for kind in ("split", "merge"):
+        assert (changes["kind"] == kind).sum() == (events["kind"] == kind).sum()
+    assert (changes["kind"] == "split").sum() > 30
+    model = TransitionSystem.from_snapshot(versions[0].snapshot())
+    rows = changes.groupby("version", sort=False)
+    for k, record_ in enumerate(versions[1:], start=1):
+        for row in rows.get_group(record_.version).itertuples():
+            if row.kind == "split":
+                assert model.split(row.source) == row.result
+            elif row.kind == "merge":
+                assert model.merge(row.source, row.target) == row.result
+            else:
+                done = getattr(model, str(row.kind))(row.source, row.target, row.action)
+                assert done == row.changed
+        if k % 25 == 0 or k == len(versions) - 1:
+            assert tuple(model.transitions()) == record_.triples()
+            assert model.states == tuple(record_.states)
 
 
 def test_a_version_without_transitions_has_one_row() -> None:

@@ -4,6 +4,8 @@
 - ``steps``: :meth:`~rsstp_replay.Recording.steps`, indexed by ``step`` (with ``--truth``,
   :func:`~rsstp_replay.audits.truth_table`);
 - ``model``: :func:`model_table`, one row per transition of every model version;
+- ``changes``: :func:`changes_table`, one row per operation on the model (what grows with the
+  learning, where ``model`` grows with the versions times the model's size);
 - ``events``: :meth:`~rsstp_replay.Recording.events`, one row per event;
 - ``scenario``: :func:`scenario_table`, one row: the ``/rsstp/scenario`` message.
 
@@ -24,11 +26,12 @@ import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_format.records import ModelRecord, ScenarioMessage
 from rsstp_replay.errors import TableError
+from rsstp_replay.reader import version_heads
 from rsstp_replay.reader.recording import Recording
 
-__all__ = ["TABLES", "model_table", "recording_table", "scenario_table"]
+__all__ = ["TABLES", "changes_table", "model_table", "recording_table", "scenario_table"]
 
-TABLES = ("steps", "model", "events", "scenario")
+TABLES = ("steps", "model", "changes", "events", "scenario")
 """What ``rsstp-replay table --what`` writes (the channels of a recording)."""
 
 
@@ -77,6 +80,48 @@ def model_table(source: _Models) -> pd.DataFrame:
     return pd.DataFrame(columns)
 
 
+def changes_table(source: _Models) -> pd.DataFrame:
+    """Every operation on the model, in order, one row each (read from the model messages'
+    operations: no version is rebuilt):
+
+    - ``version`` (int64, the version the message that holds it made) and ``step`` (int64);
+    - ``kind`` (string: split, merge, add or delete) and ``changed`` (bool: whether it
+      changed the model; an ``add`` of a transition already there does not);
+    - ``source``, ``target``, ``action``, ``result`` (nullable Int64): a ``split`` of
+      ``source`` made state ``result``; a ``merge`` moved ``target``'s transitions to
+      ``source`` (``result``) and removed ``target``; an ``add`` or ``delete`` is of the
+      transition ``source -action-> target``.
+
+    ``changes.loc[changes["kind"] == "split"].groupby("step").size()`` counts the new states
+    of each step.
+    """
+    heads = version_heads(source.model_versions())
+    columns: dict[str, list[Any]] = {
+        name: [] for name in ("version", "step", "kind", "source", "target", "action", "result")
+    }
+    changed: list[bool] = []
+    for record in heads:
+        for operation in record.operations:
+            args, kind = operation.args, operation.kind
+            columns["version"].append(record.version)
+            columns["step"].append(record.step)
+            columns["kind"].append(kind)
+            columns["source"].append(args[0])
+            columns["target"].append(args[1] if len(args) > 1 else None)
+            columns["action"].append(args[2] if len(args) > 2 else None)
+            columns["result"].append(operation.result)
+            changed.append(operation.changed)
+    table: dict[str, Any] = {
+        "version": np.asarray(columns["version"], np.int64),
+        "step": np.asarray(columns["step"], np.int64),
+        "kind": pd.array(columns["kind"], dtype="str"),
+        "changed": np.asarray(changed, np.bool_),
+    }
+    for name in ("source", "target", "action", "result"):
+        table[name] = pd.array(columns[name], dtype="Int64")
+    return pd.DataFrame(table)
+
+
 def scenario_table(source: _Scenario) -> pd.DataFrame:
     """The ``/rsstp/scenario`` message as one row: a column per field of its JSON
     (``schemas/``), a nested object's fields flattened with ``_`` (``feedback_mode``,
@@ -117,6 +162,8 @@ def recording_table(
         return recording.steps()
     if what == "model":
         return model_table(recording)
+    if what == "changes":
+        return changes_table(recording)
     if what == "events":
         return recording.events()
     return scenario_table(recording)
