@@ -130,6 +130,7 @@ class Recording:
         self._agent: StepColumns | None = None
         self._log_times: _Ints | None = None
         self._models: Sequence[ModelRecord] | None = None
+        self._version_steps: list[int] | None = None
         self._events: pd.DataFrame | None = None
 
     # -- properties ------------------------------------------------------------------------
@@ -165,6 +166,7 @@ class Recording:
         self._log_times = None
         self._agent_cache.clear()
         self._models = None
+        self._version_steps = None
         self._events = None
 
     def __enter__(self) -> Recording:
@@ -356,17 +358,23 @@ class Recording:
         """
         step = self._check_step(step)
         models = self.model_versions()
-        index = bisect.bisect_right([m.step for m in version_heads(models)], step) - 1
-        record = models[index]
-        transitions = record.transitions  # (the chain check rebuilt and checked them)
-        model = TransitionSystem.from_columns(
-            record.states,
-            record.actions,
-            (transitions.source, transitions.action, transitions.target),
-            next_id=record.next_id,
-            current=record.current,
-            version=record.version,
-        )
+        heads = version_heads(models)
+        if self._version_steps is None or len(self._version_steps) != len(heads):
+            self._version_steps = [m.step for m in heads]
+        index = bisect.bisect_right(self._version_steps, step) - 1
+        record = heads[index]
+        if isinstance(models, ModelHistory):
+            model = models.model(index)
+        else:
+            transitions = models[index].transitions
+            model = TransitionSystem.from_columns(
+                models[index].states,
+                record.actions,
+                (transitions.source, transitions.action, transitions.target),
+                next_id=record.next_id,
+                current=record.current,
+                version=record.version,
+            )
         here = self._agent_row(step)
         if here.model_version != record.version:
             raise CorruptRecording(
