@@ -21,7 +21,7 @@ from rsstp_replay.viewer._model import ACTION_COLORS
 from rsstp_sim import palette
 from rsstp_sim.recording import record
 from rsstp_sim.scenario import load_scenario, parse_scenario
-from rsstp_sim.truth import compute_truth
+from rsstp_sim.truth import check_equivalence, compute_truth
 
 ROLE_RGB = {
     UNVISITED: palette.STATE_UNVISITED,
@@ -63,6 +63,17 @@ def _expected_roles(recording: Recording) -> dict[int, dict[int, int]]:
             else:
                 known[c] = EXACT
         by_version[v] = dict(known)
+    # The final version: a model equivalent to the truth from where the run ended (and with a
+    # state per class) stands for every class exactly, visited in it or not.
+    model = recording.model_at(recording.n_steps)
+    labels = {s: bool(x) for s, x in zip(table["internal_state"], table["sensation"], strict=True)}
+    last = truth.class_of(angles[-1])
+    if (
+        len(model) == truth.n_classes
+        and check_equivalence(model, labels, truth, start_state=model.current, start_class=last)
+        is None
+    ):
+        by_version[recording.model_versions()[-1].version] = dict.fromkeys(known, EXACT)
     return by_version
 
 

@@ -7,7 +7,9 @@ class stood for by one state that stood for it alone is exact; by several states
 them for another class too, redundant; by a state that stood for another class too, aliased.
 The viewer's model map colours each pose by its class's role
 (:mod:`rsstp_replay.viewer._map`), a class keeping the role of the last version that visited
-it (:func:`class_role_changes`).
+it (:func:`class_role_changes`); in the final version, every class its model reaches has the
+role the model gives it, visited or not (:func:`model_class_roles`), so a run that ends with
+the truth's model ends with every class exact.
 """
 
 from __future__ import annotations
@@ -18,9 +20,11 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from rsstp_replay.audits.state_roles import state_roles
+from rsstp_replay.audits.state_roles import ALIASED, EXACT, REDUNDANT, state_roles
+from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.truth import GroundTruth
 
-__all__ = ["RoleChanges", "class_role_changes", "class_roles"]
+__all__ = ["RoleChanges", "class_role_changes", "class_roles", "model_class_roles"]
 
 _Ints = npt.NDArray[np.int64]
 
@@ -68,18 +72,63 @@ class RoleChanges:
     roles: npt.NDArray[np.int8]
 
 
+def model_class_roles(
+    model: TransitionSystem, truth: GroundTruth, state: int, true_class: int
+) -> tuple[_Ints, npt.NDArray[np.int8]]:
+    """The classes the ``model`` reaches from ``state`` standing for ``true_class`` (walking
+    both together, each action of the truth's), and each one's role by the model: aliased
+    when a state that stands for it stands for another class too, redundant when several
+    states stand for it, else exact. A move the model lacks, or has several successors for,
+    ends that branch of the walk."""
+    actions = truth.actions
+    seen = {(state, true_class)}
+    frontier = [(state, true_class)]
+    while frontier:
+        found = []
+        for s, c in frontier:
+            for k, a in enumerate(actions):
+                targets = model.successors(s, a) if s in model else ()
+                if len(targets) != 1:
+                    continue
+                pair = (targets[0], int(truth.class_next[c, k]))
+                if pair not in seen:
+                    seen.add(pair)
+                    found.append(pair)
+        frontier = found
+    pairs = np.array(sorted(seen), np.int64).reshape(-1, 2)
+    states, classes = pairs[:, 0], pairs[:, 1]
+    _, state_of, classes_per_state = np.unique(states, return_inverse=True, return_counts=True)
+    shared = classes_per_state[state_of] > 1
+    order = np.argsort(classes, kind="stable")
+    reached, starts, per_class = np.unique(classes[order], return_index=True, return_counts=True)
+    aliased = np.maximum.reduceat(shared[order].astype(np.int8), starts).astype(bool)
+    roles = np.where(aliased, ALIASED, np.where(per_class > 1, REDUNDANT, EXACT))
+    return reached.astype(np.int64), roles.astype(np.int8)
+
+
 def class_role_changes(
     step_versions: npt.ArrayLike,
     step_states: npt.ArrayLike,
     step_classes: npt.ArrayLike,
     *,
     state_roles: Mapping[int, Mapping[int, int]] | None = None,
+    final: tuple[int, _Ints, npt.NDArray[np.int8]] | None = None,
 ) -> RoleChanges:
     """The changes of :func:`class_roles` over versions, a class keeping the role of the last
-    version that visited it (unvisited before)."""
+    version that visited it (unvisited before). ``final``: (the final version, the classes
+    its model reaches, their roles: :func:`model_class_roles`), which hold in that version
+    whether visited or not."""
     versions, classes, roles = class_roles(
         step_versions, step_states, step_classes, roles=state_roles
     )
+    if final is not None:
+        version, reached, given = final
+        keep = ~((versions == version) & np.isin(classes, reached))
+        versions = np.r_[versions[keep], np.full(len(reached), version, np.int64)]
+        classes = np.r_[classes[keep], reached]
+        roles = np.r_[roles[keep], given].astype(np.int8)
+        order = np.lexsort((classes, versions))
+        versions, classes, roles = versions[order], classes[order], roles[order]
     order = np.lexsort((versions, classes))  # by class, then version
     c, r = classes[order], roles[order]  # every role is a visit's (never unvisited)
     changed = np.r_[True, c[1:] != c[:-1]] | np.r_[True, r[1:] != r[:-1]]

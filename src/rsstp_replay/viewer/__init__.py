@@ -425,7 +425,7 @@ def _load(recording: ViewSource) -> _Loaded:
         reach=scale,
     )
     labelled = model_part.labelled_states(places.places, room=model_part.LABEL_ROOM * scale)
-    truth, roles, map_changes = _roles(scenario, steps)
+    truth, roles, map_changes = _roles(scenario, steps, recording)
     return _Loaded(
         steps,
         versions,
@@ -643,11 +643,12 @@ def _audits(
 
 
 def _roles(
-    scenario: AnyScenario, steps: pd.DataFrame
+    scenario: AnyScenario, steps: pd.DataFrame, recording: ViewSource
 ) -> tuple[GroundTruth | None, model_part.Roles | None, map_part.RoleChanges | None]:
     """The truth, every visited state's role per version by the truth audit and (for an arm
-    the map draws) where each true class's role changes; Nones (with a warning) when the
-    truth cannot be computed (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
+    the map draws) where each true class's role changes, the final version's classes as its
+    model has them (visited or not); Nones (with a warning) when the truth cannot be computed
+    (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
     try:
         truth = load_truth(scenario, max_poses=TRUTH_MAX_POSES)
         classes = step_true_classes(steps, truth)
@@ -659,7 +660,15 @@ def _roles(
     roles = model_part.roles_by_version(step_versions, step_states, classes)
     changes = None
     if map_part.joint_grid(scenario) is not None:
+        last = recording.n_steps
+        reached, given = map_part.model_class_roles(
+            recording.model_at(last), truth, int(step_states[-1]), int(classes[-1])
+        )
         changes = map_part.class_role_changes(
-            step_versions, step_states, classes, state_roles=roles
+            step_versions,
+            step_states,
+            classes,
+            state_roles=roles,
+            final=(int(step_versions[-1]), reached, given),
         )
     return truth, roles, changes

@@ -38,7 +38,12 @@ import numpy as np
 import numpy.typing as npt
 import rerun as rr
 
-from rsstp_replay.audits.class_roles import RoleChanges, class_role_changes, class_roles
+from rsstp_replay.audits.class_roles import (
+    RoleChanges,
+    class_role_changes,
+    class_roles,
+    model_class_roles,
+)
 from rsstp_replay.audits.state_roles import (
     ALIASED,
     EXACT,
@@ -63,6 +68,7 @@ __all__ = [
     "JointGrid",
     "block_path",
     "class_role_changes",
+    "model_class_roles",
     "class_roles",
     "joint_grid",
     "log_map",
