@@ -108,7 +108,8 @@ class ContractFindings:
 def version_index(versions: Sequence[ModelRecord], steps: _Ints) -> _Ints:
     """For each step, the index in ``versions`` of the model message in force at its end (the
     last at or before it; -1 before the first message)."""
-    message_steps = np.fromiter((record.step for record in versions), np.int64, len(versions))
+    heads = version_heads(versions)
+    message_steps = np.fromiter((record.step for record in heads), np.int64, len(heads))
     return np.searchsorted(message_steps, steps, side="right").astype(np.int64) - 1
 
 
