@@ -5,7 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from rsstp_replay.audits.class_roles import class_role_changes, model_class_roles
+from rsstp_replay.audits.class_roles import (
+    class_role_changes,
+    model_class_roles,
+    model_state_roles,
+)
 from rsstp_replay.audits.state_roles import ALIASED, EXACT, REDUNDANT
 from rsstp_sim import load_scenario
 from rsstp_sim.transition_system import TransitionSystem
@@ -71,6 +75,8 @@ def test_a_split_state_makes_its_class_redundant_and_one_state_aliases_them_all(
             if set(model.successors(s, a)) == {5, copy}:
                 model.delete(s, copy if s == 5 else 5, a)
     assert model.is_deterministic()
+    states = model_state_roles(model, truth, 0, 0)
+    assert states == {s: REDUNDANT if s in (5, copy) else EXACT for s in model.states}
     reached, roles = model_class_roles(model, truth, 0, 0)
     assert dict(zip(reached.tolist(), roles.tolist(), strict=True)) == {
         c: REDUNDANT if c == 5 else EXACT for c in range(truth.n_classes)
@@ -89,3 +95,10 @@ def test_the_final_version_colours_classes_it_never_visited() -> None:
     last = {c: r for c, r in zip(changes.classes.tolist(), changes.roles.tolist(), strict=True)}
     assert last == {0: EXACT, 1: EXACT}
     assert changes.versions.tolist() == sorted(changes.versions.tolist())
+
+
+def test_the_states_roles_by_the_model_itself() -> None:
+    truth = _truth()
+    assert set(model_state_roles(truth.minimal_model(), truth, 0, 0).values()) == {EXACT}
+    one_state = TransitionSystem.universal(truth.actions)
+    assert model_state_roles(one_state, truth, 0, 0) == {0: ALIASED}

@@ -386,6 +386,25 @@ def _brute_force_roles(recording: Recording) -> dict[tuple[int, int], str]:
                 v == version and s != state and mine <= other for (v, s), other in classes.items()
             )
             roles[version, state] = "redundant" if shared else "exact"
+    # The final version: each state the model reaches walking beside the truth from where
+    # the run ended, by the classes it meets there (visited in that version or not).
+    model = recording.model_at(recording.n_steps)
+    start = (model.current, truth.class_of(angles[-1].tolist()))
+    pairs, todo = {start}, [start]
+    while todo:
+        state, cls = todo.pop()
+        for k, action in enumerate(truth.actions):
+            successors = model.successors(state, action)
+            if len(successors) == 1:
+                pair = (successors[0], int(truth.class_next[cls, k]))
+                if pair not in pairs:
+                    pairs.add(pair)
+                    todo.append(pair)
+    final = int(table["model_version"].iloc[-1])
+    for state in {s for s, _ in pairs}:
+        mine = {c for s, c in pairs if s == state}
+        shared = any(s != state and c in mine for s, c in pairs)
+        roles[final, state] = "aliased" if len(mine) > 1 else "redundant" if shared else "exact"
     return roles
 
 

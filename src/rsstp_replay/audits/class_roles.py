@@ -24,7 +24,13 @@ from rsstp_replay.audits.state_roles import ALIASED, EXACT, REDUNDANT, state_rol
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
 
-__all__ = ["RoleChanges", "class_role_changes", "class_roles", "model_class_roles"]
+__all__ = [
+    "RoleChanges",
+    "class_role_changes",
+    "class_roles",
+    "model_class_roles",
+    "model_state_roles",
+]
 
 _Ints = npt.NDArray[np.int64]
 
@@ -80,6 +86,36 @@ def model_class_roles(
     when a state that stands for it stands for another class too, redundant when several
     states stand for it, else exact. A move the model lacks, or has several successors for,
     ends that branch of the walk."""
+    states, classes = _walked(model, truth, state, true_class)
+    shared = _counts_of(states)[1] > 1
+    order = np.argsort(classes, kind="stable")
+    reached, starts, per_class = np.unique(classes[order], return_index=True, return_counts=True)
+    aliased = np.maximum.reduceat(shared[order].astype(np.int8), starts).astype(bool)
+    roles = np.where(aliased, ALIASED, np.where(per_class > 1, REDUNDANT, EXACT))
+    return reached.astype(np.int64), roles.astype(np.int8)
+
+
+def model_state_roles(
+    model: TransitionSystem, truth: GroundTruth, state: int, true_class: int
+) -> dict[int, int]:
+    """The states the ``model`` reaches, walked as :func:`model_class_roles` walks, and each
+    one's role by the model: aliased when it stands for several classes, redundant when its
+    class has other states, else exact."""
+    states, classes = _walked(model, truth, state, true_class)
+    shared = _counts_of(states)[1] > 1
+    crowded = _counts_of(classes)[1] > 1
+    roles = np.where(shared, ALIASED, np.where(crowded, REDUNDANT, EXACT))
+    found: dict[int, int] = {}
+    for s, role in zip(states.tolist(), roles.tolist(), strict=True):
+        found[s] = max(found.get(s, EXACT), role)
+    return found
+
+
+def _walked(
+    model: TransitionSystem, truth: GroundTruth, state: int, true_class: int
+) -> tuple[_Ints, _Ints]:
+    """Every (state, class) pair met walking the model and the truth together from
+    (``state``, ``true_class``), as two columns, sorted."""
     actions = truth.actions
     seen = {(state, true_class)}
     frontier = [(state, true_class)]
@@ -96,14 +132,14 @@ def model_class_roles(
                     found.append(pair)
         frontier = found
     pairs = np.array(sorted(seen), np.int64).reshape(-1, 2)
-    states, classes = pairs[:, 0], pairs[:, 1]
-    _, state_of, classes_per_state = np.unique(states, return_inverse=True, return_counts=True)
-    shared = classes_per_state[state_of] > 1
-    order = np.argsort(classes, kind="stable")
-    reached, starts, per_class = np.unique(classes[order], return_index=True, return_counts=True)
-    aliased = np.maximum.reduceat(shared[order].astype(np.int8), starts).astype(bool)
-    roles = np.where(aliased, ALIASED, np.where(per_class > 1, REDUNDANT, EXACT))
-    return reached.astype(np.int64), roles.astype(np.int8)
+    return pairs[:, 0], pairs[:, 1]
+
+
+def _counts_of(values: _Ints) -> tuple[_Ints, _Ints]:
+    """For each element, the index of its value among the distinct ones, and how many
+    elements have its value."""
+    _, where, counts = np.unique(values, return_inverse=True, return_counts=True)
+    return where, counts[where]
 
 
 def class_role_changes(

@@ -35,6 +35,7 @@ import pandas as pd
 import rerun as rr
 
 from rsstp_format.records import ModelRecord
+from rsstp_replay.audits.class_roles import model_state_roles
 from rsstp_replay.audits.consistency import ConsistencyFindings, audit_consistency_by_version
 from rsstp_replay.audits.determinism import DeterminismFindings, audit_determinism
 from rsstp_replay.audits.truth import step_true_classes
@@ -646,9 +647,9 @@ def _roles(
     scenario: AnyScenario, steps: pd.DataFrame, recording: ViewSource
 ) -> tuple[GroundTruth | None, model_part.Roles | None, map_part.RoleChanges | None]:
     """The truth, every visited state's role per version by the truth audit and (for an arm
-    the map draws) where each true class's role changes, the final version's classes as its
-    model has them (visited or not); Nones (with a warning) when the truth cannot be computed
-    (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
+    the map draws) where each true class's role changes; in the final version, the states and
+    classes as its model has them (visited or not). Nones (with a warning) when the truth
+    cannot be computed (a world of more than :data:`TRUTH_MAX_POSES` poses)."""
     try:
         truth = load_truth(scenario, max_poses=TRUTH_MAX_POSES)
         classes = step_true_classes(steps, truth)
@@ -658,17 +659,20 @@ def _roles(
     step_versions = steps["model_version"].to_numpy(np.int64)
     step_states = steps["internal_state"].to_numpy(np.int64)
     roles = model_part.roles_by_version(step_versions, step_states, classes)
+    final = int(step_versions[-1])
+    model = recording.model_at(recording.n_steps)
+    walked = model_state_roles(model, truth, int(step_states[-1]), int(classes[-1]))
+    roles[final] = {**roles.get(final, {}), **walked}
     changes = None
     if map_part.joint_grid(scenario) is not None:
-        last = recording.n_steps
         reached, given = map_part.model_class_roles(
-            recording.model_at(last), truth, int(step_states[-1]), int(classes[-1])
+            model, truth, int(step_states[-1]), int(classes[-1])
         )
         changes = map_part.class_role_changes(
             step_versions,
             step_states,
             classes,
             state_roles=roles,
-            final=(int(step_versions[-1]), reached, given),
+            final=(final, reached, given),
         )
     return truth, roles, changes
