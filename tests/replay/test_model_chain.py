@@ -160,13 +160,18 @@ def test_the_audits_and_the_viewer_rebuild_the_first_and_last_versions_only(
     viewer read each message's head and sizes, and rebuild a version whole only at the ends
     (the first shown, the final model)."""
     rebuilt: list[int] = []
-    original = ModelHistory._rebuilt
+    whole, model = ModelHistory._rebuilt, ModelHistory._rebuilt_model
 
-    def counted(self: ModelHistory, k: int, *, record: bool = True) -> ModelRecord | None:
+    def counted_whole(self: ModelHistory, k: int) -> ModelRecord:
         rebuilt.append(k)
-        return original(self, k, record=record)
+        return whole(self, k)
 
-    monkeypatch.setattr(ModelHistory, "_rebuilt", counted)
+    def counted_model(self: ModelHistory, k: int) -> TransitionSystem:
+        rebuilt.append(k)
+        return model(self, k)
+
+    monkeypatch.setattr(ModelHistory, "_rebuilt", counted_whole)
+    monkeypatch.setattr(ModelHistory, "_rebuilt_model", counted_model)
     with open_recording(LEARNER) as recording:
         versions = recording.model_versions()
         assert len(versions) > 100

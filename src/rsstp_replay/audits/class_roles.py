@@ -87,7 +87,7 @@ def model_class_roles(
     states stand for it, else exact. A move the model lacks, or has several successors for,
     ends that branch of the walk."""
     states, classes = _walked(model, truth, state, true_class)
-    shared = _counts_of(states)[1] > 1
+    shared = _how_many(states) > 1
     order = np.argsort(classes, kind="stable")
     reached, starts, per_class = np.unique(classes[order], return_index=True, return_counts=True)
     aliased = np.maximum.reduceat(shared[order].astype(np.int8), starts).astype(bool)
@@ -102,8 +102,8 @@ def model_state_roles(
     one's role by the model: aliased when it stands for several classes, redundant when its
     class has other states, else exact."""
     states, classes = _walked(model, truth, state, true_class)
-    shared = _counts_of(states)[1] > 1
-    crowded = _counts_of(classes)[1] > 1
+    shared = _how_many(states) > 1
+    crowded = _how_many(classes) > 1
     roles = np.where(shared, ALIASED, np.where(crowded, REDUNDANT, EXACT))
     found: dict[int, int] = {}
     for s, role in zip(states.tolist(), roles.tolist(), strict=True):
@@ -135,11 +135,10 @@ def _walked(
     return pairs[:, 0], pairs[:, 1]
 
 
-def _counts_of(values: _Ints) -> tuple[_Ints, _Ints]:
-    """For each element, the index of its value among the distinct ones, and how many
-    elements have its value."""
+def _how_many(values: _Ints) -> _Ints:
+    """For each element, how many elements have its value."""
     _, where, counts = np.unique(values, return_inverse=True, return_counts=True)
-    return where, counts[where]
+    return counts[where]
 
 
 def class_role_changes(

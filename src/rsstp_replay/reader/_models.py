@@ -324,20 +324,13 @@ class ModelHistory(Sequence[ModelRecord]):
 
     def model(self, index: int) -> TransitionSystem:
         """Version ``index`` (0 .. len - 1) as a model of its own (the caller's to change)."""
-        picked = range(len(self._heads))[index]
-        self._rebuilt(picked, record=False)
-        assert self._cache is not None
-        return self._cache[1].copy()
+        return self._rebuilt_model(range(len(self._heads))[index]).copy()
 
-    @overload
-    def _rebuilt(self, k: int) -> ModelRecord: ...
-    @overload
-    def _rebuilt(self, k: int, *, record: bool) -> ModelRecord | None: ...
-    def _rebuilt(self, k: int, *, record: bool = True) -> ModelRecord | None:
-        """Version ``k`` whole (``record``), or only rebuilt into the cache."""
+    def _rebuilt(self, k: int) -> ModelRecord:
+        """Version ``k`` whole."""
         slot = bisect.bisect_right(self._kept, k) - 1
-        kept, head = self._kept[slot], self._heads[k]
-        if kept == k and record:
+        head = self._heads[k]
+        if self._kept[slot] == k:
             whole = self._whole[slot]
             columns = (tuple(whole.transitions.source), tuple(whole.transitions.action),
                        tuple(whole.transitions.target))  # fmt: skip
@@ -346,6 +339,14 @@ class ModelHistory(Sequence[ModelRecord]):
                     source=columns[0], action=columns[1], target=columns[2]
                 ),
             )  # fmt: skip
+        model = self._rebuilt_model(k)
+        return msgspec.structs.replace(_whole(head, model, compact=False), keyframe=head.keyframe)
+
+    def _rebuilt_model(self, k: int) -> TransitionSystem:
+        """Version ``k``'s model, rebuilt from the last whole model kept at or before it (or
+        from the model rebuilt last, when that lies between): the history's own, cached."""
+        slot = bisect.bisect_right(self._kept, k) - 1
+        kept = self._kept[slot]
         cache = self._cache
         if cache is not None and kept <= cache[0] <= k:
             done, model = cache
@@ -365,11 +366,9 @@ class ModelHistory(Sequence[ModelRecord]):
             for operation in later.operations:
                 model.apply(operation.to_operation())
         model.drain_operations()
-        model.current = head.current
+        model.current = self._heads[k].current
         self._cache = (k, model)
-        if not record:
-            return None
-        return msgspec.structs.replace(_whole(head, model, compact=False), keyframe=head.keyframe)
+        return model
 
 
 def version_heads(versions: Sequence[ModelRecord]) -> Sequence[ModelRecord]:
