@@ -124,9 +124,10 @@ class TransitionSystem:
         if n < 1:
             raise ModelError(f"a transition system needs n_states >= 1, got {n}")
         # _out[s][a]: sorted tuple of successors (no empty entries);
-        # _in[t][a]: set of predecessors (no empty entries).
+        # _in[t][a]: set of predecessors (no empty entries); None until first needed after a
+        # copy or a model from columns (:meth:`_incoming` builds it from _out).
         self._out: dict[int, dict[int, tuple[int, ...]]] = {s: {} for s in range(n)}
-        self._in: dict[int, dict[int, set[int]]] = {s: {} for s in range(n)}
+        self._in: dict[int, dict[int, set[int]]] | None = {s: {} for s in range(n)}
         self._actions: set[int] = {_as_action(a, "action") for a in actions}
         self._actions_sorted: tuple[int, ...] | None = None
         self._current = 0
@@ -217,7 +218,7 @@ class TransitionSystem:
     def predecessors(self, s: int) -> set[int]:
         """The states with a transition into ``s`` (any action, ``s`` itself included)."""
         try:
-            return {u for sources in self._in[s].values() for u in sources}
+            return {u for sources in self._incoming()[s].values() for u in sources}
         except KeyError:
             raise ModelError(f"predecessors: unknown state {s!r}") from None
 
@@ -283,7 +284,7 @@ class TransitionSystem:
     def transitions_into(self, t: int) -> list[tuple[int, int]]:
         """Every transition into ``t`` as ``(source, action)``, sorted."""
         try:
-            into = self._in[t]
+            into = self._incoming()[t]
         except KeyError:
             raise ModelError(f"transitions_into: unknown state {t!r}") from None
         return sorted((u, a) for a, sources in into.items() for u in sources)
@@ -379,10 +380,11 @@ class TransitionSystem:
         self._check(s, "split")
         new = self._next_id
         outgoing = [(a, t) for a, targets in self._out[s].items() for t in targets]
-        incoming = [(u, a) for a, sources in self._in[s].items() for u in sources]
+        into = self._incoming()
+        incoming = [(u, a) for a, sources in into[s].items() for u in sources]
         self._next_id += 1
         self._out[new] = {}
-        self._in[new] = {}
+        into[new] = {}
         self._states_changed()
         for a, t in outgoing:
             self._link(new, a, t)
@@ -403,14 +405,15 @@ class TransitionSystem:
         if s == t:
             raise ModelError(f"merge: cannot merge state {s} with itself")
         outgoing = [(a, v) for a, targets in self._out[t].items() for v in targets]
-        incoming = [(u, a) for a, sources in self._in[t].items() for u in sources]
+        into = self._incoming()
+        incoming = [(u, a) for a, sources in into[t].items() for u in sources]
         for a, v in outgoing:
             self._unlink(t, a, v)
         for u, a in incoming:
             if u != t:  # self-loops went with the outgoing ones
                 self._unlink(u, a, t)
         del self._out[t]
-        del self._in[t]
+        del into[t]
         self._rows.pop(t, None)
         self._states_changed()
         for a, v in outgoing:
@@ -487,7 +490,7 @@ class TransitionSystem:
         """A deep copy (current, version, next id and actions included) with an empty op log."""
         other = TransitionSystem.__new__(TransitionSystem)
         other._out = {s: dict(out) for s, out in self._out.items()}
-        other._in = {t: {a: set(us) for a, us in inc.items()} for t, inc in self._in.items()}
+        other._in = None  # (built when first needed)
         other._actions = set(self._actions)
         other._actions_sorted = self._actions_sorted
         other._current = self._current
@@ -565,7 +568,6 @@ class TransitionSystem:
         no check per transition (:meth:`from_snapshot` checks everything)."""
         model = cls(1, actions=actions)
         out: dict[int, dict[int, tuple[int, ...]]] = {s: {} for s in states}
-        into: dict[int, dict[int, set[int]]] = {s: {} for s in states}
         nondeterministic = 0
         for s, a, t in zip(*columns, strict=True):
             row = out[s]
@@ -576,8 +578,7 @@ class TransitionSystem:
                 if len(targets) == 1:
                     nondeterministic += 1
                 row[a] = (*targets, t)
-            into[t].setdefault(a, set()).add(s)
-        model._out, model._in = out, into
+        model._out, model._in = out, None  # (predecessors: built when first needed)
         model._n_nondeterministic = nondeterministic
         model._n_transitions = len(columns[0])
         model._states_sorted = tuple(states)
@@ -619,7 +620,8 @@ class TransitionSystem:
         self._n_transitions += 1
         if len(targets) == 1:
             self._n_nondeterministic += 1
-        self._in[t].setdefault(a, set()).add(s)
+        if self._in is not None:
+            self._in[t].setdefault(a, set()).add(s)
         return True
 
     def _unlink(self, s: int, a: int, t: int) -> bool:
@@ -635,11 +637,25 @@ class TransitionSystem:
             out[a] = tuple(v for v in targets if v != t)
             if len(targets) == 2:
                 self._n_nondeterministic -= 1
-        sources = self._in[t][a]
-        sources.discard(s)
-        if not sources:
-            del self._in[t][a]
+        if self._in is not None:
+            sources = self._in[t][a]
+            sources.discard(s)
+            if not sources:
+                del self._in[t][a]
         return True
+
+    def _incoming(self) -> dict[int, dict[int, set[int]]]:
+        """``_in``, the predecessors by target and action, built from ``_out`` if it was left
+        out (:meth:`copy` and :meth:`from_columns` leave it out: most copies and most models
+        read from a recording never need it)."""
+        if self._in is None:
+            into: dict[int, dict[int, set[int]]] = {s: {} for s in self._out}
+            for s, out in self._out.items():
+                for a, targets in out.items():
+                    for t in targets:
+                        into[t].setdefault(a, set()).add(s)
+            self._in = into
+        return self._in
 
 
 def _as_list(value: object, what: str) -> list[object]:

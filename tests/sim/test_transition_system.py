@@ -577,6 +577,30 @@ def test_transition_columns_follow_every_operation(
 
 
 @settings(max_examples=150, deadline=None)
+@given(models(), _ops, st.integers(0, 25))
+def test_predecessors_follow_every_operation_of_a_copy(
+    model: TransitionSystem, ops: list[tuple[str, int, int, int]], asked_after: int
+) -> None:
+    # A copy (and a model from columns) builds its predecessors only when first asked: the
+    # changes made before and after that must all show, and the original must not move.
+    original = model.snapshot()
+    copy = model.copy()
+    for k, op in enumerate(ops):
+        if k == asked_after:
+            copy.predecessors(copy.states[0])
+        _run(copy, [op])
+    transitions = [
+        (u, b, v) for u in copy.states for b in copy.actions for v in copy.successors(u, b)
+    ]
+    for state in copy.states:
+        assert copy.predecessors(state) == {u for u, _, v in transitions if v == state}
+        assert copy.transitions_into(state) == sorted(
+            (u, b) for u, b, v in transitions if v == state
+        )
+    assert model.snapshot() == original
+
+
+@settings(max_examples=150, deadline=None)
 @given(models(), _ops)
 def test_incremental_determinism_matches_the_report(
     model: TransitionSystem, ops: list[tuple[str, int, int, int]]
