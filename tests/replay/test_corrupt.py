@@ -380,6 +380,27 @@ def test_an_event_of_an_unknown_kind_is_refused(original: Path, tmp_path: Path) 
             recording.events()
 
 
+def test_the_model_at_a_step_reads_that_steps_message_alone(original: Path, tmp_path: Path) -> None:
+    """``model_at`` decodes only the message of the step asked for: a step whose message is
+    invalid is named when asked for, and a step beside it in the same chunk still reads."""
+    step = STEPS // 2
+
+    def unhinge(message: dict[str, Any]) -> None:
+        message["agent"]["internal_state"] = "here"
+
+    bad = rewrite(
+        original, tmp_path / "bad-step.mcap", message=edit_json("/rsstp/step", step, unhinge)
+    )
+    with open_recording(bad) as recording, open_recording(original) as before:
+        assert recording.model_at(step + 1) == before.model_at(step + 1)
+        with pytest.raises(
+            errors.CorruptRecording,
+            match=rf"bad-step\.mcap: the step message at step {step} \(chunk at byte \d+\) is "
+            r"invalid: .*internal_state",
+        ):
+            recording.model_at(step)
+
+
 # ------------------------------------------------------------------------ the command line
 
 

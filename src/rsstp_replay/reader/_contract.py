@@ -98,12 +98,13 @@ class CheckedFile:
         return topic_chunks(self.container, self.channels[topic], self.limit_ns, step=step)
 
     def chunks_of(
-        self, topics: Sequence[str]
+        self, topics: Sequence[str], *, step: int | None = None
     ) -> Generator[tuple[ChunkRef, bytes, list[Messages]], None, None]:
-        """The chunks with messages of any of ``topics``, each read once, with its records
-        and, topic by topic, its :class:`~rsstp_replay.reader._chunks.Messages`."""
+        """The chunks with messages of any of ``topics`` (or only those around ``step``'s log
+        time), each read once, with its records and, topic by topic, its
+        :class:`~rsstp_replay.reader._chunks.Messages`."""
         channels = [self.channels[topic] for topic in topics]
-        return topics_chunks(self.container, channels, self.limit_ns)
+        return topics_chunks(self.container, channels, self.limit_ns, step=step)
 
     def decode_one(self, topic: str, part: memoryview, log_time: int, ref: ChunkRef) -> Any:
         """The record of one message of ``topic``."""

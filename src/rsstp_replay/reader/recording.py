@@ -126,7 +126,7 @@ class Recording:
         self.recovered_steps: int | None = None if file.container.finished else self.n_steps
         self.scenario_record = file.scenario_record
         self.scenario = file.scenario
-        self._agent_cache: dict[int, StepColumns] = {}
+        self._step_chunks: dict[int, tuple[ChunkRef, bytes, Messages]] = {}
         self._agent: StepColumns | None = None
         self._log_times: _Ints | None = None
         self._models: Sequence[ModelRecord] | None = None
@@ -164,7 +164,7 @@ class Recording:
         self._closed = True
         self._agent = None
         self._log_times = None
-        self._agent_cache.clear()
+        self._step_chunks.clear()
         self._models = None
         self._version_steps = None
         self._events = None
@@ -419,10 +419,10 @@ class Recording:
         return self._file.chunks(topic, step=step)
 
     def _chunks_of(
-        self, topics: Sequence[str]
+        self, topics: Sequence[str], *, step: int | None = None
     ) -> Generator[tuple[ChunkRef, bytes, list[Messages]], None, None]:
         self._check_open()
-        return self._file.chunks_of(topics)
+        return self._file.chunks_of(topics, step=step)
 
     def step_message_bytes(self) -> Generator[tuple[bytes, list[int], list[int]], None, None]:
         """The step messages' own bytes, a chunk at a time: the chunk's decompressed data and
@@ -553,27 +553,45 @@ class Recording:
 
     def _agent_row(self, step: int) -> _AgentRow:
         """The agent's fields of ``step``: from the whole memory when it was read, else from
-        the chunk holding the step (the last few such chunks are kept)."""
+        the one message of the step, in the chunk holding it (the last few such chunks are
+        kept, decompressed, with where their messages lie: no other message is decoded)."""
         if self._agent is not None:
             found = _row(self._agent, step)
             if found is None:  # pragma: no cover - the columns were checked
                 raise CorruptRecording(f"{self.path}: the message of step {step} is missing")
             return found
-        for columns in self._agent_cache.values():
-            row = _row(columns, step)
+        for ref, data, messages in self._step_chunks.values():
+            row = self._step_row(ref, data, messages, step)
             if row is not None:
                 return row
-        with closing(self._chunks("/rsstp/step", step=step)) as chunks:
-            for ref, data, parts, times in chunks:
-                columns = StepColumns(len(parts))
-                self._decode_steps(columns, ref, data, parts, times)
-                if len(self._agent_cache) >= _CACHED_CHUNKS:
-                    self._agent_cache.pop(next(iter(self._agent_cache)))
-                self._agent_cache[ref.offset] = columns
-                row = _row(columns, step)
+        with closing(self._chunks_of(("/rsstp/step",), step=step)) as chunks:
+            for ref, data, [messages] in chunks:
+                if len(self._step_chunks) >= _CACHED_CHUNKS:
+                    self._step_chunks.pop(next(iter(self._step_chunks)))
+                self._step_chunks[ref.offset] = (ref, data, messages)
+                row = self._step_row(ref, data, messages, step)
                 if row is not None:
                     return row
         raise CorruptRecording(f"{self.path}: the message of step {step} is missing")
+
+    def _step_row(
+        self, ref: ChunkRef, data: bytes, messages: Messages, step: int
+    ) -> _AgentRow | None:
+        """The agent's fields of ``step`` from its message among a chunk's ``messages``
+        (None when the chunk does not hold it)."""
+        index = int(np.searchsorted(messages.times, step * STEP_NS))
+        if index >= len(messages.times) or messages.times[index] != step * STEP_NS:
+            return None
+        part = memoryview(data)[messages.starts[index] : messages.ends[index]]
+        columns = StepColumns(1)
+        try:
+            columns.add([part], messages.times[index : index + 1])
+        except BadStep as exc:
+            raise CorruptRecording(
+                f"{self.path}: the step message at step {step} (chunk at byte {ref.offset}) is "
+                f"invalid: {exc.text}"
+            ) from None
+        return _row(columns, step)
 
 
 class _AgentRow(NamedTuple):
