@@ -37,11 +37,14 @@ learner's own, warm (the truth is computed first). Targets: every run equivalent
 4 N^2; the float twin of the 1,200-class world in at most half the boolean's steps.
 
 ``--record WORLD``: the user's path on a world of the curve (``--record two-links-10``, with
-``--float`` its twin, ``--seed``): its scenario file written, then ``rsstp-sim record`` with
-the learner and a budget of 4 N^2 steps, and ``rsstp-replay audit --truth`` of the recording,
-each cold in a fresh process: wall and CPU seconds, peak memory, the recording's size, where
-the run stopped and the audit's verdict. Target: the record of the 1,200-class world at most 2
-minutes.
+``--float`` its twin, ``--seed``): its scenario file written, then ``rsstp-sim run`` and
+``rsstp-sim record`` with the learner and a budget of 4 N^2 steps, ``rsstp-replay audit
+--truth`` and ``rsstp-replay view --save`` of the recording, each cold in a fresh process:
+wall and CPU seconds, peak memory, ``record`` against ``run``, the recording's size, where the
+run stopped and the audit's verdict. ``--keep FILE`` keeps the recording (for
+``bench/model_at.py``). Targets: the record of the 1,200-class world at most 2 minutes; for the
+4,841-class world (``two-links-5``, issue 32): ``record`` at most 1.5 x ``run``, a file of at
+most 40 MB, ``audit --truth`` within 20 s and 1 GiB, ``view --save`` within 1 GiB.
 
 ``--spread K``: the learner alone on each scenario with seeds ``0 .. K-1``, the steps to learn
 (least, median, most, and as multiples of N^2) and how many runs ended equivalent: the seed
@@ -56,6 +59,7 @@ import argparse
 import json
 import os
 import random
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -452,9 +456,10 @@ def curve(
     return good
 
 
-def record(name: str, seed: int, *, float_mode: bool) -> bool:
-    """``rsstp-sim record`` then ``rsstp-replay audit --truth`` of a world of the curve, cold;
-    prints one line each, returns whether the recording's final model is the truth's."""
+def record(name: str, seed: int, *, float_mode: bool, keep: Path | None = None) -> bool:
+    """``rsstp-sim run``, ``rsstp-sim record``, then ``rsstp-replay audit --truth`` and ``view
+    --save`` of a world of the curve, cold; prints one line each, returns whether the
+    recording's final model is the truth's. ``keep``: copy the recording there."""
     makers = dict(CURVE)
     if name not in makers:
         sys.exit(f"--record: expected one of {', '.join(makers)}, got {name!r}")
@@ -471,6 +476,8 @@ def record(name: str, seed: int, *, float_mode: bool) -> bool:
         mcap = str(Path(folder) / f"{scenario.name}.mcap")
         budget = str(4 * n * n)
         commands = {
+            "run": [sim, "run", str(toml), "--strategy", "learner", "--steps", budget]
+            + ["--seed", str(seed), "--quiet"],
             "record": [
                 sim,
                 "record",
@@ -486,15 +493,21 @@ def record(name: str, seed: int, *, float_mode: bool) -> bool:
                 mcap,
             ],
             "audit --truth": [replay, "audit", mcap, "--truth", "--json", "--quiet"],
+            "view --save": [replay, "view", mcap, "--save", str(Path(folder) / "run.rrd")],
         }
         print(
             f"{scenario.name} ({'float' if float_mode else 'boolean'}), N = {n:,}, seed {seed}, "
             f"load average {os.getloadavg()[0]:.1f}"
         )
+        walls = {}
         for what, command in commands.items():
             wall, cpu, peak = measure_cpu(command)
+            walls[what] = wall
             print(f"  {what:14s} {wall:7.1f} s wall {cpu:7.1f} s CPU {peak:5.2f} GiB", flush=True)
+        print(f"  record / run: {walls['record'] / walls['run']:.2f} x")
         size = Path(mcap).stat().st_size
+        if keep is not None:
+            shutil.copyfile(mcap, keep)
         done = subprocess.run(
             commands["audit --truth"], capture_output=True, text=True, check=False
         )
@@ -562,6 +575,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     )
     parser.add_argument("--record", metavar="WORLD", help="record and audit a world of the curve")
     parser.add_argument("--float", action="store_true", help="--record: the float twin")
+    parser.add_argument("--keep", type=Path, metavar="FILE", help="--record: keep the recording")
     parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
     parser.add_argument("scenarios", nargs="*", default=list(SCENARIOS))
     args = parser.parse_args(argv)
@@ -569,7 +583,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         _hw_child(args.hw_child, args.aalpy_seconds, args.seed, args.aalpy_memory_gib)
         return 0
     if args.record:
-        return 0 if record(args.record, args.seed, float_mode=args.float) else 1
+        return 0 if record(args.record, args.seed, float_mode=args.float, keep=args.keep) else 1
     if args.curve:
         ok = curve(
             args.max_n,
