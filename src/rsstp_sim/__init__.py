@@ -20,7 +20,6 @@ from rsstp_sim.errors import (
     StrategyError,
 )
 from rsstp_sim.memory import CompareKind, CompareResult, Memory, MemoryEntry
-from rsstp_sim.rover.env import RoverEnv
 from rsstp_sim.runner import Event, Runner, RunSummary, StepOutcome
 from rsstp_sim.scenario import Obstacle, builtin_scenarios, load_scenario, parse_scenario
 from rsstp_sim.strategies import (
@@ -68,7 +67,6 @@ __all__ = [
     "Pose",
     "RandomStrategy",
     "RecordingError",
-    "RoverEnv",
     "RsstpError",
     "RunSummary",
     "Runner",

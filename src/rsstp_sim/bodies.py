@@ -12,17 +12,24 @@ them, and a scenario module can ask it for a parser without an import cycle.
 from __future__ import annotations
 
 from importlib import import_module
-from typing import Any
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 from rsstp_sim.interface import Body
 
-__all__ = ["BODIES", "body_named", "body_of", "make_world", "registered"]
+if TYPE_CHECKING:
+    from rsstp_sim.arm.scenario import Scenario
+    from rsstp_sim.rover.scenario import RoverScenario
+
+__all__ = ["BODIES", "AnyScenario", "body_named", "body_of", "make_world", "registered"]
 
 BODIES: dict[str, str] = {
     "arm": "rsstp_sim.arm.world:ARM",
     "rover": "rsstp_sim.rover:ROVER",
 }
 """Body name (its scenario table) -> ``module:attribute`` of its :class:`Body`."""
+
+AnyScenario: TypeAlias = "Scenario | RoverScenario"
+"""A scenario of any registered body: each body's scenario class (one name a body)."""
 
 
 def registered(registry: dict[str, str], name: str) -> Any:

@@ -1,10 +1,10 @@
 """Scenarios: a body in its world, loaded from TOML.
 
-A scenario file is part of the public contract. Its body's table (``[arm]``, ``[rover]``)
-picks the body (:mod:`rsstp_sim.bodies`), whose parser checks every key at the boundary; a bad
-file raises :class:`~rsstp_sim.errors.ScenarioError` whose message names the file, the key
-path and what was expected. The arm's keys are :mod:`rsstp_sim.arm.scenario`'s, the rover's
-:mod:`rsstp_sim.rover.scenario`'s.
+A scenario file is part of the public contract. Its body's table (``[arm]``, or another
+registered body's) picks the body (:mod:`rsstp_sim.bodies`), whose parser checks every key at
+the boundary; a bad file raises :class:`~rsstp_sim.errors.ScenarioError` whose message names
+the file, the key path and what was expected. Each body's keys are its own scenario module's
+(the arm's: :mod:`rsstp_sim.arm.scenario`).
 
 Built-in scenarios ship as package data and can be named instead of a path.
 """
@@ -15,16 +15,11 @@ import tomllib
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, TypeAlias
 
-from rsstp_sim.bodies import BODIES, body_named
+from rsstp_sim.bodies import BODIES, AnyScenario, body_named
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.files import irregular
 from rsstp_sim.nesting import too_deep
-
-if TYPE_CHECKING:
-    from rsstp_sim.arm.scenario import Scenario
-    from rsstp_sim.rover.scenario import RoverScenario
 
 __all__ = [
     "AnyScenario",
@@ -53,10 +48,6 @@ class Obstacle:
 
     center: tuple[float, float]
     radius: float
-
-
-AnyScenario: TypeAlias = "Scenario | RoverScenario"
-"""A scenario of any registered body (:mod:`rsstp_sim.bodies`)."""
 
 
 def builtin_scenarios() -> dict[str, str]:
