@@ -42,9 +42,11 @@ learner's own, warm (the truth is computed first). Targets: every run equivalent
 --truth`` and ``rsstp-replay view --save`` of the recording, each cold in a fresh process:
 wall and CPU seconds, peak memory, ``record`` against ``run``, the recording's size, where the
 run stopped and the audit's verdict. ``--keep FILE`` keeps the recording (for
-``bench/model_at.py``). Targets: the record of the 1,200-class world at most 2 minutes; for the
-4,841-class world (``two-links-5``, issue 32): ``record`` at most 1.5 x ``run``, a file of at
-most 40 MB, ``audit --truth`` within 20 s and 1 GiB, ``view --save`` within 1 GiB.
+``bench/model_at.py``); ``--compact`` records a compact file (``rsstp-sim record --compact``:
+no message indexes, chunks compressed harder). Targets: the record of the 1,200-class world at
+most 2 minutes; for the 4,841-class world (``two-links-5``, issue 32): ``record`` at most 1.5 x
+``run``, a file of at most 40 MB, ``audit --truth`` within 20 s and 1 GiB, ``view --save``
+within 1 GiB.
 
 ``--spread K``: the learner alone on each scenario with seeds ``0 .. K-1``, the steps to learn
 (least, median, most, and as multiples of N^2) and how many runs ended equivalent: the seed
@@ -456,7 +458,9 @@ def curve(
     return good
 
 
-def record(name: str, seed: int, *, float_mode: bool, keep: Path | None = None) -> bool:
+def record(
+    name: str, seed: int, *, float_mode: bool, keep: Path | None = None, compact: bool = False
+) -> bool:
     """``rsstp-sim run``, ``rsstp-sim record``, then ``rsstp-replay audit --truth`` and ``view
     --save`` of a world of the curve, cold; prints one line each, returns whether the
     recording's final model is the truth's. ``keep``: copy the recording there."""
@@ -491,6 +495,7 @@ def record(name: str, seed: int, *, float_mode: bool, keep: Path | None = None) 
                 "--quiet",
                 "-o",
                 mcap,
+                *(["--compact"] if compact else []),
             ],
             "audit --truth": [replay, "audit", mcap, "--truth", "--json", "--quiet"],
             "view --save": [replay, "view", mcap, "--save", str(Path(folder) / "run.rrd")],
@@ -576,6 +581,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--record", metavar="WORLD", help="record and audit a world of the curve")
     parser.add_argument("--float", action="store_true", help="--record: the float twin")
     parser.add_argument("--keep", type=Path, metavar="FILE", help="--record: keep the recording")
+    parser.add_argument("--compact", action="store_true", help="--record: a compact file")
     parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
     parser.add_argument("scenarios", nargs="*", default=list(SCENARIOS))
     args = parser.parse_args(argv)
@@ -583,7 +589,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         _hw_child(args.hw_child, args.aalpy_seconds, args.seed, args.aalpy_memory_gib)
         return 0
     if args.record:
-        return 0 if record(args.record, args.seed, float_mode=args.float, keep=args.keep) else 1
+        return (
+            0
+            if record(
+                args.record, args.seed, float_mode=args.float, keep=args.keep, compact=args.compact
+            )
+            else 1
+        )
     if args.curve:
         ok = curve(
             args.max_n,

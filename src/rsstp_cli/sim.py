@@ -232,6 +232,7 @@ def _cmd_record(args: argparse.Namespace) -> int:
         seed=args.seed,
         chunk_size=args.chunk_size,
         force=args.force,
+        compact=args.compact,
     )
     received: list[int] = []
 
@@ -321,6 +322,12 @@ def _build_parser() -> Parser:
         default=1024 * 1024,
         metavar="BYTES",
         help="uncompressed bytes per MCAP chunk (default 1 MiB)",
+    )
+    p.add_argument(
+        "--compact",
+        action="store_true",
+        help="no message indexes, chunks compressed harder: under half the size, for readers "
+        "that read chunks through (Python mcap >= 1.4, rsstp-replay; see docs/recording.md)",
     )
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(func=_cmd_record)

@@ -23,6 +23,7 @@ from pathlib import Path
 import pytest
 from mcap.reader import make_reader
 
+from rsstp_replay import open_recording
 from rsstp_sim import RandomStrategy, load_scenario
 from rsstp_sim.errors import ChunkProcessFailed, RecordingError
 from rsstp_sim.recording.chunk_process import ChunkProcess
@@ -47,9 +48,16 @@ RUNS = [
 ]
 
 
-def recorded(path: Path, scenario: str, strategy: str, *, chunk_size: int) -> Recorder:
+def recorded(
+    path: Path, scenario: str, strategy: str, *, chunk_size: int, compact: bool = False
+) -> Recorder:
     return Recorder(
-        path, load_scenario(scenario), make_strategy(strategy), seed=4, chunk_size=chunk_size
+        path,
+        load_scenario(scenario),
+        make_strategy(strategy),
+        seed=4,
+        chunk_size=chunk_size,
+        compact=compact,
     )
 
 
@@ -67,6 +75,36 @@ def test_a_helped_run_writes_the_bytes_of_a_run_alone(
     assert summary is not None and summary.statistics is not None
     counts = summary.statistics.channel_message_counts
     assert {c.topic: counts.get(c.id, 0) for c in summary.channels.values()} == second.messages
+
+
+@pytest.mark.parametrize("helper", [False, True])
+def test_a_compact_recording_holds_the_same_messages_in_fewer_bytes(
+    tmp_path: Path, helper: bool
+) -> None:
+    """``compact``: no message indexes, harder compression; the same messages, read back by
+    mcap's own reader and by ours, and the same bytes again for the same run."""
+    default, compact, again = (tmp_path / f"{name}.mcap" for name in ("default", "c", "again"))
+    recorded(default, "thesis-algo", "learner", chunk_size=2048).run(3_000, helper=helper)
+    for path in (compact, again):
+        recorded(path, "thesis-algo", "learner", chunk_size=2048, compact=True).run(
+            3_000, helper=helper
+        )
+    assert compact.read_bytes() == again.read_bytes()
+    assert compact.stat().st_size < default.stat().st_size
+    read = {}
+    for path in (default, compact):
+        with path.open("rb") as stream:
+            reader = make_reader(stream, validate_crcs=True)
+            read[path] = [(c.topic, m.log_time, m.data) for _, c, m in reader.iter_messages()]
+            summary = reader.get_summary()
+        assert summary is not None
+        indexed = [bool(index.message_index_offsets) for index in summary.chunk_indexes]
+        assert all(indexed) if path == default else not any(indexed)
+    assert read[compact] == read[default]
+    with open_recording(default) as ours, open_recording(compact) as small:
+        assert small.steps().equals(ours.steps())
+        assert small.events().equals(ours.events())
+        assert small.model_at(3_000) == ours.model_at(3_000)
 
 
 def test_steps_one_at_a_time_then_a_helped_run(tmp_path: Path) -> None:

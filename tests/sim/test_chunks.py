@@ -9,18 +9,21 @@ writer) gives the same bytes, and a write error there surfaces at the next hand-
 
 from __future__ import annotations
 
+import contextlib
 import io
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from unittest import mock
 
 import pytest
+import zstandard
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from mcap.reader import make_reader
-from mcap.writer import CompressionType, Writer
+from mcap.writer import CompressionType, IndexType, Writer
 
-from rsstp_sim.recording.chunks import ChunkedWriter
+from rsstp_sim.recording.chunks import COMPACT_LEVEL, ChunkedWriter
 from rsstp_sim.recording.output import SideFileWriter
 
 
@@ -52,17 +55,24 @@ class Plan:
     chunk_size: int
 
 
-def with_mcap(plan: Plan) -> bytes:
+def with_mcap(plan: Plan, *, compact: bool = False) -> bytes:
+    """The file mcap's own ``Writer`` writes; ``compact``: with every index but the message
+    indexes, and zstd at the compact level instead of ``zstandard.compress``'s."""
     out = io.BytesIO()
-    writer = Writer(out, chunk_size=plan.chunk_size, compression=CompressionType.ZSTD)
-    writer.start(profile="", library="test")
-    _calls(plan, writer, lambda ch, t, data, tail: writer.add_message(ch, t, data + tail, t))
-    writer.finish()
+    indexes = IndexType.ALL & ~IndexType.MESSAGE if compact else IndexType.ALL
+    writer = Writer(
+        out, chunk_size=plan.chunk_size, compression=CompressionType.ZSTD, index_types=indexes
+    )
+    harder = zstandard.ZstdCompressor(level=COMPACT_LEVEL).compress
+    with mock.patch.object(zstandard, "compress", harder) if compact else contextlib.nullcontext():
+        writer.start(profile="", library="test")
+        _calls(plan, writer, lambda ch, t, data, tail: writer.add_message(ch, t, data + tail, t))
+        writer.finish()
     return out.getvalue()
 
 
-def with_chunked(plan: Plan, output: InMemory | SideFileWriter) -> None:
-    writer = ChunkedWriter(output, chunk_size=plan.chunk_size)
+def with_chunked(plan: Plan, output: InMemory | SideFileWriter, *, compact: bool = False) -> None:
+    writer = ChunkedWriter(output, chunk_size=plan.chunk_size, compact=compact)
     writer.start(profile="", library="test")
     _calls(plan, writer, writer.add_message)
     writer.finish()
@@ -108,6 +118,17 @@ def test_the_bytes_are_mcaps_writers(plan: Plan) -> None:
     ours = InMemory()
     with_chunked(plan, ours)
     assert bytes(ours.data) == with_mcap(plan)
+
+
+@settings(max_examples=60, deadline=None)
+@given(plan=plans())
+def test_a_compact_file_is_mcaps_writers_without_message_indexes(plan: Plan) -> None:
+    ours = InMemory()
+    with_chunked(plan, ours, compact=True)
+    assert bytes(ours.data) == with_mcap(plan, compact=True)
+    summary = make_reader(io.BytesIO(bytes(ours.data))).get_summary()
+    assert summary is not None
+    assert all(not index.message_index_offsets for index in summary.chunk_indexes)
 
 
 def test_a_long_file_reads_back_with_its_crcs(tmp_path: Path) -> None:

@@ -203,6 +203,19 @@ def test_same_bytes_across_processes_and_hash_seeds(tmp_path: Path) -> None:
     assert paths[0].read_bytes() == paths[1].read_bytes() == in_process.read_bytes()
 
 
+def test_compact_writes_the_compact_file_of_the_same_run(tmp_path: Path) -> None:
+    out = tmp_path / "small.mcap"
+    done = rsstp_record("three-joint", "--steps", "1000", "--seed", "5", "-o", out, "--compact")
+    assert done.returncode == 0, done.stderr
+    in_process = tmp_path / "in-process.mcap"
+    scenario = load_scenario("three-joint")
+    record(in_process, scenario, RandomStrategy(), steps=1000, seed=5, compact=True)
+    assert out.read_bytes() == in_process.read_bytes()
+    default = tmp_path / "default.mcap"
+    record(default, scenario, RandomStrategy(), steps=1000, seed=5)
+    assert out.stat().st_size < default.stat().st_size
+
+
 # ----------------------------------------------------------------- crash safety
 
 

@@ -72,7 +72,9 @@ class ChunkProcess:
     :meth:`close` (always) ends the helper.
     """
 
-    def __init__(self, *, chunk_size: int, channels: tuple[int, int]) -> None:
+    def __init__(
+        self, *, chunk_size: int, channels: tuple[int, int], compact: bool = False
+    ) -> None:
         """Start the helper; raises ``OSError`` when no process can be started."""
         blocks_in, blocks_out = os.pipe()
         chunks_in, chunks_out = os.pipe()
@@ -101,7 +103,7 @@ class ChunkProcess:
             target=self._receive, name="rsstp-chunk-process", daemon=True
         )
         self._receiver.start()
-        self._setup = chunk_size, channels
+        self._setup = chunk_size, channels, compact
 
     def take_over(self, chunk: OpenChunk) -> None:
         """Give the helper the chunk being built: it goes on from there."""
@@ -198,8 +200,8 @@ def _serve(blocks_fd: int, chunks_fd: int) -> int:
         outbox.send_bytes(pickle.dumps(item, pickle.HIGHEST_PROTOCOL))
 
     try:
-        chunk_size, channels, chunk = pickle.loads(inbox.recv_bytes())
-        compress = compressor()
+        chunk_size, channels, compact, chunk = pickle.loads(inbox.recv_bytes())
+        compress = compressor(compact=compact)
 
         def sealed(chunk: SealedChunk) -> None:
             send(pack(chunk, compress))

@@ -162,7 +162,9 @@ class Recorder:
     is the same either way.
 
     ``versions`` overrides the library versions written in the metadata (used
-    to reproduce a reference recording byte for byte on newer libraries).
+    to reproduce a reference recording byte for byte on newer libraries). ``compact``: write
+    no message indexes and compress the chunks harder (:mod:`~rsstp_sim.recording.chunks`):
+    the same messages in less than half the bytes, for readers that read chunks through.
     """
 
     def __init__(
@@ -177,6 +179,7 @@ class Recorder:
         versions: Mapping[str, str] | None = None,
         model: bool = True,
         world: World | None = None,
+        compact: bool = False,
     ) -> None:
         if isinstance(chunk_size, bool) or not isinstance(chunk_size, int) or chunk_size < 1024:
             raise RecordingError(f"chunk size must be an integer >= 1024 bytes, got {chunk_size!r}")
@@ -208,7 +211,7 @@ class Recorder:
         self.side_file = side_file(self.path)
         self._raw = open_side_file(self.path, force=force)
         self._file = SideFileWriter(self._raw)
-        self._writer = ChunkedWriter(self._file, chunk_size=chunk_size)
+        self._writer = ChunkedWriter(self._file, chunk_size=chunk_size, compact=compact)
         self._closed = False
         try:
             self._write_header(scenario, strategy, seed)
@@ -465,7 +468,11 @@ class Recorder:
 
     def _start_helper(self) -> ChunkProcess | None:
         try:
-            return ChunkProcess(chunk_size=self._writer.chunk_size, channels=self._column_channels)
+            return ChunkProcess(
+                chunk_size=self._writer.chunk_size,
+                channels=self._column_channels,
+                compact=self._writer.compact,
+            )
         except OSError:
             return None
 
@@ -668,8 +675,10 @@ def record(
     chunk_size: int = DEFAULT_CHUNK_SIZE,
     force: bool = False,
     versions: Mapping[str, str] | None = None,
+    compact: bool = False,
 ) -> RecordResult:
-    """Record ``steps`` steps of ``strategy`` in ``scenario`` to ``path`` (one call)."""
+    """Record ``steps`` steps of ``strategy`` in ``scenario`` to ``path`` (one call);
+    ``compact``: see :class:`Recorder`."""
     _check_steps(steps)  # before the file exists: bad input must not leave a file behind
     recorder = Recorder(
         path,
@@ -679,5 +688,6 @@ def record(
         chunk_size=chunk_size,
         force=force,
         versions=versions,
+        compact=compact,
     )
     return recorder.run(steps)
