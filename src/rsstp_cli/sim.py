@@ -327,7 +327,8 @@ def _build_parser() -> Parser:
         "--compact",
         action="store_true",
         help="no message indexes, chunks compressed harder: under half the size, for readers "
-        "that read chunks through (Python mcap >= 1.4, rsstp-replay; see docs/recording.md)",
+        "that read chunks through (rsstp-replay, Python mcap >= 1.4; not Foxglove: see "
+        "docs/recording.md)",
     )
     p.add_argument("--force", action="store_true", help="overwrite an existing output file")
     p.set_defaults(func=_cmd_record)

@@ -27,7 +27,8 @@ with no message index offsets, as the MCAP specification allows) and compresses 
 harder (zstd level :data:`COMPACT_LEVEL`): a long run's file shrinks by more than half, and a
 reader finds each message by reading its chunk through. Readers that rely on message indexes
 to find a chunk's messages read nothing from such a file (the Python ``mcap`` reader before
-1.4: foxglove/mcap#1735): hence it is not the default.
+1.4: foxglove/mcap#1735), or refuse it (``@mcap/core``'s indexed reader, which Foxglove opens
+files with): hence it is not the default.
 """
 
 from __future__ import annotations
