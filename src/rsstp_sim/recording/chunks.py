@@ -95,9 +95,9 @@ _MESSAGE_INDEX = struct.Struct("<BQHI").pack  # opcode, length, channel, entries
 _LENGTH = struct.Struct("<Q").pack
 _ZSTD_LEVEL = 3  # mcap's Writer: zstandard.compress(data), at its default level
 COMPACT_LEVEL = 9
-"""The zstd level of a compact file's chunks: a step of an arm's run takes about 15 bytes
-instead of 19.5 at level 3, compressed at about 80 MB/s instead of 700 (level 19: 12 bytes at
-2 MB/s)."""
+"""The zstd level of a compact file's chunks. The 1 MiB chunks of a 2,130,183-step learner run
+(1,009 MB of messages) take 62.6 MB at level 3 and 54.0 MB at level 9, compressed at about
+545 and 77 MB/s (level 12: 53.4 MB at 49 MB/s)."""
 
 
 class ChunkOutput(Protocol):
