@@ -15,7 +15,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from rsstp_sim._arrays import BoolArray, IntArray
+from rsstp_sim.arrays import BoolArray, IntArray
 
 __all__ = [
     "Blocker",

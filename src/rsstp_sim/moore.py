@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from rsstp_sim._arrays import BoolArray, IntArray
+from rsstp_sim.arrays import BoolArray, IntArray, distinct
 
 __all__ = ["moore_classes", "reached"]
 
@@ -79,7 +79,7 @@ def reached(tail: IntArray, head: IntArray, start: int, n: int) -> BoolArray:
         lo, hi = bounds[frontier], bounds[frontier + 1]
         sizes = hi - lo
         offsets = np.repeat(lo - np.cumsum(sizes) + sizes, sizes) + np.arange(int(sizes.sum()))
-        following = np.unique(heads[offsets])
+        following = distinct(heads[offsets])
         frontier = following[~seen[following]]
         seen[frontier] = True
     return seen

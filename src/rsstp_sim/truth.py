@@ -36,7 +36,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from rsstp_sim._arrays import BoolArray, IntArray
+from rsstp_sim.arrays import BoolArray, IntArray
 from rsstp_sim.bodies import body_of
 from rsstp_sim.errors import ModelError, TruthError
 from rsstp_sim.interface import PoseMachine, WorldScenario

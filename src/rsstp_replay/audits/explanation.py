@@ -45,6 +45,7 @@ import numpy.typing as npt
 from rsstp_format.records import ModelRecord
 from rsstp_replay.audits._columns import first_indices
 from rsstp_replay.audits.summary import PhaseShare
+from rsstp_sim.arrays import distinct
 from rsstp_sim.memory import Memory
 from rsstp_sim.truth import GroundTruth
 from rsstp_sim.words import counted
@@ -311,7 +312,7 @@ def _moves_to_sensed(truth: GroundTruth, visited: npt.NDArray[np.bool_]) -> int 
         if truth.class_sensation[frontier].any():
             return moves
         moves += 1
-        following = np.unique(truth.class_next[frontier].ravel())
+        following = distinct(truth.class_next[frontier])
         frontier = following[distance[following] < 0]
         distance[frontier] = moves
     return None

@@ -29,12 +29,13 @@ from numpy.typing import NDArray
 
 from rsstp_format import records
 from rsstp_replay.errors import PhysicsDifference
+from rsstp_sim.arrays import distinct
 from rsstp_sim.bodies import make_world
 from rsstp_sim.errors import ActionError
 from rsstp_sim.recording import builders
 from rsstp_sim.strategies import StrategyOrigin
 
-IntArray = NDArray[np.int64]  # (rsstp_sim._arrays is the simulator's own)
+IntArray = NDArray[np.int64]  # (rsstp_sim.arrays is the simulator's own)
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -178,15 +179,15 @@ def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: Int
     blocker (each pair encoded once)."""
     width = int(blockers.max(initial=0)) + 1
     keys = rows * width + blockers
-    distinct = np.unique(keys)
+    found = distinct(keys)
     expected = []
-    for key in distinct.tolist():
+    for key in found.tolist():
         row, code = divmod(key, width)
         truth = world.truth_at(row, code)
         expected.append(_TRUTH_KEY + records.encode_json(truth) + b"}")
     step = 0
     for data, starts, ends in recording.step_message_bytes():
-        chunk_keys = np.searchsorted(distinct, keys[step : step + len(starts)]).tolist()
+        chunk_keys = np.searchsorted(found, keys[step : step + len(starts)]).tolist()
         if len(chunk_keys) != len(starts):  # pragma: no cover - the steps were counted
             raise PhysicsDifference(step, "truth", "more step messages than steps")
         tails = list(map(expected.__getitem__, chunk_keys))

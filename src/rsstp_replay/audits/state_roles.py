@@ -21,6 +21,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
+from rsstp_sim.arrays import distinct
 from rsstp_sim.errors import MemoryRangeError
 
 __all__ = ["ALIASED", "EXACT", "REDUNDANT", "ROLE_NAMES", "UNVISITED", "state_roles"]
@@ -65,7 +66,7 @@ def state_roles(
     s_ids, s_codes = np.unique(step_s, return_inverse=True)
     c_ids, c_codes = np.unique(step_c, return_inverse=True)
     n_s, n_c = len(s_ids), len(c_ids)
-    triples = np.unique((v_codes * n_s + s_codes) * n_c + c_codes)
+    triples = distinct((v_codes * n_s + s_codes) * n_c + c_codes)
     vs = triples // n_c  # (version, state) code of each triple
     vc = (triples // (n_s * n_c)) * n_c + triples % n_c  # (version, class) code
     pairs, classes_per_pair = np.unique(vs, return_counts=True)

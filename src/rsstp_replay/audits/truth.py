@@ -50,6 +50,7 @@ from rsstp_replay.audits.contract import version_index
 from rsstp_replay.audits.loaded import load
 from rsstp_replay.audits.verdict import Counterexample, Verdict, judge_versions
 from rsstp_replay.reader import version_heads, version_sizes
+from rsstp_sim.arrays import distinct
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.truth import GroundTruth
@@ -110,11 +111,11 @@ def _pairs(keys: NDArray[np.int64], values: NDArray[np.int64]) -> NDArray[np.int
     low = min(int(keys.min()), int(values.min()))
     width = int(values.max()) + 1
     if low >= 0 and (int(keys.max()) + 1) * width < 2**62:  # one sort of packed pairs
-        packed = np.unique(keys * width + values)
+        packed = distinct(keys * width + values)
         return np.stack([packed // width, packed % width], axis=1)
     key_ids, key_codes = _codes(keys)
     value_ids, value_codes = _codes(values)
-    combined = np.unique(key_codes * len(value_ids) + value_codes)
+    combined = distinct(key_codes * len(value_ids) + value_codes)
     return np.stack(
         [key_ids[combined // len(value_ids)], value_ids[combined % len(value_ids)]], axis=1
     )

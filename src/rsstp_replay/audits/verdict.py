@@ -43,6 +43,7 @@ from rsstp_replay.audits._equivalence import (
     equivalent_classes,
 )
 from rsstp_replay.reader import version_heads, version_sizes
+from rsstp_sim.arrays import distinct
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence
 from rsstp_sim.words import counted
@@ -282,11 +283,11 @@ class _Visits:
             int(states.min(initial=0)) >= 0
             and int(true_class.min(initial=0)) >= 0
             and n_versions * width_state * width_class < 2**62
-        ):  # one integer per triple: a hashed unique, no sort of a long run's steps
+        ):  # one integer per triple: one sort of plain integers, not a lexsort
             packed = (index[keep] * width_state + states[keep]) * width_class + true_class[keep]
-            distinct = np.unique(packed)
+            seen = distinct(packed)
             del packed
-            rest, c = np.divmod(distinct, width_class)
+            rest, c = np.divmod(seen, width_class)
             v, s = np.divmod(rest, width_state)
             return cls(s, c, np.searchsorted(v, np.arange(n_versions + 1, dtype=np.int64)))
         order = np.lexsort((true_class[keep], states[keep], index[keep]))

@@ -24,6 +24,7 @@ from itertools import chain
 import numpy as np
 
 from rsstp_format.records import ModelRecord
+from rsstp_sim.arrays import distinct
 from rsstp_sim.graph import plain_positions, run_graphviz
 from rsstp_sim.transition_system import TransitionSystem, snapshot_form
 
@@ -52,7 +53,7 @@ def union_model(
     ]
     # Every version's transitions at once, as one int64 key each: the distinct ones, sorted.
     base = int(max((c.max(initial=0) for c in columns), default=0)) + 1
-    keys = np.unique((columns[0] * base + columns[1]) * base + columns[2])
+    keys = distinct((columns[0] * base + columns[1]) * base + columns[2])
     transitions = np.stack([keys // (base * base), keys // base % base, keys % base], axis=1)
     if not states:
         states.add(0)

@@ -62,6 +62,7 @@ from rsstp_replay.audits.state_roles import (
 from rsstp_replay.reader import version_heads, version_state_ids
 from rsstp_replay.viewer._chunks import TIMELINE, send_rows
 from rsstp_sim import palette
+from rsstp_sim.arrays import distinct
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = [
@@ -207,7 +208,7 @@ def roles_by_version(
     if not len(step_states):
         return {}
     width = int(step_states.max()) + 1
-    pairs = np.unique(step_versions * width + step_states)
+    pairs = distinct(step_versions * width + step_states)
     versions, states = pairs // width, pairs % width
     roles = state_roles(step_versions, step_states, step_classes, versions=versions, states=states)
     found: Roles = {}

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from rsstp_format.vocabulary import BlockerKind
-from rsstp_sim._arrays import FloatArray, IntArray
+from rsstp_sim.arrays import FloatArray, IntArray
 
 __all__ = [
     "ARM_BLOCKER_KINDS",

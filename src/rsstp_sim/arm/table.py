@@ -44,10 +44,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from rsstp_sim._arrays import BoolArray, FloatArray, Int32Array, IntArray
 from rsstp_sim.arm import geometry
 from rsstp_sim.arm.geometry import ArmGeometry
 from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.arrays import BoolArray, FloatArray, Int32Array, IntArray, distinct
 
 __all__ = [
     "DENSE_LIMIT",
@@ -245,7 +245,7 @@ class WorldTable:
             self._compute_moves(frontier)
             done += len(frontier)
             nxt = self.next_array()
-            reached = np.unique(nxt[frontier].ravel())
+            reached = distinct(nxt[frontier])
             frontier = reached[(nxt[reached] < 0).any(axis=1)].astype(np.int64)
             del nxt
         assert self.next_row[row * n_actions] >= 0
@@ -370,7 +370,7 @@ class WorldTable:
             target_rows = np.where(free, there, np.repeat(chunk, n_actions)).astype(np.int32)
             new = target_rows < 0  # free moves to poses not in the table yet
             if new.any():
-                self._add_poses(np.unique(moved[new]))
+                self._add_poses(distinct(moved[new]))
                 target_rows[new] = self.rows_of(moved[new])
             self.next_array()[chunk] = target_rows.reshape(-1, n_actions)
             self.blocker_array()[chunk] = blockers.reshape(-1, n_actions)

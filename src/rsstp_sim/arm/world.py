@@ -27,7 +27,6 @@ from rsstp_format.records import (
     TruthRecord,
     encode_json,
 )
-from rsstp_sim._arrays import BoolArray, FloatArray, IntArray
 from rsstp_sim.arm.geometry import Blocker
 from rsstp_sim.arm.scenario import Scenario, parse_arm
 from rsstp_sim.arm.table import (
@@ -37,6 +36,7 @@ from rsstp_sim.arm.table import (
     tabulation_checks,
     unsensable,
 )
+from rsstp_sim.arrays import BoolArray, FloatArray, IntArray
 from rsstp_sim.errors import ActionError, TruthError, UnknownPose
 from rsstp_sim.interface import PoseMachine
 from rsstp_sim.scenario import MANY_OBSTACLES

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from rsstp_sim._arrays import BoolArray, FloatArray, IntArray
+from rsstp_sim.arrays import BoolArray, FloatArray, IntArray
 from rsstp_sim.rover.scenario import Door, RoverScenario, Wall
 
 __all__ = ["ROOM_EDGES", "RoverTable", "cell_clearance", "headings_xy", "segment_distance"]

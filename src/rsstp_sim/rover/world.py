@@ -11,7 +11,7 @@ import numpy as np
 
 from rsstp_format.records import BlockedByRecord, PointRecord, RoverTruthRecord
 from rsstp_format.vocabulary import BlockerKind
-from rsstp_sim._arrays import BoolArray, FloatArray, IntArray
+from rsstp_sim.arrays import BoolArray, FloatArray, IntArray
 from rsstp_sim.errors import ActionError
 from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario
 from rsstp_sim.rover.table import ROOM_EDGES, RoverTable
