@@ -165,6 +165,22 @@ class Hypothesis:
             self._matched = (key, found)
         return found
 
+    def follow(self, states: IntArray, action: int, sensation: bool, feel: float) -> IntArray:
+        """The confirmed successors by ``action`` of ``states`` that agree with what was then
+        sensed and felt (:meth:`agree`), in the order of ``states`` (repeats kept)."""
+        moved: IntArray = self.next[:, self.column[action]][states]
+        if not self.feels:  # (label[-1], read for an unconfirmed successor, is masked out)
+            keep = self.label[moved]
+            if sensation:
+                keep &= moved >= 0
+            else:
+                keep |= moved < 0
+                np.logical_not(keep, out=keep)
+            return moved[keep]
+        keep = moved >= 0
+        keep[keep] = self.agree(moved[keep], sensation, feel)
+        return moved[keep]
+
     def step(
         self, start: IntArray, position: IntArray, action: int, via: tuple[int, int]
     ) -> IntArray:
