@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rsstp_sim.moore import moore_classes
+from rsstp_sim.strategies._learner_incoming import Incoming
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["FAR", "Hypothesis"]
@@ -82,8 +83,11 @@ class Hypothesis:
         self._merged: BoolArray = np.zeros(capacity, dtype=bool)
         self.labels: dict[int, bool] = {}
         self.access: dict[int, tuple[int, ...]] = {}
+        self.incoming = Incoming(len(actions), capacity)
+        """Who leads to each state, the counts behind :meth:`inverses`, the open actions."""
         for s in model.states:
             self.alive[s] = True
+            self.incoming.open_row(s, self.next[s])
             self.labels[s] = s == landmark
             self.label[s] = s == landmark
             self.access[s] = ()
@@ -270,28 +274,26 @@ class Hypothesis:
             self._aim(np.asarray([s], dtype=np.int64))
             return
         distance[s] = distance[t] + 1
-        changed = [s]
-        frontier = np.asarray([s], dtype=np.int64)
-        while len(frontier):
-            into = np.zeros(len(distance), dtype=bool)
-            into[frontier] = True
-            confirmed = self.next >= 0
-            sources, columns = np.nonzero(confirmed & into[np.maximum(self.next, 0)])
-            better = distance[self.next[sources, columns]] + 1
-            order = np.lexsort((better, sources))
-            sources, better = sources[order], better[order]
-            keep = np.ones(len(sources), dtype=bool)
-            keep[1:] = sources[1:] != sources[:-1]  # the least distance per source
-            sources, better = sources[keep], better[keep]
-            shorter = better < distance[sources]
-            frontier = sources[shorter]
-            distance[frontier] = better[shorter]
-            changed.extend(frontier.tolist())
-        touched = np.asarray(changed, dtype=np.int64)
-        into = np.zeros(len(distance), dtype=bool)
-        into[touched] = True
-        before = np.flatnonzero(((self.next >= 0) & into[np.maximum(self.next, 0)]).any(axis=1))
-        self._aim(np.union1d(touched, before))
+        # Spread the shorter way back along the confirmed transitions into the states it
+        # shortened, a level at a time; then aim again every state whose distance or whose
+        # successor's distance changed.
+        incoming = self.incoming
+        changed = {s}
+        frontier = [s]
+        while frontier:
+            level: list[int] = []
+            for u in frontier:
+                shorter = int(distance[u]) + 1
+                for p, _ in incoming.predecessors(u):
+                    if shorter < distance[p]:
+                        distance[p] = shorter
+                        level.append(p)
+            frontier = level
+            changed.update(level)
+        aimed = set(changed)
+        for u in changed:
+            aimed.update(p for p, _ in incoming.predecessors(u))
+        self._aim(np.asarray(sorted(aimed), dtype=np.int64))
 
     @property
     def distance(self) -> IntArray:
@@ -396,21 +398,17 @@ class Hypothesis:
 
         ``b`` undoes ``a`` when, of the confirmed ``s -a-> t`` (``t != s``) with a confirmed
         ``t -b->``, most have ``t -b-> s``: learned from the agent's own experience, used to
-        guess, never to conclude. (Worked out again after each change of the hypothesis.)
+        guess, never to conclude. (Read from the counts :attr:`incoming` keeps, after each
+        change of the hypothesis.)
         """
         if self._inverse[0] == self._edits:
             return self._inverse[1]
-        states = np.flatnonzero(self.alive)
         inverse: dict[int, int] = {}
+        back, known = self.incoming.back, self.incoming.known
         for ka, a in enumerate(self.actions):
-            t = self.next[states, ka]
-            moved = (t >= 0) & (t != states)
-            sources, targets = states[moved], t[moved]
             best, best_count = -1, 0
-            for kb in range(len(self.actions)):
-                back = self.next[targets, kb]
-                count = int(np.count_nonzero(back == sources))
-                if count > best_count and 2 * count >= np.count_nonzero(back >= 0):
+            for kb, count in enumerate(back[ka]):
+                if count > best_count and 2 * count >= known[ka][kb]:
                     best, best_count = kb, count
             if best >= 0:
                 inverse[a] = self.actions[best]
@@ -522,7 +520,7 @@ class Hypothesis:
             self._edits += 1
         if before < 0:
             self.unconfirmed -= 1
-        self.next[s, k] = t
+        self.incoming.set(self.next, s, k, t)
         old = self.target(s, action)
         if old != t:
             self.model.delete(s, old, action)
@@ -538,7 +536,7 @@ class Hypothesis:
         if self.next[s, k] >= 0:
             self._edits += 1
             self.unconfirmed += 1
-            self.next[s, k] = -1
+            self.incoming.set(self.next, s, k, -1)
             self._changed()
 
     def create(
@@ -574,13 +572,15 @@ class Hypothesis:
         self.labels[new] = sensation
         self.feel[new] = feel
         self.access[new] = access
-        self.next[new] = -1
+        for column in range(len(self.actions)):
+            self.incoming.set(self.next, new, column, -1)
+        self.incoming.open_row(new, self.next[new])
         self.unconfirmed += len(self.actions)
         k = self.column[action]
         before = int(self.next[s, k])
         if before < 0:
             self.unconfirmed -= 1
-        self.next[s, k] = new
+        self.incoming.set(self.next, s, k, new)
         if before >= 0:
             self._changed()
         return new
@@ -603,7 +603,9 @@ class Hypothesis:
         self.feel[new] = np.nan
         self.labels[new] = False
         self.access[new] = ()
-        self.next[new] = new
+        for column in range(len(self.actions)):
+            self.incoming.set(self.next, new, column, new)
+        self.incoming.open_row(new, self.next[new])
         return new
 
     def merge(self, keep: int, gone: int) -> None:
@@ -619,8 +621,12 @@ class Hypothesis:
             self._merged[keep] = True
         self._merged[gone] = False
         self.unconfirmed -= int(np.count_nonzero(self.next[gone] < 0))
-        self.next[gone] = -1
-        self.next[self.next == gone] = keep
+        incoming = self.incoming
+        for column in range(len(self.actions)):
+            incoming.set(self.next, gone, column, -1)
+        for u, column in incoming.predecessors(gone):
+            incoming.set(self.next, u, column, keep)
+        incoming.close_row(gone)
         self.alive[gone] = False
         del self.labels[gone]
         del self.access[gone]
@@ -653,6 +659,7 @@ class Hypothesis:
             self._distance = np.concatenate([self._distance, np.full(size - capacity, FAR)])
             self._toward = np.concatenate([self._toward, np.full(size - capacity, -1)])
         self.feel = np.concatenate([self.feel, np.full(size - capacity, np.nan)])
+        self.incoming.grow(size)
         self._merged = np.concatenate([self._merged, np.zeros(size - capacity, dtype=bool)])
 
     def minimise(self) -> list[tuple[int, int]]:

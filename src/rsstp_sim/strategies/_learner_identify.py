@@ -205,8 +205,7 @@ class Identifier(Walker):
                 if h.next[c, k] == q:
                     votes[c] = votes.get(c, 0) + 2
         column = h.column[a]
-        sources, columns = np.nonzero(h.next == q)
-        for p, kb in zip(sources.tolist(), columns.tolist(), strict=True):
+        for p, kb in h.incoming.predecessors(q):
             r = int(h.next[p, column])
             if r >= 0:
                 y = int(h.next[r, kb])

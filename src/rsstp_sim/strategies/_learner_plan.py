@@ -139,20 +139,27 @@ class Learning(Identifier):
         belief = self.belief
         assert belief is not None
         distance = h.distance
-        open_mask = h.alive[:, None] & (h.next < 0)
+        put_off: dict[int, set[int]] = {}  # the open columns of a state put off, by state
         for (s, a), deferred in self.deferred.items():
             # Put off until the model changed and a candidate can be tested.
             if deferred.version == h.version or not any(
                 u not in h.labels or distance[u] < FAR for u in deferred.candidates
             ):
-                open_mask[s, h.column[a]] = False
-        wanted: NDArray[np.bool_] = np.asarray(open_mask.any(axis=1), dtype=bool)
+                if h.alive[s] and h.next[s, h.column[a]] < 0:
+                    put_off.setdefault(s, set()).add(h.column[a])
+        open_count = h.incoming.open
+        wanted: NDArray[np.bool_] = open_count > 0
+        for s, columns in put_off.items():
+            if len(columns) == open_count[s]:
+                wanted[s] = False
         if not wanted.any():
             return None
         actions_of = h.actions
 
         def open_actions(s: int) -> list[int]:
-            return [actions_of[k] for k in np.flatnonzero(open_mask[s]).tolist()]
+            shut = put_off.get(s, ())
+            row = h.next[s].tolist()
+            return [actions_of[k] for k, t in enumerate(row) if t < 0 and k not in shut]
 
         inverse = h.inverses()
 
