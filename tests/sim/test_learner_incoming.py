@@ -11,6 +11,7 @@ from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies._learner_hypothesis import Hypothesis
 from rsstp_sim.strategies._learner_incoming import Incoming
 from rsstp_sim.strategies.learner import LearnerStrategy
+from rsstp_sim.transition_system import TransitionSystem
 
 
 def recount(
@@ -119,3 +120,60 @@ def test_the_index_is_kept_through_a_whole_run() -> None:
             assert h.inverses() == _inverses_by_recount(h)
             checked += 1
         assert learner.done and checked > 10
+
+
+def test_the_states_by_feel_are_kept_through_a_whole_run() -> None:
+    # With float feedback the learner finds the states agreeing with what it sensed and felt
+    # by an index of their feels, kept as states come, are felt, merge and go: at every
+    # fiftieth step it equals a scan of every state.
+    scenario = load_scenario("two-joint-30")
+    twin = parse_scenario(scenario.source.replace("[feedback]\n", '[feedback]\nmode = "float"\n'))
+    learner = LearnerStrategy()
+    runner = Runner(twin, learner, seed=2)
+    while not learner.done and runner.step_index < 50_000:
+        runner.step()
+        if runner.step_index % 50 or learner._learning is None:
+            continue
+        h = learner._learning.h
+        states = np.flatnonzero(h.alive)
+        feels = {float(f) for f in h.feel[states]} | {0.0, 0.5, float(runner.memory.last_feedback)}
+        for felt in h.also_felt.values():
+            feels |= felt
+        for feel in sorted(f for f in feels if f == f):
+            for sensation in (False, True):
+                expected = states[h.agree(states, sensation, feel)].tolist()
+                assert h.matching(sensation, feel) == expected
+    assert learner.done
+
+
+@settings(max_examples=100, deadline=None)
+@given(
+    st.lists(
+        st.tuples(
+            st.sampled_from(["create", "merge", "feel"]),
+            st.integers(0, 30),
+            st.integers(0, 30),
+            st.sampled_from([0.25, 0.5, 0.75, float("nan")]),
+        ),
+        max_size=40,
+    )  # fmt: skip
+)
+def test_the_states_by_feel_follow_new_states_feels_and_merges(
+    edits: list[tuple[str, int, int, float]],
+) -> None:
+    actions = (0, 1)
+    h = Hypothesis(TransitionSystem.universal(actions), actions, landmark=0, feels=True)
+    for kind, i, j, feel in edits:
+        states = h.states()
+        s, t = states[i % len(states)], states[j % len(states)]
+        if kind == "create":
+            h.create(s, actions[j % 2], bool(j % 3 == 0), (), feel)
+        elif kind == "merge" and s != t:
+            h.merge(s, t)
+        elif kind == "feel":
+            h.set_feel(s, feel)
+        alive = np.flatnonzero(h.alive)
+        for felt in (0.25, 0.5, 0.75):
+            for sensation in (False, True):
+                expected = alive[h.agree(alive, sensation, felt)].tolist()
+                assert h.matching(sensation, felt) == expected

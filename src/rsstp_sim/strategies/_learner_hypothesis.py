@@ -81,6 +81,11 @@ class Hypothesis:
         self.feel: FloatArray = np.full(capacity, np.nan)
         self.also_felt: dict[int, set[float]] = {}
         self._merged: BoolArray = np.zeros(capacity, dtype=bool)
+        self._by_feel: dict[float, set[int]] = {}
+        """With ``feels``: the states that agree with a feel, by feel (their own, and those of
+        the states merged into them), the states whose feel is unknown aside (``_unfelt``)."""
+        self._unfelt: set[int] = set()
+        self._feel_keys: dict[int, tuple[float, ...]] = {}
         self.labels: dict[int, bool] = {}
         self.access: dict[int, tuple[int, ...]] = {}
         self.incoming = Incoming(len(actions), capacity)
@@ -88,6 +93,7 @@ class Hypothesis:
         for s in model.states:
             self.alive[s] = True
             self.incoming.open_row(s, self.next[s])
+            self._refelt(s)
             self.labels[s] = s == landmark
             self.label[s] = s == landmark
             self.access[s] = ()
@@ -162,6 +168,12 @@ class Hypothesis:
         key = (self._edits, sensation)
         if not self.feels and self._matched[0] == key:
             return self._matched[1]
+        if self.feels and feel == feel:  # (the states felt so, and those never felt)
+            felt = self._by_feel.get(feel, set()) | self._unfelt
+            ids = np.fromiter(sorted(felt), dtype=np.int64, count=len(felt))
+            agreeing: IntArray = ids[self.label[ids] == sensation]
+            agreeing.flags.writeable = False
+            return agreeing
         states = np.flatnonzero(self.alive)
         found = states[self.agree(states, sensation, feel)]
         found.flags.writeable = False
@@ -210,8 +222,7 @@ class Hypothesis:
         label) and ``feels`` (with :attr:`feels`), if ``via`` leads to ``c`` (see
         :meth:`step`)."""
         felt = feels if self.feels and feels else (0.0,) * len(outputs)
-        start = np.flatnonzero(self.alive)
-        start = start[self.agree(start, outputs[0], felt[0])]
+        start = self.matching_ids(outputs[0], felt[0])
         position = start.copy()
         for action, sensation, feel in zip(word, outputs[1:], felt[1:], strict=True):
             moved = self.step(start, position, action, via)
@@ -219,6 +230,32 @@ class Hypothesis:
             keep[keep] = self.agree(moved[keep], sensation, feel)
             start, position = start[keep], moved[keep]
         return [int(s) for s in start]
+
+    def set_feel(self, s: int, feel: float) -> None:
+        """What is felt at the world state ``s`` stands for (first felt now)."""
+        self.feel[s] = feel
+        self._refelt(s)
+
+    def _refelt(self, s: int) -> None:
+        """State ``s``'s feels changed (or it came or went): index it anew."""
+        if not self.feels:
+            return
+        for key in self._feel_keys.pop(s, ()):
+            states = self._by_feel[key]
+            states.discard(s)
+            if not states:
+                del self._by_feel[key]
+        self._unfelt.discard(s)
+        if not self.alive[s]:
+            return
+        felt = float(self.feel[s])
+        if felt != felt:
+            self._unfelt.add(s)
+            return
+        keys = {felt, *self.also_felt.get(s, ())} if self._merged[s] else {felt}
+        self._feel_keys[s] = tuple(keys)
+        for key in keys:
+            self._by_feel.setdefault(key, set()).add(s)
 
     def is_complete(self) -> bool:
         return self.unconfirmed == 0
@@ -571,6 +608,7 @@ class Hypothesis:
         self.label[new] = sensation
         self.labels[new] = sensation
         self.feel[new] = feel
+        self._refelt(new)
         self.access[new] = access
         for column in range(len(self.actions)):
             self.incoming.set(self.next, new, column, -1)
@@ -601,6 +639,7 @@ class Hypothesis:
         self.alive[new] = True
         self.label[new] = False
         self.feel[new] = np.nan
+        self._refelt(new)
         self.labels[new] = False
         self.access[new] = ()
         for column in range(len(self.actions)):
@@ -628,6 +667,8 @@ class Hypothesis:
             incoming.set(self.next, u, column, keep)
         incoming.close_row(gone)
         self.alive[gone] = False
+        self._refelt(gone)
+        self._refelt(keep)
         del self.labels[gone]
         del self.access[gone]
         if self.landmark == gone:

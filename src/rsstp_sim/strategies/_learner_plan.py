@@ -387,8 +387,7 @@ class Learning(Identifier):
         actions = memory.actions[1 : first + 1].tolist()
         sensations = memory.sensations[: first + 1].tolist()
         felt = memory.feedback[: first + 1].tolist() if h.feels else [0.0] * (first + 1)
-        candidates = np.flatnonzero(h.alive)
-        candidates = candidates[h.agree(candidates, sensations[0], felt[0])]
+        candidates = h.matching_ids(sensations[0], felt[0])
         position = candidates.copy()
         for action, sensation, feel in zip(actions, sensations[1:], felt[1:], strict=True):
             position = h.next[position, h.column[action]]

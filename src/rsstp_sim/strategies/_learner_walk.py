@@ -166,7 +166,7 @@ class Walker:
         self.last_seen = self.agent.step
         self.seen = True
         if h.feels and np.isnan(h.feel[h.landmark]):
-            h.feel[h.landmark] = self.feel()
+            h.set_feel(h.landmark, self.feel())
         self.word.clear()
         self.trace.clear()
         self.felt.clear()
