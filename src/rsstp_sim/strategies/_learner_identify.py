@@ -11,6 +11,7 @@ from collections.abc import Generator
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR, BoolArray
@@ -56,6 +57,9 @@ class Identifier(Walker):
         self.deferred: dict[tuple[int, int], Deferral] = {}
         self._singles = np.zeros((0, len(self.h.actions)), dtype=np.int8)
         self._singles_edits = -1
+        self.retested: set[tuple[int, int]] = set()
+        """The (state, action column) pairs whose tests changed since the verification last
+        looked (:meth:`Learning.suspect <rsstp_sim.strategies._learner_plan.Learning.suspect>`)."""
 
     def confirm(self, q: int, a: int, t: int) -> None:
         self.deferred.pop((q, a), None)
@@ -302,8 +306,10 @@ class Identifier(Walker):
         return self.traces.pop((q, a), [])
 
     def _retest(self, q: int, a: int) -> None:
+        k = self.h.column[a]
+        self.retested.add((q, k))
         if q < len(self._singles):
-            self._singles[q, self.h.column[a]] = -1
+            self._singles[q, k] = -1
 
     def singled_out(self, wanted: BoolArray) -> BoolArray:
         """For the (state, action column) pairs ``wanted`` (rows: state ids): whether the tests
@@ -312,22 +318,38 @@ class Identifier(Walker):
 
         Each pair is replayed once while the hypothesis's confirmed successors (its
         :attr:`~Hypothesis.edits`) and the pair's tests stay as they are."""
+        singles = self._singles_for(len(wanted))
+        rows, columns = np.nonzero(wanted & (singles < 0))
+        for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
+            self._replay(s, k)
+        single: BoolArray = wanted & (singles == 1)
+        return single
+
+    def single(self, s: int, k: int, n: int) -> bool:
+        """:meth:`singled_out` for the one pair ``(s, k)`` (``s < n``, the rows wanted)."""
+        singles = self._singles_for(n)
+        if singles[s, k] < 0:
+            self._replay(s, k)
+        return bool(singles[s, k] == 1)
+
+    def _singles_for(self, n: int) -> NDArray[np.int8]:
+        """The pairs of states ``0 .. n-1`` replayed (1: singled out, 0: not, -1: not yet), as
+        long as the :attr:`~Hypothesis.edits` stay the same."""
         h = self.h
-        n = len(wanted)
         if self._singles_edits != h.edits or len(self._singles) < n:
             self._singles = np.full((n, len(h.actions)), -1, dtype=np.int8)
             self._singles_edits = h.edits
-        singles = self._singles[:n]
-        rows, columns = np.nonzero(wanted & (singles < 0))
-        for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
-            a = h.actions[k]
-            agreeing: set[int] | None = None
-            for word, outputs, felt in self.traces.get((s, a), ()):
-                found = set(h.consistent(word, outputs, (s, a), felt))
-                agreeing = found if agreeing is None else agreeing & found
-            singles[s, k] = agreeing == {int(h.next[s, k])}
-        single: BoolArray = wanted & (singles == 1)
-        return single
+        return self._singles[:n]
+
+    def _replay(self, s: int, k: int) -> None:
+        """Replay the tests kept for ``(s, k)``: whether they single out its successor."""
+        h = self.h
+        a = h.actions[k]
+        agreeing: set[int] | None = None
+        for word, outputs, felt in self.traces.get((s, a), ()):
+            found = set(h.consistent(word, outputs, (s, a), felt))
+            agreeing = found if agreeing is None else agreeing & found
+        self._singles[s, k] = agreeing == {int(h.next[s, k])}
 
     def return_to(
         self, q: int, a: int, route: tuple[int, ...] | None

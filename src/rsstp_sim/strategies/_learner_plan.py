@@ -32,6 +32,9 @@ class Learning(Identifier):
         self.done = False
         self._checked = np.zeros((0, len(self.h.actions)), dtype=bool)
         self._checked_version = -1
+        self._doubtful: tuple[tuple[int, int, int], NDArray[np.bool_], set[int]] | None = None
+        """What :meth:`suspect` found: for the (model version, edits, rows) then, the doubtful
+        pairs and the states they are of, kept up to date as pairs are retested."""
         self._settled = -1
         """The hypothesis's :attr:`~Hypothesis.edits` when it was last found complete, with
         every state reachable and none to merge."""
@@ -232,6 +235,7 @@ class Learning(Identifier):
             if traces and keep is not None:  # (the merge changed the edits: all are replayed)
                 self.traces.setdefault((keep, a), []).extend(traces)
         self._checked[:] = False
+        self._doubtful = None
 
     # ------------------------------------------------------------- verification
 
@@ -251,14 +255,31 @@ class Learning(Identifier):
             self._checked[:] = False
             self._checked_version = h.version
         checked = self._checked_for(n)
-        todo = h.alive[:n, None] & (h.next[:n] != h.landmark) & ~checked
-        singled_out = self.singled_out(todo)
-        checked |= todo & singled_out
-        doubtful = todo & ~singled_out
-        states = np.flatnonzero(doubtful.any(axis=1))
-        if not len(states):
+        key = (h.version, h.edits, n)
+        if self._doubtful is None or self._doubtful[0] != key:
+            todo = h.alive[:n, None] & (h.next[:n] != h.landmark) & ~checked
+            singled_out = self.singled_out(todo)
+            checked |= todo & singled_out
+            doubtful = todo & ~singled_out
+            states = set(np.flatnonzero(doubtful.any(axis=1)).tolist())
+            self._doubtful = (key, doubtful, states)
+        else:  # (only the pairs retested since can have changed)
+            _, doubtful, states = self._doubtful
+            for q, k in self.retested:
+                if q >= n:
+                    continue
+                todo = bool(h.alive[q]) and h.next[q, k] != h.landmark and not checked[q, k]
+                singled = todo and self.single(q, k, n)
+                checked[q, k] |= singled
+                doubtful[q, k] = todo and not singled
+                if doubtful[q].any():
+                    states.add(q)
+                else:
+                    states.discard(q)
+        self.retested.clear()
+        if not states:
             return None
-        nearest = h.nearest(self.belief, set(states.tolist()))
+        nearest = h.nearest(self.belief, states)
         if nearest is None:
             return None
         s = nearest[1]
@@ -283,6 +304,7 @@ class Learning(Identifier):
             self.agent.note(f"verification: state {q} by action {a} leads elsewhere")
         self._checked_for(len(h.label))[q, h.column[a]] = True
         self._checked_version = h.version
+        self.retested.add((q, h.column[a]))
 
     def _checked_for(self, n: int) -> NDArray[np.bool_]:
         """The checked transitions of states ``0 .. n-1``, by action column."""
