@@ -483,17 +483,19 @@ def test_paths_are_the_first_shortest_words_a_breadth_first_search_finds(
     h._changed()
     wanted = np.zeros(n, dtype=bool)
     wanted[list(goals)] = True
-    assert h.nearest_where(source, wanted) == _first_shortest_word(
-        successors, order, actions, source, goals
-    )
-    assert h.nearest(source, goals) == _first_shortest_word(
-        successors, order, actions, source, goals
-    )
-    home = _first_shortest_word(successors, order, actions, source, {0})
-    assert h.path(source, 0) == (None if home is None else home[0])
-    for goal in goals:
-        found = _first_shortest_word(successors, order, actions, source, {goal})
-        assert h.path(source, goal) == (None if found is None else found[0])
+    for near_states in (1024, 2, 0):  # one state at a time, then a level at a time, or both
+        h.near_states = near_states
+        assert h.nearest_where(source, wanted) == _first_shortest_word(
+            successors, order, actions, source, goals
+        )
+        assert h.nearest(source, goals) == _first_shortest_word(
+            successors, order, actions, source, goals
+        )
+        home = _first_shortest_word(successors, order, actions, source, {0})
+        assert h.path(source, 0) == (None if home is None else home[0])
+        for goal in goals:
+            found = _first_shortest_word(successors, order, actions, source, {goal})
+            assert h.path(source, goal) == (None if found is None else found[0])
 
 
 def _separating_word_pair_by_pair(

@@ -36,6 +36,13 @@ EVIDENCE = 4
 needs before it finds that no action undoes it."""
 
 
+class _TooFar:
+    """:meth:`Hypothesis._search_near` met too many states: search a level at a time."""
+
+
+_TOO_FAR = _TooFar()
+
+
 class Hypothesis:
     """Labels, confirmed successors and the landmark, over the model's state ids.
 
@@ -104,6 +111,8 @@ class Hypothesis:
         self._edits = 0
         self._inverse: tuple[int, dict[int, int]] = (-1, {})
         self._matched: tuple[tuple[int, bool], IntArray] = ((-1, False), np.zeros(0, np.int64))
+        self.near_states = 1024
+        """How many states a search meets one at a time before it goes a level at a time."""
 
     # ----------------------------------------------------------------- queries
 
@@ -384,12 +393,17 @@ class Hypothesis:
         """Breadth first over the confirmed transitions, the actions in the run's order: the
         word to the first state reached that is ``wanted``, and that state.
 
-        One numpy pass per distance from ``source``: each level's successors in the order a
+        A first-in first-out search, state by state, while it has met at most
+        :attr:`near_states` states (the goal is most often a few steps away); past that, one
+        numpy pass per distance from ``source``: each level's successors in the order the
         first-in first-out search meets them (state by state in the level's order, action by
         action), each state kept where it is first met; so the state found, and its word, are
-        those of the one-state-at-a-time search."""
+        the same either way."""
         if wanted[source]:
             return [], source
+        near = self._search_near(source, wanted)
+        if not isinstance(near, _TooFar):
+            return near
         width = len(self.actions)
         columns = np.asarray(self._columns, dtype=np.int64)
         seen = np.zeros(len(self.label), dtype=bool)
@@ -415,6 +429,33 @@ class Hypothesis:
                     at = int(came[at]) // width
                 word.reverse()
                 return word, found
+        return None
+
+    def _search_near(
+        self, source: int, wanted: BoolArray
+    ) -> tuple[list[int], int] | None | _TooFar:
+        """:meth:`_search` one state at a time; :data:`_TOO_FAR` once it has met more than
+        :attr:`near_states` states."""
+        next_, columns, limit = self.next, self._columns, self.near_states
+        parent: dict[int, tuple[int, int]] = {source: (source, -1)}
+        queue = [source]
+        for s in queue:
+            row = next_[s].tolist()
+            for i, k in enumerate(columns):
+                t = row[k]
+                if t < 0 or t in parent:
+                    continue
+                parent[t] = (s, i)
+                if wanted[t]:
+                    found, word = t, []
+                    while t != source:
+                        t, i = parent[t]
+                        word.append(self._ordered[i])
+                    word.reverse()
+                    return word, found
+                queue.append(t)
+            if len(queue) > limit:
+                return _TOO_FAR
         return None
 
     def around(self, source: int, radius: int) -> set[int]:
