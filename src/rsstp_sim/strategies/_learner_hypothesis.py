@@ -149,9 +149,10 @@ class Hypothesis:
         if self.feels:
             felt = self.feel[states]
             alike = np.isnan(felt) | (felt == feel)
-            other = np.flatnonzero(self._merged[states] & ~alike)
-            for i in other.tolist():
-                alike[i] = feel in self.also_felt[int(states[i])]
+            if self.also_felt:  # (a merged state is also felt as the states merged into it)
+                other = np.flatnonzero(self._merged[states] & ~alike)
+                for i in other.tolist():
+                    alike[i] = feel in self.also_felt[int(states[i])]
             same &= alike
         return same
 
@@ -297,12 +298,20 @@ class Hypothesis:
             self._aim(np.flatnonzero(distance < FAR))
         return self._distance, self._toward
 
-    def _aim(self, states: IntArray) -> None:
+    def _aim(self, states: IntArray | list[int]) -> None:
         """``toward`` of ``states`` from the distances: the first action, in the run's order,
         to a successor one step nearer the landmark (-1 at the landmark and out of reach)."""
         distance, toward = self._distance, self._toward
         assert distance is not None and toward is not None
         if not len(states):
+            return
+        if len(states) <= 16:  # (a few states, one at a time: a confirmation's)
+            for x in states:
+                nearer = int(distance[x]) - 1
+                row = self.next[x].tolist()
+                toward[x] = next(
+                    (k for k in self._columns if row[k] >= 0 and distance[row[k]] == nearer), -1
+                )
             return
         successors = self.next[states][:, self._columns]
         ahead = np.where(successors >= 0, distance[np.maximum(successors, 0)], FAR)
@@ -317,7 +326,7 @@ class Hypothesis:
         if distance is None:
             return
         if distance[t] + 1 >= distance[s]:
-            self._aim(np.asarray([s], dtype=np.int64))
+            self._aim([s])
             return
         distance[s] = distance[t] + 1
         # Spread the shorter way back along the confirmed transitions into the states it
@@ -339,7 +348,7 @@ class Hypothesis:
         aimed = set(changed)
         for u in changed:
             aimed.update(p for p, _ in incoming.predecessors(u))
-        self._aim(np.asarray(sorted(aimed), dtype=np.int64))
+        self._aim(sorted(aimed))
 
     @property
     def distance(self) -> IntArray:
