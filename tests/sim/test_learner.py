@@ -711,3 +711,26 @@ def test_a_wrong_transition_is_refuted_found_and_repaired(name: str) -> None:
     assert learning.stats.get("counterexamples", 0) >= 1
     assert learner.done
     assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
+@pytest.mark.parametrize("mode", ["bool", "float"])
+def test_a_test_takes_the_same_steps_with_arrays_or_one_candidate_at_a_time(
+    mode: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A test follows many candidates with numpy arrays and few (FEW or fewer) one at a time;
+    # either way the same steps, the same draws of the generator, the same model.
+    import rsstp_sim.strategies._learner_identify as identify
+
+    scenario = load_scenario("two-joint-30")
+    if mode == "float":
+        scenario = float_twin(scenario)
+    runs = []
+    for few in (0, identify.FEW, 1_000_000):
+        monkeypatch.setattr(identify, "FEW", few)
+        learner, runner = learn(scenario, 20_000, seed=4)
+        assert learner.done
+        runs.append(
+            (runner.memory.actions.tolist(), runner.memory.internal_states.tolist(),
+             runner.rng.random(), sorted(runner.model.transitions()))
+        )  # fmt: skip
+    assert runs[0] == runs[1] == runs[2]

@@ -23,6 +23,10 @@ Trace = tuple[tuple[int, ...], tuple[bool, ...], tuple[float, ...]]
 """A test: its actions, the sensations before the first and after each action, and the
 float feedback felt there (empty when the agent has none)."""
 
+FEW = 24
+"""A test follows this many candidates or fewer one at a time (:meth:`Identifier.session`):
+fewer steps of Python than the arrays' fixed cost."""
+
 LOCATED_STEPS = 2
 """With float feedback, a test ends when one candidate is left and it has agreed with what
 was sensed and felt for this many steps: the agent is located there
@@ -247,6 +251,13 @@ class Identifier(Walker):
         at_landmark = False
         taken = 0
         while len(ids) or script:
+            if len(ids) <= FEW:
+                return (
+                    yield from self._session_few(
+                        via, ids.tolist(), position.tolist(), tracked.tolist(), chosen, script,
+                        follow=follow, taken=taken,
+                    )
+                )  # fmt: skip
             if script:
                 action = script.pop(0)
             elif not follow:
@@ -287,6 +298,74 @@ class Identifier(Walker):
                 return {int(ids[0])}, {int(ids[0])}, False, int(ids[0])
         survivors = {int(s) for s in ids[tracked]} if at_landmark else set()
         return survivors, {int(s) for s in ids}, at_landmark, None
+
+    def _session_few(
+        self,
+        via: tuple[int, int],
+        ids: list[int],
+        position: list[int],
+        tracked: list[bool],
+        chosen: int | None,
+        script: list[int],
+        *,
+        follow: bool,
+        taken: int,
+    ) -> Generator[int, bool, tuple[set[int], set[int], bool, int | None]]:
+        """:meth:`session` on from where it is, with :data:`FEW` candidates or fewer: one at a
+        time, in lists (``ids[i]`` followed from ``position[i]``, ruled out when it disagrees
+        while ``tracked[i]``), the same steps as the arrays take."""
+        h = self.h
+        at_landmark = False
+        while ids or script:
+            if script:
+                action = script.pop(0)
+            elif not follow:
+                break
+            else:
+                distance = h.distance
+                index = -1
+                if chosen is not None and chosen in ids:
+                    i = ids.index(chosen)
+                    if tracked[i] and distance[position[i]] < FAR:
+                        index = i
+                if index < 0:
+                    usable = [i for i, t in enumerate(tracked) if t and distance[position[i]] < FAR]
+                    if not usable:
+                        break
+                    least = min(int(distance[position[i]]) for i in usable)
+                    index = self.pick([i for i in usable if distance[position[i]] == least])
+                    chosen = ids[index]
+                action = h.actions[int(h.toward[position[index]])]
+                if position[index] == via[0] and action == via[1]:
+                    tracked[index] = False  # (it would go round for ever: see session)
+                    continue
+            sensation = yield from self.move(action)
+            taken += 1
+            feel = self.feel()
+            column = h.next[:, h.column[action]]
+            back = action == via[1]  # (from via's state, a candidate goes back to itself)
+            kept: tuple[list[int], list[int], list[bool]] = ([], [], [])
+            for c, p, follows in zip(ids, position, tracked, strict=True):
+                if follows:
+                    moved = c if back and p == via[0] else int(column[p])
+                    if moved < 0:
+                        follows = False
+                    else:
+                        p = moved
+                if not follows or h.agrees(p, sensation, feel):
+                    kept[0].append(c)
+                    kept[1].append(p)
+                    kept[2].append(follows)
+            ids, position, tracked = kept
+            if sensation:
+                at_landmark = True
+                break
+            if h.feels and taken >= LOCATED_STEPS and len(ids) == 1 and tracked[0]:
+                self.belief = position[0]
+                self.beliefs[-1] = self.belief
+                return {ids[0]}, {ids[0]}, False, ids[0]
+        survivors = {c for c, follows in zip(ids, tracked, strict=True) if follows}
+        return (survivors if at_landmark else set()), set(ids), at_landmark, None
 
     def record(self, q: int, a: int, label: bool, feel: float, start: int) -> None:
         """Keep the test from ``q -a->`` made since step ``start``: actions, sensations (and
