@@ -734,3 +734,13 @@ def test_a_test_takes_the_same_steps_with_arrays_or_one_candidate_at_a_time(
              runner.rng.random(), sorted(runner.model.transitions()))
         )  # fmt: skip
     assert runs[0] == runs[1] == runs[2]
+
+
+def test_a_permutation_of_one_or_none_draws_nothing_from_the_generator() -> None:
+    # The learner's votes skip the generator's permutation for one candidate or none: the
+    # run's draws are the same only because such a permutation draws nothing.
+    for among in ([], [5]):
+        rng = np.random.default_rng(7)
+        before = rng.bit_generator.state
+        assert rng.permutation(among).tolist() == among
+        assert rng.bit_generator.state == before

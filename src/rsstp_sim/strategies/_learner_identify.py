@@ -219,6 +219,8 @@ class Identifier(Walker):
                 y = int(h.next[r, kb])
                 if y in candidates:
                     votes[y] = votes.get(y, 0) + 1
+        if len(votes) < 2:  # (a permutation of one draws nothing from the generator)
+            return list(votes)
         tie = {c: i for i, c in enumerate(self.agent.rng.permutation(sorted(votes)).tolist())}
         return sorted(votes, key=lambda c: (-votes[c], tie[c]))
 
