@@ -32,9 +32,10 @@ class Learning(Identifier):
         self.done = False
         self._checked = np.zeros((0, len(self.h.actions)), dtype=bool)
         self._checked_version = -1
-        self._doubtful: tuple[tuple[int, int, int], NDArray[np.bool_], set[int]] | None = None
+        self._doubtful: tuple[tuple[int, int, int], NDArray[np.bool_], NDArray[np.bool_]] | None
+        self._doubtful = None
         """What :meth:`suspect` found: for the (model version, edits, rows) then, the doubtful
-        pairs and the states they are of, kept up to date as pairs are retested."""
+        pairs and the states they are of (a mask), kept up to date as pairs are retested."""
         self._settled = -1
         """The hypothesis's :attr:`~Hypothesis.edits` when it was last found complete, with
         every state reachable and none to merge."""
@@ -261,7 +262,7 @@ class Learning(Identifier):
             singled_out = self.singled_out(todo)
             checked |= todo & singled_out
             doubtful = todo & ~singled_out
-            states = set(np.flatnonzero(doubtful.any(axis=1)).tolist())
+            states = doubtful.any(axis=1)
             self._doubtful = (key, doubtful, states)
         else:  # (only the pairs retested since can have changed)
             _, doubtful, states = self._doubtful
@@ -272,14 +273,11 @@ class Learning(Identifier):
                 singled = todo and self.single(q, k, n)
                 checked[q, k] |= singled
                 doubtful[q, k] = todo and not singled
-                if doubtful[q].any():
-                    states.add(q)
-                else:
-                    states.discard(q)
+                states[q] = doubtful[q].any()
         self.retested.clear()
-        if not states:
+        if not states.any():
             return None
-        nearest = h.nearest(self.belief, states)
+        nearest = h.nearest_where(self.belief, states)
         if nearest is None:
             return None
         s = nearest[1]
