@@ -157,6 +157,21 @@ class Memory:
             raise MemoryRangeError("last_state of an empty memory: there is no entry yet")
         return int(self._states[self._length - 1])
 
+    @property
+    def last_sensation(self) -> bool:
+        """The sensation of the last entry (a strategy reads it after every step: no view)."""
+        if self._length == 0:
+            raise MemoryRangeError("last_sensation of an empty memory: there is no entry yet")
+        return bool(self._sensations[self._length - 1])
+
+    @property
+    def last_feedback(self) -> float:
+        """The float feedback of the last entry (a strategy reads it after every step: no
+        view)."""
+        if self._length == 0:
+            raise MemoryRangeError("last_feedback of an empty memory: there is no entry yet")
+        return float(self._feedback[self._length - 1])
+
     def _make_room(self) -> None:
         if self._length == 0:
             raise MemoryRangeError("append before reset: entry 0 must be written by reset()")

@@ -483,17 +483,19 @@ def test_paths_are_the_first_shortest_words_a_breadth_first_search_finds(
     h._changed()
     wanted = np.zeros(n, dtype=bool)
     wanted[list(goals)] = True
-    assert h.nearest_where(source, wanted) == _first_shortest_word(
-        successors, order, actions, source, goals
-    )
-    assert h.nearest(source, goals) == _first_shortest_word(
-        successors, order, actions, source, goals
-    )
-    home = _first_shortest_word(successors, order, actions, source, {0})
-    assert h.path(source, 0) == (None if home is None else home[0])
-    for goal in goals:
-        found = _first_shortest_word(successors, order, actions, source, {goal})
-        assert h.path(source, goal) == (None if found is None else found[0])
+    for near_states in (1024, 2, 0):  # one state at a time, then a level at a time, or both
+        h.near_states = near_states
+        assert h.nearest_where(source, wanted) == _first_shortest_word(
+            successors, order, actions, source, goals
+        )
+        assert h.nearest(source, goals) == _first_shortest_word(
+            successors, order, actions, source, goals
+        )
+        home = _first_shortest_word(successors, order, actions, source, {0})
+        assert h.path(source, 0) == (None if home is None else home[0])
+        for goal in goals:
+            found = _first_shortest_word(successors, order, actions, source, {goal})
+            assert h.path(source, goal) == (None if found is None else found[0])
 
 
 def _separating_word_pair_by_pair(
@@ -709,3 +711,36 @@ def test_a_wrong_transition_is_refuted_found_and_repaired(name: str) -> None:
     assert learning.stats.get("counterexamples", 0) >= 1
     assert learner.done
     assert_minimal_and_equivalent(learner, runner.model, truth)
+
+
+@pytest.mark.parametrize("mode", ["bool", "float"])
+def test_a_test_takes_the_same_steps_with_arrays_or_one_candidate_at_a_time(
+    mode: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # A test follows many candidates with numpy arrays and few (FEW or fewer) one at a time;
+    # either way the same steps, the same draws of the generator, the same model.
+    import rsstp_sim.strategies._learner_identify as identify
+
+    scenario = load_scenario("two-joint-30")
+    if mode == "float":
+        scenario = float_twin(scenario)
+    runs = []
+    for few in (0, identify.FEW, 1_000_000):
+        monkeypatch.setattr(identify, "FEW", few)
+        learner, runner = learn(scenario, 20_000, seed=4)
+        assert learner.done
+        runs.append(
+            (runner.memory.actions.tolist(), runner.memory.internal_states.tolist(),
+             runner.rng.random(), sorted(runner.model.transitions()))
+        )  # fmt: skip
+    assert runs[0] == runs[1] == runs[2]
+
+
+def test_a_permutation_of_one_or_none_draws_nothing_from_the_generator() -> None:
+    # The learner's votes skip the generator's permutation for one candidate or none: the
+    # run's draws are the same only because such a permutation draws nothing.
+    for among in ([], [5]):
+        rng = np.random.default_rng(7)
+        before = rng.bit_generator.state
+        assert rng.permutation(among).tolist() == among
+        assert rng.bit_generator.state == before

@@ -63,6 +63,18 @@ def test_reset_and_append() -> None:
     assert type(entry.sensation) is bool and type(entry.feedback) is float
 
 
+def test_last_entry_without_a_view() -> None:
+    memory = Memory(capacity=1)
+    for name in ("last_state", "last_sensation", "last_feedback"):
+        with pytest.raises(MemoryRangeError, match=f"{name} of an empty memory"):
+            getattr(memory, name)
+    memory.reset(7, True, 0.25)
+    assert (memory.last_state, memory.last_sensation, memory.last_feedback) == (7, True, 0.25)
+    memory.append(3, 8, False, 0.5)  # (past the capacity: the buffers grew)
+    assert (memory.last_state, memory.last_sensation, memory.last_feedback) == (8, False, 0.5)
+    assert type(memory.last_sensation) is bool and type(memory.last_feedback) is float
+
+
 def test_column_dtypes() -> None:
     memory = build([(1, 2, True)])
     assert memory.actions.dtype == np.int32

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from rsstp_sim.moore import moore_classes
+from rsstp_sim.strategies._learner_incoming import Incoming
 from rsstp_sim.transition_system import TransitionSystem
 
 __all__ = ["FAR", "Hypothesis"]
@@ -33,6 +34,13 @@ FAR = np.iinfo(np.int64).max // 4
 EVIDENCE = 4
 """The confirmed moves by an action, from states known whole, that :meth:`Hypothesis.irreversible`
 needs before it finds that no action undoes it."""
+
+
+class _TooFar:
+    """:meth:`Hypothesis._search_near` met too many states: search a level at a time."""
+
+
+_TOO_FAR = _TooFar()
 
 
 class Hypothesis:
@@ -80,10 +88,19 @@ class Hypothesis:
         self.feel: FloatArray = np.full(capacity, np.nan)
         self.also_felt: dict[int, set[float]] = {}
         self._merged: BoolArray = np.zeros(capacity, dtype=bool)
+        self._by_feel: dict[float, set[int]] = {}
+        """With ``feels``: the states that agree with a feel, by feel (their own, and those of
+        the states merged into them), the states whose feel is unknown aside (``_unfelt``)."""
+        self._unfelt: set[int] = set()
+        self._feel_keys: dict[int, tuple[float, ...]] = {}
         self.labels: dict[int, bool] = {}
         self.access: dict[int, tuple[int, ...]] = {}
+        self.incoming = Incoming(len(actions), capacity)
+        """Who leads to each state, the counts behind :meth:`inverses`, the open actions."""
         for s in model.states:
             self.alive[s] = True
+            self.incoming.open_row(s, self.next[s])
+            self._refelt(s)
             self.labels[s] = s == landmark
             self.label[s] = s == landmark
             self.access[s] = ()
@@ -94,6 +111,8 @@ class Hypothesis:
         self._edits = 0
         self._inverse: tuple[int, dict[int, int]] = (-1, {})
         self._matched: tuple[tuple[int, bool], IntArray] = ((-1, False), np.zeros(0, np.int64))
+        self.near_states = 1024
+        """How many states a search meets one at a time before it goes a level at a time."""
 
     # ----------------------------------------------------------------- queries
 
@@ -130,9 +149,10 @@ class Hypothesis:
         if self.feels:
             felt = self.feel[states]
             alike = np.isnan(felt) | (felt == feel)
-            other = np.flatnonzero(self._merged[states] & ~alike)
-            for i in other.tolist():
-                alike[i] = feel in self.also_felt[int(states[i])]
+            if self.also_felt:  # (a merged state is also felt as the states merged into it)
+                other = np.flatnonzero(self._merged[states] & ~alike)
+                for i in other.tolist():
+                    alike[i] = feel in self.also_felt[int(states[i])]
             same &= alike
         return same
 
@@ -158,12 +178,34 @@ class Hypothesis:
         key = (self._edits, sensation)
         if not self.feels and self._matched[0] == key:
             return self._matched[1]
+        if self.feels and feel == feel:  # (the states felt so, and those never felt)
+            felt = self._by_feel.get(feel, set()) | self._unfelt
+            ids = np.fromiter(sorted(felt), dtype=np.int64, count=len(felt))
+            agreeing: IntArray = ids[self.label[ids] == sensation]
+            agreeing.flags.writeable = False
+            return agreeing
         states = np.flatnonzero(self.alive)
         found = states[self.agree(states, sensation, feel)]
         found.flags.writeable = False
         if not self.feels:
             self._matched = (key, found)
         return found
+
+    def follow(self, states: IntArray, action: int, sensation: bool, feel: float) -> IntArray:
+        """The confirmed successors by ``action`` of ``states`` that agree with what was then
+        sensed and felt (:meth:`agree`), in the order of ``states`` (repeats kept)."""
+        moved: IntArray = self.next[:, self.column[action]][states]
+        if not self.feels:  # (label[-1], read for an unconfirmed successor, is masked out)
+            keep = self.label[moved]
+            if sensation:
+                keep &= moved >= 0
+            else:
+                keep |= moved < 0
+                np.logical_not(keep, out=keep)
+            return moved[keep]
+        keep = moved >= 0
+        keep[keep] = self.agree(moved[keep], sensation, feel)
+        return moved[keep]
 
     def step(
         self, start: IntArray, position: IntArray, action: int, via: tuple[int, int]
@@ -190,8 +232,7 @@ class Hypothesis:
         label) and ``feels`` (with :attr:`feels`), if ``via`` leads to ``c`` (see
         :meth:`step`)."""
         felt = feels if self.feels and feels else (0.0,) * len(outputs)
-        start = np.flatnonzero(self.alive)
-        start = start[self.agree(start, outputs[0], felt[0])]
+        start = self.matching_ids(outputs[0], felt[0])
         position = start.copy()
         for action, sensation, feel in zip(word, outputs[1:], felt[1:], strict=True):
             moved = self.step(start, position, action, via)
@@ -199,6 +240,32 @@ class Hypothesis:
             keep[keep] = self.agree(moved[keep], sensation, feel)
             start, position = start[keep], moved[keep]
         return [int(s) for s in start]
+
+    def set_feel(self, s: int, feel: float) -> None:
+        """What is felt at the world state ``s`` stands for (first felt now)."""
+        self.feel[s] = feel
+        self._refelt(s)
+
+    def _refelt(self, s: int) -> None:
+        """State ``s``'s feels changed (or it came or went): index it anew."""
+        if not self.feels:
+            return
+        for key in self._feel_keys.pop(s, ()):
+            states = self._by_feel[key]
+            states.discard(s)
+            if not states:
+                del self._by_feel[key]
+        self._unfelt.discard(s)
+        if not self.alive[s]:
+            return
+        felt = float(self.feel[s])
+        if felt != felt:
+            self._unfelt.add(s)
+            return
+        keys = {felt, *self.also_felt.get(s, ())} if self._merged[s] else {felt}
+        self._feel_keys[s] = tuple(keys)
+        for key in keys:
+            self._by_feel.setdefault(key, set()).add(s)
 
     def is_complete(self) -> bool:
         return self.unconfirmed == 0
@@ -231,12 +298,20 @@ class Hypothesis:
             self._aim(np.flatnonzero(distance < FAR))
         return self._distance, self._toward
 
-    def _aim(self, states: IntArray) -> None:
+    def _aim(self, states: IntArray | list[int]) -> None:
         """``toward`` of ``states`` from the distances: the first action, in the run's order,
         to a successor one step nearer the landmark (-1 at the landmark and out of reach)."""
         distance, toward = self._distance, self._toward
         assert distance is not None and toward is not None
         if not len(states):
+            return
+        if len(states) <= 16:  # (a few states, one at a time: a confirmation's)
+            for x in states:
+                nearer = int(distance[x]) - 1
+                row = self.next[x].tolist()
+                toward[x] = next(
+                    (k for k in self._columns if row[k] >= 0 and distance[row[k]] == nearer), -1
+                )
             return
         successors = self.next[states][:, self._columns]
         ahead = np.where(successors >= 0, distance[np.maximum(successors, 0)], FAR)
@@ -251,31 +326,29 @@ class Hypothesis:
         if distance is None:
             return
         if distance[t] + 1 >= distance[s]:
-            self._aim(np.asarray([s], dtype=np.int64))
+            self._aim([s])
             return
         distance[s] = distance[t] + 1
-        changed = [s]
-        frontier = np.asarray([s], dtype=np.int64)
-        while len(frontier):
-            into = np.zeros(len(distance), dtype=bool)
-            into[frontier] = True
-            confirmed = self.next >= 0
-            sources, columns = np.nonzero(confirmed & into[np.maximum(self.next, 0)])
-            better = distance[self.next[sources, columns]] + 1
-            order = np.lexsort((better, sources))
-            sources, better = sources[order], better[order]
-            keep = np.ones(len(sources), dtype=bool)
-            keep[1:] = sources[1:] != sources[:-1]  # the least distance per source
-            sources, better = sources[keep], better[keep]
-            shorter = better < distance[sources]
-            frontier = sources[shorter]
-            distance[frontier] = better[shorter]
-            changed.extend(frontier.tolist())
-        touched = np.asarray(changed, dtype=np.int64)
-        into = np.zeros(len(distance), dtype=bool)
-        into[touched] = True
-        before = np.flatnonzero(((self.next >= 0) & into[np.maximum(self.next, 0)]).any(axis=1))
-        self._aim(np.union1d(touched, before))
+        # Spread the shorter way back along the confirmed transitions into the states it
+        # shortened, a level at a time; then aim again every state whose distance or whose
+        # successor's distance changed.
+        incoming = self.incoming
+        changed = {s}
+        frontier = [s]
+        while frontier:
+            level: list[int] = []
+            for u in frontier:
+                shorter = int(distance[u]) + 1
+                for p, _ in incoming.predecessors(u):
+                    if shorter < distance[p]:
+                        distance[p] = shorter
+                        level.append(p)
+            frontier = level
+            changed.update(level)
+        aimed = set(changed)
+        for u in changed:
+            aimed.update(p for p, _ in incoming.predecessors(u))
+        self._aim(sorted(aimed))
 
     @property
     def distance(self) -> IntArray:
@@ -329,12 +402,17 @@ class Hypothesis:
         """Breadth first over the confirmed transitions, the actions in the run's order: the
         word to the first state reached that is ``wanted``, and that state.
 
-        One numpy pass per distance from ``source``: each level's successors in the order a
+        A first-in first-out search, state by state, while it has met at most
+        :attr:`near_states` states (the goal is most often a few steps away); past that, one
+        numpy pass per distance from ``source``: each level's successors in the order the
         first-in first-out search meets them (state by state in the level's order, action by
         action), each state kept where it is first met; so the state found, and its word, are
-        those of the one-state-at-a-time search."""
+        the same either way."""
         if wanted[source]:
             return [], source
+        near = self._search_near(source, wanted)
+        if not isinstance(near, _TooFar):
+            return near
         width = len(self.actions)
         columns = np.asarray(self._columns, dtype=np.int64)
         seen = np.zeros(len(self.label), dtype=bool)
@@ -362,6 +440,33 @@ class Hypothesis:
                 return word, found
         return None
 
+    def _search_near(
+        self, source: int, wanted: BoolArray
+    ) -> tuple[list[int], int] | None | _TooFar:
+        """:meth:`_search` one state at a time; :data:`_TOO_FAR` once it has met more than
+        :attr:`near_states` states."""
+        next_, columns, limit = self.next, self._columns, self.near_states
+        parent: dict[int, tuple[int, int]] = {source: (source, -1)}
+        queue = [source]
+        for s in queue:
+            row = next_[s].tolist()
+            for i, k in enumerate(columns):
+                t = row[k]
+                if t < 0 or t in parent:
+                    continue
+                parent[t] = (s, i)
+                if wanted[t]:
+                    found, word = t, []
+                    while t != source:
+                        t, i = parent[t]
+                        word.append(self._ordered[i])
+                    word.reverse()
+                    return word, found
+                queue.append(t)
+            if len(queue) > limit:
+                return _TOO_FAR
+        return None
+
     def around(self, source: int, radius: int) -> set[int]:
         """The states within ``radius`` confirmed transitions of ``source``, either way."""
         sources, columns = np.nonzero(self.next >= 0)
@@ -380,21 +485,17 @@ class Hypothesis:
 
         ``b`` undoes ``a`` when, of the confirmed ``s -a-> t`` (``t != s``) with a confirmed
         ``t -b->``, most have ``t -b-> s``: learned from the agent's own experience, used to
-        guess, never to conclude. (Worked out again after each change of the hypothesis.)
+        guess, never to conclude. (Read from the counts :attr:`incoming` keeps, after each
+        change of the hypothesis.)
         """
         if self._inverse[0] == self._edits:
             return self._inverse[1]
-        states = np.flatnonzero(self.alive)
         inverse: dict[int, int] = {}
+        back, known = self.incoming.back, self.incoming.known
         for ka, a in enumerate(self.actions):
-            t = self.next[states, ka]
-            moved = (t >= 0) & (t != states)
-            sources, targets = states[moved], t[moved]
             best, best_count = -1, 0
-            for kb in range(len(self.actions)):
-                back = self.next[targets, kb]
-                count = int(np.count_nonzero(back == sources))
-                if count > best_count and 2 * count >= np.count_nonzero(back >= 0):
+            for kb, count in enumerate(back[ka]):
+                if count > best_count and 2 * count >= known[ka][kb]:
                     best, best_count = kb, count
             if best >= 0:
                 inverse[a] = self.actions[best]
@@ -506,7 +607,7 @@ class Hypothesis:
             self._edits += 1
         if before < 0:
             self.unconfirmed -= 1
-        self.next[s, k] = t
+        self.incoming.set(self.next, s, k, t)
         old = self.target(s, action)
         if old != t:
             self.model.delete(s, old, action)
@@ -522,7 +623,7 @@ class Hypothesis:
         if self.next[s, k] >= 0:
             self._edits += 1
             self.unconfirmed += 1
-            self.next[s, k] = -1
+            self.incoming.set(self.next, s, k, -1)
             self._changed()
 
     def create(
@@ -557,14 +658,17 @@ class Hypothesis:
         self.label[new] = sensation
         self.labels[new] = sensation
         self.feel[new] = feel
+        self._refelt(new)
         self.access[new] = access
-        self.next[new] = -1
+        for column in range(len(self.actions)):
+            self.incoming.set(self.next, new, column, -1)
+        self.incoming.open_row(new, self.next[new])
         self.unconfirmed += len(self.actions)
         k = self.column[action]
         before = int(self.next[s, k])
         if before < 0:
             self.unconfirmed -= 1
-        self.next[s, k] = new
+        self.incoming.set(self.next, s, k, new)
         if before >= 0:
             self._changed()
         return new
@@ -585,9 +689,12 @@ class Hypothesis:
         self.alive[new] = True
         self.label[new] = False
         self.feel[new] = np.nan
+        self._refelt(new)
         self.labels[new] = False
         self.access[new] = ()
-        self.next[new] = new
+        for column in range(len(self.actions)):
+            self.incoming.set(self.next, new, column, new)
+        self.incoming.open_row(new, self.next[new])
         return new
 
     def merge(self, keep: int, gone: int) -> None:
@@ -603,9 +710,15 @@ class Hypothesis:
             self._merged[keep] = True
         self._merged[gone] = False
         self.unconfirmed -= int(np.count_nonzero(self.next[gone] < 0))
-        self.next[gone] = -1
-        self.next[self.next == gone] = keep
+        incoming = self.incoming
+        for column in range(len(self.actions)):
+            incoming.set(self.next, gone, column, -1)
+        for u, column in incoming.predecessors(gone):
+            incoming.set(self.next, u, column, keep)
+        incoming.close_row(gone)
         self.alive[gone] = False
+        self._refelt(gone)
+        self._refelt(keep)
         del self.labels[gone]
         del self.access[gone]
         if self.landmark == gone:
@@ -637,6 +750,7 @@ class Hypothesis:
             self._distance = np.concatenate([self._distance, np.full(size - capacity, FAR)])
             self._toward = np.concatenate([self._toward, np.full(size - capacity, -1)])
         self.feel = np.concatenate([self.feel, np.full(size - capacity, np.nan)])
+        self.incoming.grow(size)
         self._merged = np.concatenate([self._merged, np.zeros(size - capacity, dtype=bool)])
 
     def minimise(self) -> list[tuple[int, int]]:

@@ -11,6 +11,7 @@ from collections.abc import Generator
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import NDArray
 
 from rsstp_sim.strategies._base import AgentView
 from rsstp_sim.strategies._learner_hypothesis import FAR, BoolArray
@@ -21,6 +22,10 @@ __all__ = ["Deferral", "Identifier", "Trace"]
 Trace = tuple[tuple[int, ...], tuple[bool, ...], tuple[float, ...]]
 """A test: its actions, the sensations before the first and after each action, and the
 float feedback felt there (empty when the agent has none)."""
+
+FEW = 24
+"""A test follows this many candidates or fewer one at a time (:meth:`Identifier.session`):
+fewer steps of Python than the arrays' fixed cost."""
 
 LOCATED_STEPS = 2
 """With float feedback, a test ends when one candidate is left and it has agreed with what
@@ -56,6 +61,9 @@ class Identifier(Walker):
         self.deferred: dict[tuple[int, int], Deferral] = {}
         self._singles = np.zeros((0, len(self.h.actions)), dtype=np.int8)
         self._singles_edits = -1
+        self.retested: set[tuple[int, int]] = set()
+        """The (state, action column) pairs whose tests changed since the verification last
+        looked (:meth:`Learning.suspect <rsstp_sim.strategies._learner_plan.Learning.suspect>`)."""
 
     def confirm(self, q: int, a: int, t: int) -> None:
         self.deferred.pop((q, a), None)
@@ -205,13 +213,14 @@ class Identifier(Walker):
                 if h.next[c, k] == q:
                     votes[c] = votes.get(c, 0) + 2
         column = h.column[a]
-        sources, columns = np.nonzero(h.next == q)
-        for p, kb in zip(sources.tolist(), columns.tolist(), strict=True):
+        for p, kb in h.incoming.predecessors(q):
             r = int(h.next[p, column])
             if r >= 0:
                 y = int(h.next[r, kb])
                 if y in candidates:
                     votes[y] = votes.get(y, 0) + 1
+        if len(votes) < 2:  # (a permutation of one draws nothing from the generator)
+            return list(votes)
         tie = {c: i for i, c in enumerate(self.agent.rng.permutation(sorted(votes)).tolist())}
         return sorted(votes, key=lambda c: (-votes[c], tie[c]))
 
@@ -244,6 +253,13 @@ class Identifier(Walker):
         at_landmark = False
         taken = 0
         while len(ids) or script:
+            if len(ids) <= FEW:
+                return (
+                    yield from self._session_few(
+                        via, ids.tolist(), position.tolist(), tracked.tolist(), chosen, script,
+                        follow=follow, taken=taken,
+                    )
+                )  # fmt: skip
             if script:
                 action = script.pop(0)
             elif not follow:
@@ -285,6 +301,74 @@ class Identifier(Walker):
         survivors = {int(s) for s in ids[tracked]} if at_landmark else set()
         return survivors, {int(s) for s in ids}, at_landmark, None
 
+    def _session_few(
+        self,
+        via: tuple[int, int],
+        ids: list[int],
+        position: list[int],
+        tracked: list[bool],
+        chosen: int | None,
+        script: list[int],
+        *,
+        follow: bool,
+        taken: int,
+    ) -> Generator[int, bool, tuple[set[int], set[int], bool, int | None]]:
+        """:meth:`session` on from where it is, with :data:`FEW` candidates or fewer: one at a
+        time, in lists (``ids[i]`` followed from ``position[i]``, ruled out when it disagrees
+        while ``tracked[i]``), the same steps as the arrays take."""
+        h = self.h
+        at_landmark = False
+        while ids or script:
+            if script:
+                action = script.pop(0)
+            elif not follow:
+                break
+            else:
+                distance = h.distance
+                index = -1
+                if chosen is not None and chosen in ids:
+                    i = ids.index(chosen)
+                    if tracked[i] and distance[position[i]] < FAR:
+                        index = i
+                if index < 0:
+                    usable = [i for i, t in enumerate(tracked) if t and distance[position[i]] < FAR]
+                    if not usable:
+                        break
+                    least = min(int(distance[position[i]]) for i in usable)
+                    index = self.pick([i for i in usable if distance[position[i]] == least])
+                    chosen = ids[index]
+                action = h.actions[int(h.toward[position[index]])]
+                if position[index] == via[0] and action == via[1]:
+                    tracked[index] = False  # (it would go round for ever: see session)
+                    continue
+            sensation = yield from self.move(action)
+            taken += 1
+            feel = self.feel()
+            column = h.next[:, h.column[action]]
+            back = action == via[1]  # (from via's state, a candidate goes back to itself)
+            kept: tuple[list[int], list[int], list[bool]] = ([], [], [])
+            for c, p, follows in zip(ids, position, tracked, strict=True):
+                if follows:
+                    moved = c if back and p == via[0] else int(column[p])
+                    if moved < 0:
+                        follows = False
+                    else:
+                        p = moved
+                if not follows or h.agrees(p, sensation, feel):
+                    kept[0].append(c)
+                    kept[1].append(p)
+                    kept[2].append(follows)
+            ids, position, tracked = kept
+            if sensation:
+                at_landmark = True
+                break
+            if h.feels and taken >= LOCATED_STEPS and len(ids) == 1 and tracked[0]:
+                self.belief = position[0]
+                self.beliefs[-1] = self.belief
+                return {ids[0]}, {ids[0]}, False, ids[0]
+        survivors = {c for c, follows in zip(ids, tracked, strict=True) if follows}
+        return (survivors if at_landmark else set()), set(ids), at_landmark, None
+
     def record(self, q: int, a: int, label: bool, feel: float, start: int) -> None:
         """Keep the test from ``q -a->`` made since step ``start``: actions, sensations (and
         what was felt, with float feedback)."""
@@ -303,8 +387,10 @@ class Identifier(Walker):
         return self.traces.pop((q, a), [])
 
     def _retest(self, q: int, a: int) -> None:
+        k = self.h.column[a]
+        self.retested.add((q, k))
         if q < len(self._singles):
-            self._singles[q, self.h.column[a]] = -1
+            self._singles[q, k] = -1
 
     def singled_out(self, wanted: BoolArray) -> BoolArray:
         """For the (state, action column) pairs ``wanted`` (rows: state ids): whether the tests
@@ -313,22 +399,38 @@ class Identifier(Walker):
 
         Each pair is replayed once while the hypothesis's confirmed successors (its
         :attr:`~Hypothesis.edits`) and the pair's tests stay as they are."""
+        singles = self._singles_for(len(wanted))
+        rows, columns = np.nonzero(wanted & (singles < 0))
+        for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
+            self._replay(s, k)
+        single: BoolArray = wanted & (singles == 1)
+        return single
+
+    def single(self, s: int, k: int, n: int) -> bool:
+        """:meth:`singled_out` for the one pair ``(s, k)`` (``s < n``, the rows wanted)."""
+        singles = self._singles_for(n)
+        if singles[s, k] < 0:
+            self._replay(s, k)
+        return bool(singles[s, k] == 1)
+
+    def _singles_for(self, n: int) -> NDArray[np.int8]:
+        """The pairs of states ``0 .. n-1`` replayed (1: singled out, 0: not, -1: not yet), as
+        long as the :attr:`~Hypothesis.edits` stay the same."""
         h = self.h
-        n = len(wanted)
         if self._singles_edits != h.edits or len(self._singles) < n:
             self._singles = np.full((n, len(h.actions)), -1, dtype=np.int8)
             self._singles_edits = h.edits
-        singles = self._singles[:n]
-        rows, columns = np.nonzero(wanted & (singles < 0))
-        for s, k in zip(rows.tolist(), columns.tolist(), strict=True):
-            a = h.actions[k]
-            agreeing: set[int] | None = None
-            for word, outputs, felt in self.traces.get((s, a), ()):
-                found = set(h.consistent(word, outputs, (s, a), felt))
-                agreeing = found if agreeing is None else agreeing & found
-            singles[s, k] = agreeing == {int(h.next[s, k])}
-        single: BoolArray = wanted & (singles == 1)
-        return single
+        return self._singles[:n]
+
+    def _replay(self, s: int, k: int) -> None:
+        """Replay the tests kept for ``(s, k)``: whether they single out its successor."""
+        h = self.h
+        a = h.actions[k]
+        agreeing: set[int] | None = None
+        for word, outputs, felt in self.traces.get((s, a), ()):
+            found = set(h.consistent(word, outputs, (s, a), felt))
+            agreeing = found if agreeing is None else agreeing & found
+        self._singles[s, k] = agreeing == {int(h.next[s, k])}
 
     def return_to(
         self, q: int, a: int, route: tuple[int, ...] | None

@@ -32,6 +32,10 @@ class Learning(Identifier):
         self.done = False
         self._checked = np.zeros((0, len(self.h.actions)), dtype=bool)
         self._checked_version = -1
+        self._doubtful: tuple[tuple[int, int, int], NDArray[np.bool_], NDArray[np.bool_]] | None
+        self._doubtful = None
+        """What :meth:`suspect` found: for the (model version, edits, rows) then, the doubtful
+        pairs and the states they are of (a mask), kept up to date as pairs are retested."""
         self._settled = -1
         """The hypothesis's :attr:`~Hypothesis.edits` when it was last found complete, with
         every state reachable and none to merge."""
@@ -139,20 +143,27 @@ class Learning(Identifier):
         belief = self.belief
         assert belief is not None
         distance = h.distance
-        open_mask = h.alive[:, None] & (h.next < 0)
+        put_off: dict[int, set[int]] = {}  # the open columns of a state put off, by state
         for (s, a), deferred in self.deferred.items():
             # Put off until the model changed and a candidate can be tested.
             if deferred.version == h.version or not any(
                 u not in h.labels or distance[u] < FAR for u in deferred.candidates
             ):
-                open_mask[s, h.column[a]] = False
-        wanted: NDArray[np.bool_] = np.asarray(open_mask.any(axis=1), dtype=bool)
+                if h.alive[s] and h.next[s, h.column[a]] < 0:
+                    put_off.setdefault(s, set()).add(h.column[a])
+        open_count = h.incoming.open
+        wanted: NDArray[np.bool_] = open_count > 0
+        for s, columns in put_off.items():
+            if len(columns) == open_count[s]:
+                wanted[s] = False
         if not wanted.any():
             return None
         actions_of = h.actions
 
         def open_actions(s: int) -> list[int]:
-            return [actions_of[k] for k in np.flatnonzero(open_mask[s]).tolist()]
+            shut = put_off.get(s, ())
+            row = h.next[s].tolist()
+            return [actions_of[k] for k, t in enumerate(row) if t < 0 and k not in shut]
 
         inverse = h.inverses()
 
@@ -225,6 +236,7 @@ class Learning(Identifier):
             if traces and keep is not None:  # (the merge changed the edits: all are replayed)
                 self.traces.setdefault((keep, a), []).extend(traces)
         self._checked[:] = False
+        self._doubtful = None
 
     # ------------------------------------------------------------- verification
 
@@ -244,14 +256,28 @@ class Learning(Identifier):
             self._checked[:] = False
             self._checked_version = h.version
         checked = self._checked_for(n)
-        todo = h.alive[:n, None] & (h.next[:n] != h.landmark) & ~checked
-        singled_out = self.singled_out(todo)
-        checked |= todo & singled_out
-        doubtful = todo & ~singled_out
-        states = np.flatnonzero(doubtful.any(axis=1))
-        if not len(states):
+        key = (h.version, h.edits, n)
+        if self._doubtful is None or self._doubtful[0] != key:
+            todo = h.alive[:n, None] & (h.next[:n] != h.landmark) & ~checked
+            singled_out = self.singled_out(todo)
+            checked |= todo & singled_out
+            doubtful = todo & ~singled_out
+            states = doubtful.any(axis=1)
+            self._doubtful = (key, doubtful, states)
+        else:  # (only the pairs retested since can have changed)
+            _, doubtful, states = self._doubtful
+            for q, k in self.retested:
+                if q >= n:
+                    continue
+                todo = bool(h.alive[q]) and h.next[q, k] != h.landmark and not checked[q, k]
+                singled = todo and self.single(q, k, n)
+                checked[q, k] |= singled
+                doubtful[q, k] = todo and not singled
+                states[q] = doubtful[q].any()
+        self.retested.clear()
+        if not states.any():
             return None
-        nearest = h.nearest(self.belief, set(states.tolist()))
+        nearest = h.nearest_where(self.belief, states)
         if nearest is None:
             return None
         s = nearest[1]
@@ -276,6 +302,7 @@ class Learning(Identifier):
             self.agent.note(f"verification: state {q} by action {a} leads elsewhere")
         self._checked_for(len(h.label))[q, h.column[a]] = True
         self._checked_version = h.version
+        self.retested.add((q, h.column[a]))
 
     def _checked_for(self, n: int) -> NDArray[np.bool_]:
         """The checked transitions of states ``0 .. n-1``, by action column."""
@@ -380,8 +407,7 @@ class Learning(Identifier):
         actions = memory.actions[1 : first + 1].tolist()
         sensations = memory.sensations[: first + 1].tolist()
         felt = memory.feedback[: first + 1].tolist() if h.feels else [0.0] * (first + 1)
-        candidates = np.flatnonzero(h.alive)
-        candidates = candidates[h.agree(candidates, sensations[0], felt[0])]
+        candidates = h.matching_ids(sensations[0], felt[0])
         position = candidates.copy()
         for action, sensation, feel in zip(actions, sensations[1:], felt[1:], strict=True):
             position = h.next[position, h.column[action]]

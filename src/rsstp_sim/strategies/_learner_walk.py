@@ -45,6 +45,9 @@ PHASES = {
 (telling where a transition led: tests, returns, counterexamples, verification), *done*
 (walking the finished model, with ``stop=False``)."""
 
+_STEPS = {phase: f"steps_{phase}" for phase in PHASES}
+"""The step counter of each phase (made once: :meth:`Walker.move` counts every step)."""
+
 CONFINED_STEPS = 16_384
 """The shortest search for the landmark after which the agent may conclude it is confined (a
 world of a thousand classes, lost early, can take thousands of steps to find it again)."""
@@ -122,15 +125,18 @@ class Walker:
 
     def feel(self) -> float:
         """The float feedback felt now (0.0 when the agent has none)."""
-        return float(self.agent.memory.feedback[-1]) if self.h.feels else 0.0
+        return self.agent.memory.last_feedback if self.h.feels else 0.0
 
     def move(self, action: int, *, check: bool = False) -> Generator[int, bool, bool]:
         """Take ``action``; follow the belief. With ``check``, a wrong prediction of a
         confirmed transition raises :class:`Refuted` (else the agent is just lost)."""
         sensation = yield action
-        self.count(f"steps_{self.phase}")
-        self.agent.enter(PHASES[self.phase])
-        feel = self.feel()
+        phase, stats, agent = self.phase, self.stats, self.agent
+        key = _STEPS[phase]
+        stats[key] = stats.get(key, 0) + 1
+        if agent.phase != PHASES[phase]:
+            agent.enter(PHASES[phase])
+        feel = agent.memory.last_feedback if self.h.feels else 0.0
         self.word.append(action)
         self.trace.append(sensation)
         self.felt.append(feel)
@@ -160,7 +166,7 @@ class Walker:
         self.last_seen = self.agent.step
         self.seen = True
         if h.feels and np.isnan(h.feel[h.landmark]):
-            h.feel[h.landmark] = self.feel()
+            h.set_feel(h.landmark, self.feel())
         self.word.clear()
         self.trace.clear()
         self.felt.clear()
@@ -225,12 +231,16 @@ class Walker:
             ids = h.matching_ids(sensation, feel)
         failed = wander = 0
         while True:
-            usable = np.flatnonzero(h.distance[ids] < FAR)
+            usable = -1  # (the first candidate with a path to the landmark, when one is wanted)
+            if wander <= 0 and self._run_left <= 0 and len(ids):
+                homeward = h.distance[ids] < FAR
+                first = int(homeward.argmax())
+                usable = first if homeward[first] else -1
             if wander > 0:  # every state of the hypothesis ruled out: outside it, wander
                 wander -= 1
                 action = self.random_action()
-            elif len(usable) and self._run_left <= 0:
-                action = h.actions[int(h.toward[ids[usable[0]]])]
+            elif usable >= 0:
+                action = h.actions[int(h.toward[ids[usable]])]
             elif climbing:  # climb the feedback for a while, instead of a random run
                 if (yield from self.climb(LONGEST_RUN * len(h.actions))):
                     self.phase = phase
@@ -252,10 +262,7 @@ class Walker:
                 return
             self.check_confined()
             feel = self.feel()
-            moved = h.next[ids, h.column[action]]
-            keep = moved >= 0
-            keep[keep] = h.agree(moved[keep], sensation, feel)
-            ids = moved[keep]
+            ids = h.follow(ids, action, sensation, feel)
             if not len(ids):
                 if widened and self._run_left <= 0:
                     self.random_action()  # start a run
@@ -317,7 +324,7 @@ class Walker:
         tried: set[int] = set()
         action: int | None = None
         escapes = 0
-        best = float(memory.feedback[-1])
+        best = memory.last_feedback
         while end is None or self.agent.step < end:
             if action is None:
                 untried = [b for b in actions if b not in tried]
@@ -333,14 +340,14 @@ class Walker:
                             return True
                         self.check_confined()
                     tried.clear()
-                    best = float(memory.feedback[-1])
+                    best = memory.last_feedback
                     continue
                 action = self.pick(untried)
-            before = float(memory.feedback[-1])  # (the memory's arrays are views: read anew)
+            before = memory.last_feedback
             if (yield from self.move(action)):
                 return True
             self.check_confined()
-            after = float(memory.feedback[-1])
+            after = memory.last_feedback
             undo = inverse.get(action)
             if after > best:
                 best = after

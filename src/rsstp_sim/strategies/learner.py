@@ -101,7 +101,7 @@ class LearnerStrategy(StrategyBase):
 
     def refine(self, agent: AgentView) -> None:
         learning, plan = self._run()
-        self._next = plan.send(bool(agent.memory.sensations[-1]))
+        self._next = plan.send(agent.memory.last_sensation)
         if learning.belief is not None and agent.model.current != learning.belief:
             agent.model.current = learning.belief
 
