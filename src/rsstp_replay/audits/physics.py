@@ -80,12 +80,18 @@ class PhysicsFindings:
         }
 
 
-def check_physics(recording: Recording, steps: pd.DataFrame | None = None) -> PhysicsFindings:
+def check_physics(
+    recording: Recording,
+    steps: pd.DataFrame | None = None,
+    *,
+    events: pd.DataFrame | None = None,
+) -> PhysicsFindings:
     """Re-simulate ``recording``'s world from its attached scenario and recorded actions and
     compare every ground-truth field of every step (see the module docstring). ``steps``, when
     given, is the recording's steps table already read (its ``action``, ``sensation`` and
     ``feedback`` columns are used; the audit passes the one it has, saving a second decoding
-    of every step)."""
+    of every step); ``events`` likewise its events table (its ``text`` and ``data`` may be
+    categorical)."""
     try:
         _check_scenario_message(recording)
         if steps is None:
@@ -94,7 +100,9 @@ def check_physics(recording: Recording, steps: pd.DataFrame | None = None) -> Ph
         world, rows, blockers = _simulate(recording, actions, steps)
         _check_agent_view(steps, world, rows)
         _check_truth(recording, world, rows, blockers)
-        _check_blocked_events(recording, world, actions, blockers)
+        _check_blocked_events(
+            recording.events() if events is None else events, world, actions, blockers
+        )
     except PhysicsDifference as broken:
         return PhysicsFindings(recording.n_steps, broken.step, broken.field, broken.difference)
     return PhysicsFindings(recording.n_steps, None, None, None)
@@ -254,7 +262,7 @@ def _scalar(value: object) -> str:
 
 
 def _check_blocked_events(
-    recording: Recording, world: Any, actions: IntArray, blockers: IntArray
+    events: pd.DataFrame, world: Any, actions: IntArray, blockers: IntArray
 ) -> None:
     """A ``blocked`` event at exactly the blocked steps, with the action and the blocker.
 
@@ -273,7 +281,6 @@ def _check_blocked_events(
         assert blocker is not None  # a non-zero code always names a blocker
         event = builders.blocked_event(0, action=action, blocker=blocker)
         made.append((event.text, msgspec.to_builtins(event.data)))
-    events = recording.events()
     # The blocked events' rows by position: no copy of the table's text columns.
     rows = np.flatnonzero((events["kind"] == "blocked").to_numpy())
     found_steps = events["step"].to_numpy(np.int64)[rows]
