@@ -145,7 +145,13 @@ def _simulate(
         rows, blockers = world.follow(actions, steps)
     except ActionError:
         raise _unknown_action(actions, recording.scenario.actions) from None
-    return world, rows, blockers
+    # Kept for the whole check: a long run's rows and blockers in the narrowest dtypes.
+    return world, _narrowed(rows), _narrowed(blockers)
+
+
+def _narrowed(values: IntArray) -> Any:
+    """``values`` (non-negative) in the narrowest signed dtype that holds them."""
+    return values.astype(np.min_scalar_type(-int(values.max(initial=0)) - 1), copy=False)
 
 
 def _unknown_action(actions: IntArray, known: tuple[int, ...]) -> PhysicsDifference:
@@ -185,8 +191,16 @@ def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: Int
     """Every step message's truth, against the bytes the recorder writes for its pose and
     blocker (each pair encoded once)."""
     width = int(blockers.max(initial=0)) + 1
-    keys = rows * width + blockers
-    distinct = np.unique(keys)
+
+    def keys_of(start: int, stop: int) -> IntArray:
+        return rows[start:stop].astype(np.int64) * width + blockers[start:stop]
+
+    distinct = np.unique(  # a block of steps at a time: no int64 key per step kept
+        np.concatenate(
+            [np.unique(keys_of(a, a + _ROWS_AT_ONCE)) for a in range(0, len(rows), _ROWS_AT_ONCE)]
+            or [np.empty(0, np.int64)]
+        )
+    )
     expected = []
     for key in distinct.tolist():
         row, code = divmod(key, width)
@@ -194,7 +208,7 @@ def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: Int
         expected.append(_TRUTH_KEY + records.encode_json(truth) + b"}")
     step = 0
     for data, starts, ends in recording.step_message_bytes():
-        chunk_keys = np.searchsorted(distinct, keys[step : step + len(starts)]).tolist()
+        chunk_keys = np.searchsorted(distinct, keys_of(step, step + len(starts))).tolist()
         if len(chunk_keys) != len(starts):  # pragma: no cover - the steps were counted
             raise PhysicsDifference(step, "truth", "more step messages than steps")
         tails = list(map(expected.__getitem__, chunk_keys))
