@@ -1,29 +1,30 @@
 """Explaining a long failed run, cold: ``rsstp-replay audit --truth`` of a learner run that never
 learned, in a fresh process (wall and CPU seconds, peak RSS), and the explanation it printed.
 
-    python bench/explain.py                      # 30,000,000 steps (recorded once, ~20 min)
+    python bench/explain.py                      # 30,000,000 steps (recorded once, ~2 hours)
     python bench/explain.py --steps 1000000      # a shorter run of the same world
     python bench/explain.py --mcap RUN.mcap      # a recording at hand
 
-The world (issue 32, point 5): links (2, 1) at 5 degrees between two obstacles at (0, +-2.5)
-of radius 0.4, float feedback sensed at [180, 90]: 4,782 true classes. The ``learner`` climbs its
-float feedback from the start, is held at a local maximum (0.86) and never senses the target:
-every step is in its ``home`` phase and the model stays one state. It is recorded once with
+The world (issue 32, point 5): ``world-0-36`` of ``bench/worlds.py --max-n 2000`` (family 0),
+the boolean form: links (0.8, 2.03) at 8 degrees, one obstacle, the first joint turning
+counter-clockwise only (actions 0, 2, 3: a one-way world), 1,936 true classes. The ``learner``
+senses its target at step 2,346 and then spends nearly every step in its ``home`` phase,
+searching for the sensed pose, its landmark, which in this one-way world it cannot go back to
+at will: after 1,000,000 steps (seed 0) 98.7 % of the steps were in ``home``, its model has
+93 states for 1,936 classes and grows by about 0.0001 states a step. It is recorded once with
 ``rsstp-sim record WORLD --strategy learner --seed 0 --steps N`` into the temporary folder
-(``/tmp/rsstp-bench-stuck-learner-N.mcap``). The truth cache lives in a temporary
-``XDG_CACHE_HOME``, so the truth is computed too (a fraction of a second for this world).
+(``/tmp/rsstp-bench-one-way-learner-N.mcap``; about 60 bytes a step; 300,000 steps took 21.5 s
+at a load of 5, 30,000,000 nearly two hours at a load of 5 to 12). The truth cache lives in a
+temporary ``XDG_CACHE_HOME``, so the truth is computed too (a fraction of a second for this
+world). At 15,093,472 steps the run is still in ``home`` (98.7 %), 1,185 states.
 
 Targets (issue 32, point 5): ``audit --truth`` of a 30,000,000-step failed run in at most 2
 minutes and 2 GiB (before: 844 s and 8.3 GB for 38.6 M steps, most in the consistency audit's
 suffix sort). On 2026-11-28, at a load of 5 to 9 on 2 cores: 471 s wall, 231 s CPU, 4.81 GiB
 (the code before this bench: 1,065 s, 365 s CPU, 6.14 GiB): missed, see docs/performance.md.
-
-Since the same day's fix of the learner's climb (a climb with no known undo went round the same
-few poses for ever) the learner senses this target at step 193 (seed 0) and learns the world:
-the figures above are of the recording made before the fix, and this bench's own recording is
-no longer a failed run. A run that fails today: ``bench/worlds.py --max-n 2000`` finds them
-(``world-0-36``'s float twin, a one-way world, spent 3,000,000 steps in ``home``); pass its
-recording with ``--mcap``.
+Those figures are of the world this bench had before (links (2, 1) at 5 degrees between two
+obstacles, float feedback), which the learner has learned since the same day's fix of its
+climb.
 """
 
 from __future__ import annotations
@@ -37,24 +38,24 @@ from pathlib import Path
 
 from _recordings import recorded
 
-STUCK = """\
-name = "two-links-5-stuck"
-description = "Links (2, 1) at 5 degrees between two obstacles, float feedback sensed at [180, 90]"
+ONE_WAY = """\
+name = "world-0-36"
+
 [arm]
-lengths = [2.0, 1.0]
-initial_deg = [0, 0]
-step_deg = 5
+lengths = [0.8, 2.03]
+initial_deg = [336, 280]
+step_deg = 8
+actions = [0, 2, 3]
+
 [[obstacles]]
-center = [0.0, 2.5]
-radius = 0.4
-[[obstacles]]
-center = [0.0, -2.5]
-radius = 0.4
+center = [1.93, 1.909]
+radius = 0.713
+
 [feedback]
-target_deg = [180, 90]
-mode = "float"
+target_deg = [208, 320]
 """
-"""The learner's failed world (tests/replay/test_explanation.py has the same)."""
+"""The learner's failed world: ``bench/worlds.py --max-n 2000 --only world-0-36 --write DIR``
+writes the same file (``world-0-36.toml``)."""
 
 TARGET_S, TARGET_GIB = 120.0, 2.0
 
@@ -85,11 +86,11 @@ def measure(command: list[str], out: Path) -> tuple[float, float, float]:
     return float(seconds), float(cpu), int(peak_kib) / 2**20
 
 
-def stuck_run(steps: int) -> Path:
-    world = Path(tempfile.gettempdir()) / "rsstp-bench-two-links-5-stuck.toml"
-    world.write_text(STUCK)
+def failed_run(steps: int) -> Path:
+    world = Path(tempfile.gettempdir()) / "rsstp-bench-world-0-36.toml"
+    world.write_text(ONE_WAY)
     return recorded(
-        f"stuck-learner-{steps}", str(world), "--strategy", "learner", "--seed", "0",
+        f"one-way-learner-{steps}", str(world), "--strategy", "learner", "--seed", "0",
         "--steps", str(steps), "--quiet",
     )  # fmt: skip
 
@@ -102,7 +103,7 @@ def main() -> None:
         "--consistency-steps", type=int, help="passed to audit (default: the audit's)"
     )
     args = parser.parse_args()
-    mcap = args.mcap or stuck_run(args.steps)
+    mcap = args.mcap or failed_run(args.steps)
     command = [sys.executable, "-m", "rsstp_cli.replay", "audit", "--truth", "--quiet"]
     if args.consistency_steps is not None:
         command += ["--consistency-steps", str(args.consistency_steps)]

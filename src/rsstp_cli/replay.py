@@ -206,7 +206,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
         bar.to(1)
         bar.stage("auditing")
         report = run_audits(loaded, consistency_steps=args.consistency_steps or None)
-        physics = check_physics(recording, loaded.steps())
+        physics = check_physics(recording, loaded.steps(), events=loaded.events())
         bar.to(2)
         truth = explanation = None
         if args.truth:

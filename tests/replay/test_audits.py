@@ -455,8 +455,9 @@ def test_audits_of_a_real_recording_equal_those_of_the_live_run(tmp_path: Path) 
 
 def test_a_loaded_recording_keeps_what_the_audits_read_once(tmp_path: Path) -> None:
     """The steps table read for the audits: the recording's table less the geometry and
-    the blocker's details, its angles in two bytes, its memory columns shared with the
-    memory (one copy), the values unchanged."""
+    the blocker's details, its angles in two bytes and its other integer columns in the
+    narrowest dtype of their values, its memory columns shared with the memory (one copy),
+    the values unchanged."""
     from rsstp_replay.audits.loaded import load
 
     path = tmp_path / "run.mcap"
@@ -470,9 +471,20 @@ def test_a_loaded_recording_keeps_what_the_audits_read_once(tmp_path: Path) -> N
     assert detail <= set(full.columns)
     assert list(table.columns) == [name for name in full.columns if name not in detail]
     assert table.index.equals(full.index)
+
+    def narrowest(column: pd.Series) -> str:
+        values = [-1, *column.dropna().tolist()]  # -1: where a nullable column is missing
+        dtype = next(
+            t for t in ("int8", "int16", "int32", "int64")
+            if np.iinfo(t).min <= min(values) and max(values) <= np.iinfo(t).max
+        )  # fmt: skip
+        return dtype.capitalize() if isinstance(column.dtype, pd.Int64Dtype) else dtype
+
+    narrow = {name: narrowest(full[name]) for name in ("action", "state_before", "model_version")}
+    narrow |= {name: "int16" for name in table.columns if name.startswith("angle_deg_")}
     for name in table.columns:
-        expected = full[name].astype(np.int16) if name.startswith("angle_deg_") else full[name]
-        pd.testing.assert_series_equal(table[name], expected)
+        assert str(table[name].dtype) == narrow.get(name, str(full[name].dtype)), name
+        pd.testing.assert_series_equal(table[name], full[name], check_dtype=False)
     for name, column in (
         ("internal_state", memory.internal_states),
         ("sensation", memory.sensations),

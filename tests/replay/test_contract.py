@@ -105,9 +105,17 @@ def test_reference_recordings_keep_the_contract(path: Path) -> None:
         assert check_contract(recording).holds
 
 
-def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
+@pytest.mark.parametrize("block", [None, 1, 7, 20])
+def test_a_broken_chain_is_found_at_its_first_step(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, block: int | None
+) -> None:
     """The check reads the columns, not the live run: feed it a step that starts elsewhere,
-    a step in a state its version lacks, and a step naming the wrong version."""
+    a step in a state its version lacks, and a step naming the wrong version (each twice:
+    the first and the count are found whatever the blocks of steps checked together)."""
+    import rsstp_replay.audits.contract as contract
+
+    if block is not None:
+        monkeypatch.setattr(contract, "_BLOCK", block)
     path = tmp_path / "run.mcap"
     record(path, load_scenario("thesis-roulette"), make_strategy("roulette"), steps=40, seed=0)
     with open_recording(path) as recording:
@@ -115,13 +123,19 @@ def test_a_broken_chain_is_found_at_its_first_step(tmp_path: Path) -> None:
         times, events = recording.step_log_times(), recording.events()
 
     edited = table.copy()
-    edited.loc[20, "state_before"] = 999
-    edited.loc[30, "internal_state"] = 998
-    edited.loc[35, "model_version"] = 997
+    edited.loc[[20, 27], "state_before"] = 999
+    edited.loc[[30, 39], "internal_state"] = 998
+    edited.loc[[35, 21], "model_version"] = 997
     found = check_contract(_Edited(edited, versions, times, events))  # type: ignore[arg-type]
-    rules = {v.rule: v.step for v in found.violations}
-    assert rules == {"state-chain": 20, "state-in-model": 30, "model-version": 35}
+    rules = {v.rule: (v.step, v.count) for v in found.violations}
+    # A step in another state breaks the chain at the step after it too (31, 40: 4 in all).
+    assert rules == {
+        "state-chain": (20, 4),
+        "state-in-model": (30, 2),
+        "model-version": (21, 2),
+    }
     assert "step 30 is in internal state 998" in found.to_text()
+    assert "step 21 names model version 997" in found.to_text()
 
 
 @pytest.mark.slow

@@ -507,3 +507,43 @@ def test_a_change_rebuilt_from_its_keyframe_is_what_the_run_had(tmp_path: Path) 
             expected = dict(live[record_.version])
             snapshot.pop("current"), expected.pop("current")
             assert snapshot == expected
+
+
+def test_narrow_steps_and_events_hold_the_same_values(random_run: tuple[Path, Any]) -> None:
+    """``narrow=True``: the integer columns in the narrowest dtype that holds their values,
+    the events' text and data categorical; every value the documented table's."""
+    with open_recording(random_run[0]) as recording:
+        steps, events = recording.steps_and_events(geometry=False)
+    with open_recording(random_run[0]) as recording:
+        narrow_steps, narrow_events = recording.steps_and_events(geometry=False, narrow=True)
+        again = recording.events()
+    for name in steps.columns:
+        values = steps[name].dropna().to_numpy()
+        if name.startswith("angle_deg_"):  # 0 .. 359: always two bytes
+            assert narrow_steps[name].dtype == np.int16
+        if name in ("action", "state_before", "internal_state", "model_version"):
+            low, high = min(-1, int(values.min())), int(values.max())  # -1: a missing value
+            fits = [t for t in ("int8", "int16", "int32", "int64") if np.iinfo(t).min <= low]
+            fits = [t for t in fits if high <= np.iinfo(t).max]
+            assert narrow_steps[name].dtype.itemsize == np.dtype(fits[0]).itemsize, name
+        pd.testing.assert_series_equal(narrow_steps[name], steps[name], check_dtype=False)
+    assert isinstance(narrow_events["text"].dtype, pd.CategoricalDtype)
+    assert isinstance(narrow_events["data"].dtype, pd.CategoricalDtype)
+    assert narrow_events["text"].tolist() == events["text"].tolist()
+    assert narrow_events["data"].tolist() == events["data"].tolist()
+    pd.testing.assert_frame_equal(again, events)  # the documented table, from the kept one
+
+
+def test_an_integer_column_widens_as_its_values_need() -> None:
+    from rsstp_replay.reader._decode import _IntColumn
+
+    column = _IntColumn(6)
+    batches = [[1, 2], [300], [-5, 2**40, 7]]
+    widths = []
+    start = 0
+    for batch in batches:
+        column.put(slice(start, start + len(batch)), batch)
+        start += len(batch)
+        widths.append(column.values.dtype.itemsize)
+    assert widths == [1, 2, 8]  # int8 holds 1 and 2; 300 needs int16; 2**40 int64
+    assert column.values.tolist() == [1, 2, 300, -5, 2**40, 7]

@@ -13,9 +13,9 @@ from hypothesis import strategies as st
 from shapely.geometry import LineString, Point
 
 from conftest import THIN_OBSTACLE_TOML
-from rsstp_sim.arrays import IntArray
 from rsstp_sim.arm import geometry
 from rsstp_sim.arm.geometry import ArmGeometry, Blocker
+from rsstp_sim.arrays import IntArray
 from rsstp_sim.scenario import parse_scenario
 from scenarios import arm_toml
 

@@ -113,16 +113,28 @@ def version_index(versions: Sequence[ModelRecord], steps: _Ints) -> _Ints:
     return np.searchsorted(message_steps, steps, side="right").astype(np.int64) - 1
 
 
+_BLOCK = 1 << 20
+"""Steps whose per-step rules :func:`check_contract` checks together: a long run's int64
+temporaries stay a few megabytes, not eight bytes a step each."""
+
+
 def check_contract(source: ContractSource) -> ContractFindings:
     """Check every step against the model messages (see the module docstring)."""
     table = source.steps(geometry=False)
     history = source.model_versions()
     versions = version_heads(history)
-    step = table.index.to_numpy(np.int64)
-    state = table["internal_state"].to_numpy(np.int64)
-    named = table["model_version"].to_numpy(np.int64)
-    before = table["state_before"].to_numpy(np.int64, na_value=-1)
+    n = len(table)
+    steps = _Steps(table.index)
+    state_column = table["internal_state"].to_numpy()
+    named_column = table["model_version"].to_numpy()
+    before_column = table["state_before"]
     found: list[Violation] = []
+
+    def ints(column: npt.NDArray[Any], rows: slice) -> _Ints:
+        return column[rows].astype(np.int64)
+
+    def before_at(rows: slice) -> _Ints:
+        return before_column.iloc[rows].to_numpy(np.int64, na_value=-1)
 
     numbers = np.fromiter((record.version for record in versions), np.int64, len(versions))
     backwards = np.flatnonzero(np.diff(numbers) <= 0)
@@ -137,36 +149,57 @@ def check_contract(source: ContractSource) -> ContractFindings:
             )
         )
 
-    index = version_index(versions, step)
-    in_force = np.where(index >= 0, numbers[np.maximum(index, 0)], -1)
+    # The per-step rules, a block of steps at a time: each rule's first bad step and count.
+    log_times = source.step_log_times()
+    bad: dict[str, list[_Ints]] = {rule: [] for rule in _STEP_RULES}
+    for start in range(0, n, _BLOCK):
+        stop = min(start + _BLOCK, n)
+        step = steps.block(start, stop)
+        state = ints(state_column, slice(start, stop))
+        named = ints(named_column, slice(start, stop))
+        index = version_index(versions, step)
+        in_force = np.where(index >= 0, numbers[np.maximum(index, 0)], -1)
+        bad["model-version"].append(np.flatnonzero(named != in_force) + start)
+        member = version_alive(history, index, state)
+        bad["state-in-model"].append(np.flatnonzero(~member) + start)
+        first = max(start, 1)  # step 0 has no state before
+        before = before_at(slice(first, stop))
+        earlier = ints(state_column, slice(first - 1, stop - 1))
+        bad["state-chain"].append(np.flatnonzero(before != earlier) + first)
+        bad["log-time"].append(np.flatnonzero(log_times[start:stop] != step * STEP_NS) + start)
+    rows = {rule: np.concatenate(parts) if parts else _NONE for rule, parts in bad.items()}
+
+    def version_at(t: int) -> int:  # (a row)
+        index = int(version_index(versions, steps.block(t, t + 1))[0])
+        return int(numbers[index]) if index >= 0 else -1
+
     found += _first_of(
         "model-version",
-        np.flatnonzero(named != in_force),
-        step,
+        rows["model-version"],
+        steps,
         lambda t: (
-            f"step {step[t]} names model version {named[t]}, but the version in force "
-            f"is {in_force[t]}"
+            f"step {steps[t]} names model version {named_column[t]}, but the version in "
+            f"force is {version_at(t)}"
         ),
     )
-
-    member = version_alive(history, index, state)
     found += _first_of(
         "state-in-model",
-        np.flatnonzero(~member),
-        step,
+        rows["state-in-model"],
+        steps,
         lambda t: (
-            f"step {step[t]} is in internal state {state[t]}, which is not a state of "
-            f"model version {in_force[t]}"
+            f"step {steps[t]} is in internal state {state_column[t]}, which is not a state "
+            f"of model version {version_at(t)}"
         ),
     )
 
     message_steps = np.fromiter((record.step for record in versions), np.int64, len(versions))
     currents = np.fromiter((record.current for record in versions), np.int64, len(versions))
     last_of_step = np.r_[message_steps[1:] != message_steps[:-1], True] if len(versions) else []
-    row = np.searchsorted(step, message_steps)
-    known = (row < len(step)) & (step[np.minimum(row, max(len(step) - 1, 0))] == message_steps)
+    row = steps.index.searchsorted(message_steps)
+    known = (row < n) & (steps.index.take(np.minimum(row, max(n - 1, 0))) == message_steps)
     checked = np.flatnonzero(np.asarray(last_of_step, np.bool_) & known)
-    wrong = checked[currents[checked] != state[row[checked]]]
+    ended = state_column[row[checked]].astype(np.int64)
+    wrong = checked[currents[checked] != ended]
     if len(wrong):
         k = int(wrong[0])
         found.append(
@@ -176,33 +209,53 @@ def check_contract(source: ContractSource) -> ContractFindings:
                 len(wrong),
                 f"model version {numbers[k]} (step {message_steps[k]:,}) says the current state "
                 f"is {currents[k]}, but step {message_steps[k]:,} ends in state "
-                f"{state[row[k]]}",
+                f"{state_column[row[k]]}",
                 counted="model message",
             )
         )
 
     found += _first_of(
         "state-chain",
-        np.flatnonzero(before[1:] != state[:-1]) + 1,
-        step,
+        rows["state-chain"],
+        steps,
         lambda t: (
-            f"step {step[t]} starts in state {before[t]}, but step {step[t - 1]} ended "
-            f"in state {state[t - 1]}"
+            f"step {steps[t]} starts in state {before_at(slice(t, t + 1))[0]}, but step "
+            f"{steps[t - 1]} ended in state {state_column[t - 1]}"
         ),
     )
-    log_time = source.step_log_times()
     found += _first_of(
         "log-time",
-        np.flatnonzero(log_time != step * STEP_NS),
-        step,
-        lambda t: f"step {step[t]} is logged at {log_time[t]:,} ns, not {step[t] * STEP_NS:,}",
+        rows["log-time"],
+        steps,
+        lambda t: f"step {steps[t]} is logged at {log_times[t]:,} ns, not {steps[t] * STEP_NS:,}",
     )
-    found += _event_steps(source.events(), int(step[-1]) if len(step) else 0)
+    last = int(steps[-1]) if n else 0
+    found += _event_steps(source.events(), last)
     found.sort(key=lambda v: v.step)
-    return ContractFindings(int(step[-1]) if len(step) else 0, tuple(found))
+    return ContractFindings(last, tuple(found))
 
 
-def _first_of(rule: str, bad: _Ints, step: _Ints, text: Callable[[int], str]) -> list[Violation]:
+class _Steps:
+    """A table's step numbers (its index) by row, a block at a time: a long run's
+    ``RangeIndex`` is never made an array whole."""
+
+    def __init__(self, index: pd.Index) -> None:
+        self.index = index
+
+    def block(self, start: int, stop: int) -> _Ints:
+        return self.index[start:stop].to_numpy(np.int64)
+
+    def __getitem__(self, row: int) -> int:
+        return int(self.index[row])
+
+
+_STEP_RULES = ("model-version", "state-in-model", "state-chain", "log-time")
+_NONE = np.empty(0, np.int64)
+
+
+def _first_of(
+    rule: str, bad: _Ints, step: _Ints | _Steps, text: Callable[[int], str]
+) -> list[Violation]:
     """One violation of ``rule`` for the steps at the rows ``bad``: the first, described by
     ``text(row)``, and how many there are."""
     if not len(bad):

@@ -46,19 +46,20 @@ class LoadedRecording:
         both = getattr(source, "steps_and_events", None)
         self._events: pd.DataFrame | None = None
         if both is not None:
-            table, self._events = both(geometry=False, blockers=False)
+            table, self._events = both(geometry=False, blockers=False, narrow=True)
         else:
             table = source.steps(geometry=False)
         table = table.drop(columns=["blocked_kind", *detail], errors="ignore")
         self._models = source.model_versions()
         self._memory = memory = Memory.from_arrays(
-            table["action"].to_numpy(np.int64, na_value=-1),
-            table["internal_state"].to_numpy(np.int64),
+            table["action"].to_numpy(table["action"].dtype.numpy_dtype, na_value=-1),
+            table["internal_state"].to_numpy(),
             table["sensation"].to_numpy(np.bool_),
             table["feedback"].to_numpy(np.float64),
         )
         # The memory's columns are the table's, value for value: the table reads them from
-        # the memory instead of keeping a copy; the joint angles (0 .. 359) take two bytes.
+        # the memory instead of keeping a copy; the joint angles (0 .. 359) take two bytes,
+        # the other integer columns (from a recording) the narrowest dtype of their values.
         shared = {
             "internal_state": memory.internal_states,
             "sensation": memory.sensations,
@@ -86,7 +87,8 @@ class LoadedRecording:
     def steps(self, *, geometry: bool = True) -> pd.DataFrame:
         """The steps table without the joint positions and distances (``geometry`` is
         ignored: the audits do not read them), ``blocked_kind`` and the blocker's indices;
-        the ``angle_deg_{j}`` columns in int16."""
+        the ``angle_deg_{j}`` columns in int16, from a recording the agent's integer columns
+        (but ``internal_state``, the memory's) in the narrowest dtype of their values."""
         return self._steps
 
     def memory(self) -> Memory:

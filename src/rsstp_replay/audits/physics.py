@@ -81,12 +81,18 @@ class PhysicsFindings:
         }
 
 
-def check_physics(recording: Recording, steps: pd.DataFrame | None = None) -> PhysicsFindings:
+def check_physics(
+    recording: Recording,
+    steps: pd.DataFrame | None = None,
+    *,
+    events: pd.DataFrame | None = None,
+) -> PhysicsFindings:
     """Re-simulate ``recording``'s world from its attached scenario and recorded actions and
     compare every ground-truth field of every step (see the module docstring). ``steps``, when
     given, is the recording's steps table already read (its ``action``, ``sensation`` and
     ``feedback`` columns are used; the audit passes the one it has, saving a second decoding
-    of every step)."""
+    of every step); ``events`` likewise its events table (its ``text`` and ``data`` may be
+    categorical)."""
     try:
         _check_scenario_message(recording)
         if steps is None:
@@ -95,7 +101,9 @@ def check_physics(recording: Recording, steps: pd.DataFrame | None = None) -> Ph
         world, rows, blockers = _simulate(recording, actions, steps)
         _check_agent_view(steps, world, rows)
         _check_truth(recording, world, rows, blockers)
-        _check_blocked_events(recording, world, actions, blockers)
+        _check_blocked_events(
+            recording.events() if events is None else events, world, actions, blockers
+        )
     except PhysicsDifference as broken:
         return PhysicsFindings(recording.n_steps, broken.step, broken.field, broken.difference)
     return PhysicsFindings(recording.n_steps, None, None, None)
@@ -138,7 +146,13 @@ def _simulate(
         rows, blockers = world.follow(actions, steps)
     except ActionError:
         raise _unknown_action(actions, recording.scenario.actions) from None
-    return world, rows, blockers
+    # Kept for the whole check: a long run's rows and blockers in the narrowest dtypes.
+    return world, _narrowed(rows), _narrowed(blockers)
+
+
+def _narrowed(values: IntArray) -> Any:
+    """``values`` (non-negative) in the narrowest signed dtype that holds them."""
+    return values.astype(np.min_scalar_type(-int(values.max(initial=0)) - 1), copy=False)
 
 
 def _unknown_action(actions: IntArray, known: tuple[int, ...]) -> PhysicsDifference:
@@ -178,8 +192,16 @@ def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: Int
     """Every step message's truth, against the bytes the recorder writes for its pose and
     blocker (each pair encoded once)."""
     width = int(blockers.max(initial=0)) + 1
-    keys = rows * width + blockers
-    found = distinct(keys)
+
+    def keys_of(start: int, stop: int) -> IntArray:
+        return rows[start:stop].astype(np.int64) * width + blockers[start:stop]
+
+    found = distinct(  # a block of steps at a time: no int64 key per step kept
+        np.concatenate(
+            [distinct(keys_of(a, a + _ROWS_AT_ONCE)) for a in range(0, len(rows), _ROWS_AT_ONCE)]
+            or [np.empty(0, np.int64)]
+        )
+    )
     expected = []
     for key in found.tolist():
         row, code = divmod(key, width)
@@ -187,7 +209,7 @@ def _check_truth(recording: Recording, world: Any, rows: IntArray, blockers: Int
         expected.append(_TRUTH_KEY + records.encode_json(truth) + b"}")
     step = 0
     for data, starts, ends in recording.step_message_bytes():
-        chunk_keys = np.searchsorted(found, keys[step : step + len(starts)]).tolist()
+        chunk_keys = np.searchsorted(found, keys_of(step, step + len(starts))).tolist()
         if len(chunk_keys) != len(starts):  # pragma: no cover - the steps were counted
             raise PhysicsDifference(step, "truth", "more step messages than steps")
         tails = list(map(expected.__getitem__, chunk_keys))
@@ -255,7 +277,7 @@ def _scalar(value: object) -> str:
 
 
 def _check_blocked_events(
-    recording: Recording, world: Any, actions: IntArray, blockers: IntArray
+    events: pd.DataFrame, world: Any, actions: IntArray, blockers: IntArray
 ) -> None:
     """A ``blocked`` event at exactly the blocked steps, with the action and the blocker.
 
@@ -274,7 +296,6 @@ def _check_blocked_events(
         assert blocker is not None  # a non-zero code always names a blocker
         event = builders.blocked_event(0, action=action, blocker=blocker)
         made.append((event.text, msgspec.to_builtins(event.data)))
-    events = recording.events()
     # The blocked events' rows by position: no copy of the table's text columns.
     rows = np.flatnonzero((events["kind"] == "blocked").to_numpy())
     found_steps = events["step"].to_numpy(np.int64)[rows]

@@ -349,8 +349,8 @@ def audit_truth(
         states=states,
         sensations=np.asarray(memory.sensations, np.bool_),
         true_class=true_class,
-        actions=steps["action"].to_numpy(np.int64, na_value=-1),
-        angles=steps[columns].to_numpy(np.int64),
+        actions=np.asarray(memory.actions),  # the table's action column, -1 at step 0
+        angles=np.stack([steps[name].to_numpy() for name in columns], axis=1),
     )
 
     # Within each version: keys (version index, state) and (version index, class).

@@ -331,8 +331,8 @@ def judge_versions(
     states: _Ints,
     sensations: npt.NDArray[np.bool_],
     true_class: _Ints,
-    actions: npt.NDArray[np.int64] | None = None,
-    angles: _Ints | None = None,
+    actions: npt.NDArray[np.integer[Any]] | None = None,
+    angles: npt.NDArray[np.integer[Any]] | None = None,
 ) -> tuple[Verdict, npt.NDArray[np.bool_]]:
     """The verdict, and whether each version was equivalent to the truth.
 

@@ -85,8 +85,9 @@ class _ArmColumns:
         self.n_joints = n_joints
         self.n_obstacles = n_obstacles
         self.numbers = numbers
-        # One row per column, so each DataFrame column is a contiguous array.
-        self.angles_deg = np.empty((n_joints, n_rows), np.int64)
+        # One row per column, so each DataFrame column is a contiguous array; an angle
+        # (0 .. 359) takes two bytes.
+        self.angles_deg = np.empty((n_joints, n_rows), np.int16)
         # A pose's code -> x0, y0, x1, y1, ... then the distances tip by tip, as the first
         # message at that pose holds them.
         self.pose_numbers: dict[int, list[float]] = {}
@@ -150,9 +151,12 @@ class _ArmColumns:
                 numbers += row
             known[code] = numbers
 
-    def columns(self, part: slice, *, geometry: bool) -> dict[str, Any]:
+    def columns(self, part: slice, *, geometry: bool, narrow: bool = False) -> dict[str, Any]:
         columns: dict[str, Any] = {
-            f"angle_deg_{j}": self.angles_deg[j, part] for j in range(self.n_joints)
+            f"angle_deg_{j}": self.angles_deg[j, part]
+            if narrow
+            else self.angles_deg[j, part].astype(np.int64)
+            for j in range(self.n_joints)
         }
         if geometry:
             if not self.numbers:
@@ -164,7 +168,7 @@ class _ArmColumns:
         """``joint{k}_x``, ``joint{k}_y`` and ``dist_{k}_{j}`` of the rows ``part``: each
         distinct pose's numbers as the file holds them (found by its code,
         ``sum_j angle_j * 360**j``), each column taken whole from those."""
-        index, codes = pd.factorize(self._places @ self.angles_deg[:, part])
+        index, codes = pd.factorize(self._places @ self.angles_deg[:, part].astype(np.int64))
         n, m = self.n_joints, self.n_obstacles
         known = self.pose_numbers
         numbers = np.array([known[code] for code in np.asarray(codes).tolist()], np.float64)

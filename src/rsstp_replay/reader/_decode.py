@@ -15,8 +15,9 @@ ground truth by its :class:`BodyReader` (:data:`BODY_READERS`: the arm's in
 
 from __future__ import annotations
 
+import operator
 import re
-from typing import Annotated, Any, Protocol
+from typing import Annotated, Any, NamedTuple, Protocol
 
 import msgspec
 import numpy as np
@@ -24,6 +25,7 @@ import numpy.typing as npt
 import pandas as pd  # type: ignore[import-untyped,unused-ignore]
 
 from rsstp_format.records import json_array
+from rsstp_format.schemas import STEP_NS
 from rsstp_format.vocabulary import (
     BLOCKED_COLUMNS,
     BLOCKER_ARITY,
@@ -45,6 +47,7 @@ __all__ = [
     "Count",
     "Point",
     "BodyReader",
+    "LogTimes",
     "StepColumns",
     "TruthColumns",
     "blocker_label",
@@ -133,9 +136,10 @@ class TruthColumns(Protocol):
         """The truths of a batch (its ``parts``, their bytes) into ``rows``; :class:`BadStep`
         (its ``index`` in the batch) for a bad one."""
 
-    def columns(self, part: slice, *, geometry: bool) -> dict[str, Any]:
+    def columns(self, part: slice, *, geometry: bool, narrow: bool = False) -> dict[str, Any]:
         """The columns of the rows ``part``: the pose's, and with ``geometry`` the numbers
-        that follow from it (positions, distances)."""
+        that follow from it (positions, distances); ``narrow``: integer columns may be in a
+        narrower dtype than int64."""
 
 
 class BodyReader(Protocol):
@@ -167,6 +171,21 @@ def body_reader(name: str) -> BodyReader:
     return reader
 
 
+class LogTimes(NamedTuple):
+    """The log times of ``n_rows`` consecutive steps from ``first_step``: each step's
+    ``step * STEP_NS`` but at the rows of ``odd`` (rows, their log times)."""
+
+    n_rows: int
+    first_step: int
+    odd: tuple[tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]], ...]
+
+    def values(self) -> npt.NDArray[np.int64]:
+        times = (np.arange(self.n_rows, dtype=np.int64) + self.first_step) * STEP_NS
+        for rows, found in self.odd:
+            times[rows] = found
+        return times
+
+
 class StepColumns:
     """The columns of ``n_rows`` step messages, filled batch by batch with :meth:`add`.
 
@@ -180,20 +199,26 @@ class StepColumns:
         *,
         truth: TruthColumns | None = None,
         kinds: tuple[BlockerKind, ...] = (),
+        keep_steps: bool = False,
     ) -> None:
         self.n_rows = n_rows
         self.truth = truth is not None
         self._pose = truth
         self._kinds = kinds
         self.rows = 0
-        self.step = np.empty(n_rows, np.int64)
-        self.log_time = np.empty(n_rows, np.int64)
-        self.action = np.empty(n_rows, np.int64)
-        self.state_before = np.empty(n_rows, np.int64)
-        self.internal_state = np.empty(n_rows, np.int64)
+        # The step numbers and log times are what the rows say (``first_step + row``, times
+        # STEP_NS) but where noted: nothing per row in a long run. ``keep_steps`` keeps them
+        # whole (a chunk's columns, searched by step).
+        self.first_step: int | None = None
+        self._wrong_step: tuple[int, int] | None = None  # the first row whose step differs
+        self._steps: _IntColumn | None = _IntColumn(n_rows) if keep_steps else None
+        self._odd_times: list[tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]] = []
+        self.action = _IntColumn(n_rows)
+        self.state_before = _IntColumn(n_rows)
+        self.internal_state = _IntColumn(n_rows)
         self.sensation = np.empty(n_rows, np.bool_)
         self.feedback = np.empty(n_rows, np.float64)
-        self.model_version = np.empty(n_rows, np.int64)
+        self.model_version = _IntColumn(n_rows)
         self.no_transition = np.empty(n_rows, np.bool_)
         self.action_nulls: list[int] = []
         self.state_before_nulls: list[int] = []
@@ -201,6 +226,25 @@ class StepColumns:
             self.blocked = np.empty(n_rows, np.bool_)
             self.blocker = np.full(n_rows, -1, np.int16)
             self.blocker_labels: dict[BlockedBy, int] = {}
+
+    @property
+    def step(self) -> npt.NDArray[np.int64]:
+        """Each row's step number."""
+        if self._steps is not None:
+            return self._steps.values[: self.rows].astype(np.int64)
+        steps = np.arange(self.rows, dtype=np.int64) + (self.first_step or 0)
+        if self._wrong_step is not None:  # pragma: no cover - check() refuses such columns
+            raise BadStep("the step numbers were not kept", step=self._wrong_step[0])
+        return steps
+
+    @property
+    def log_time(self) -> npt.NDArray[np.int64]:
+        """Each row's log time (ns)."""
+        return self.log_times().values()
+
+    def log_times(self) -> LogTimes:
+        """The rows' log times, kept apart from these columns (a few numbers)."""
+        return LogTimes(self.rows, self.first_step or 0, tuple(self._odd_times))
 
     # -- filling ----------------------------------------------------------------------------
 
@@ -228,23 +272,40 @@ class StepColumns:
         if r + k > self.n_rows:
             raise BadStep(f"more step messages than the {self.n_rows} counted", index=0)
         s = slice(r, r + k)
-        self.step[s] = [x.step for x in rows]
-        self.log_time[s] = log_times
-        agents = [x.agent for x in rows]
-        self.action[s] = _nullable([a.action for a in agents], r, self.action_nulls)
-        self.state_before[s] = _nullable(
-            [a.state_before for a in agents], r, self.state_before_nulls
+        steps = np.fromiter(map(_STEP, rows), np.int64, k)
+        self._note_steps(steps, np.asarray(log_times, np.int64), r)
+        agents = list(map(_AGENT, rows))
+        self.action.put(s, _nullable(list(map(_ACTION, agents)), r, self.action_nulls))
+        self.state_before.put(
+            s, _nullable(list(map(_STATE_BEFORE, agents)), r, self.state_before_nulls)
         )
-        self.internal_state[s] = [a.internal_state for a in agents]
-        self.sensation[s] = np.array([a.sensation for a in agents], np.bool_)
-        self.feedback[s] = [a.feedback for a in agents]
-        self.model_version[s] = [a.model_version for a in agents]
-        self.no_transition[s] = np.array([a.no_transition for a in agents], np.bool_)
+        self.internal_state.put(s, np.fromiter(map(_INTERNAL_STATE, agents), np.int64, k))
+        self.sensation[s] = np.fromiter(map(_SENSATION, agents), np.bool_, k)
+        self.feedback[s] = np.fromiter(map(_FEEDBACK, agents), np.float64, k)
+        self.model_version.put(s, np.fromiter(map(_MODEL_VERSION, agents), np.int64, k))
+        self.no_transition[s] = np.fromiter(map(_NO_TRANSITION, agents), np.bool_, k)
         if self._pose is not None:
-            truths = [x.truth for x in rows]
+            truths = list(map(_TRUTH, rows))
             self._pose.add(truths, s, parts)
             self._add_blockers(truths, r)
         self.rows = r + k
+
+    def _note_steps(
+        self, steps: npt.NDArray[np.int64], log_times: npt.NDArray[np.int64], r: int
+    ) -> None:
+        """Where the rows ``r ..`` of a batch say another step than ``first_step + row``, and
+        another log time than their step's."""
+        if self.first_step is None and len(steps):
+            self.first_step = int(steps[0])
+        rows = np.arange(r, r + len(steps), dtype=np.int64)
+        if self._steps is not None:
+            self._steps.put(slice(r, r + len(steps)), steps)
+        wrong = np.flatnonzero(steps != rows + (self.first_step or 0))
+        if len(wrong) and self._wrong_step is None:
+            self._wrong_step = (r + int(wrong[0]), int(steps[wrong[0]]))
+        odd = np.flatnonzero(log_times != steps * STEP_NS)
+        if len(odd):
+            self._odd_times.append((rows[odd], log_times[odd]))
 
     def _add_blockers(self, truths: list[Any], r: int) -> None:
         k = len(truths)
@@ -277,23 +338,22 @@ class StepColumns:
         """The rules between fields and between messages; :class:`BadStep` names the step."""
         if self.rows != self.n_rows:
             raise BadStep(f"expected {self.n_rows} step messages, found {self.rows}")
-        steps = self.step
-        bad = np.flatnonzero(steps != np.arange(self.n_rows))
-        if bad.size:
-            t = int(bad[0])
-            raise BadStep(f"expected step {t} in this place, found step {steps[t]}", step=t)
+        wrong = (0, self.first_step) if self.first_step else self._wrong_step
+        if wrong is not None:
+            t, found = wrong
+            raise BadStep(f"expected step {t} in this place, found step {found}", step=t)
         nullable = (("action", self.action_nulls), ("state_before", self.state_before_nulls))
         for name, nulls in nullable:
             if self.n_rows and nulls[:1] != [0]:
                 raise BadStep(f"agent.{name}: expected none at step 0 (the reset)", step=0)
             if len(nulls) > 1:
                 raise BadStep(f"agent.{name}: missing after step 0", step=nulls[1])
-        unknown = np.flatnonzero(~np.isin(self.action[1:], np.array(actions, np.int64)))
+        action = self.action.values
+        unknown = np.flatnonzero(~np.isin(action[1:], np.array(actions, np.int64)))
         if unknown.size:
             t = int(unknown[0]) + 1
             raise BadStep(
-                f"agent.action {self.action[t]} is not one of the scenario's actions "
-                f"{list(actions)}",
+                f"agent.action {action[t]} is not one of the scenario's actions {list(actions)}",
                 step=t,
             )
         if self.truth:
@@ -310,33 +370,42 @@ class StepColumns:
         blockers: bool = True,
         copy: bool = False,
         rows: slice | None = None,
+        narrow: bool = False,
     ) -> pd.DataFrame:
         """The steps table, indexed by ``step`` (see :meth:`rsstp_replay.Recording.steps` for
         the columns; :meth:`check` made the steps ``0 .. n_rows - 1``); ``geometry=False``
         leaves out the joint positions and distances, ``blockers=False`` what blocked a move
         (``blocked_kind`` and the indices; ``blocked`` stays); ``copy=True`` gives a table
         that shares no array with these columns; ``rows``: only those rows (a part of the
-        table, its index the steps' numbers)."""
+        table, its index the steps' numbers); ``narrow=True``: each integer column in the
+        narrowest dtype that holds its values (as kept; else int64, as documented), a pose's
+        too where its body keeps it narrow."""
         part = slice(0, self.n_rows) if rows is None else rows
         start, stop = part.start, part.stop
         action_mask = np.zeros(stop - start, np.bool_)
         action_mask[[t - start for t in self.action_nulls if start <= t < stop]] = True
         before_mask = np.zeros(stop - start, np.bool_)
         before_mask[[t - start for t in self.state_before_nulls if start <= t < stop]] = True
+        ints = {
+            name: getattr(self, name).values[part]
+            for name in ("action", "state_before", "internal_state", "model_version")
+        }
+        if not narrow:
+            ints = {name: values.astype(np.int64) for name, values in ints.items()}
         columns: dict[str, Any] = {
-            "action": pd.arrays.IntegerArray(self.action[part], action_mask),
-            "state_before": pd.arrays.IntegerArray(self.state_before[part], before_mask),
-            "internal_state": self.internal_state[part],
+            "action": pd.arrays.IntegerArray(ints["action"], action_mask),
+            "state_before": pd.arrays.IntegerArray(ints["state_before"], before_mask),
+            "internal_state": ints["internal_state"],
             "sensation": self.sensation[part],
             "feedback": self.feedback[part],
-            "model_version": self.model_version[part],
+            "model_version": ints["model_version"],
             "no_transition": self.no_transition[part],
         }
         if self._pose is not None:
             columns["blocked"] = self.blocked[part]
             if blockers:
                 columns |= self._blocked_columns(part)
-            columns |= self._pose.columns(part, geometry=geometry)
+            columns |= self._pose.columns(part, geometry=geometry, narrow=narrow)
         return pd.DataFrame(columns, index=pd.RangeIndex(start, stop, name="step"), copy=copy)
 
     def _blocked_columns(self, part: slice) -> dict[str, Any]:
@@ -383,6 +452,39 @@ def blocker_texts(steps: pd.DataFrame, rows: npt.NDArray[np.int64]) -> npt.NDArr
         )  # (its body's)
         texts.append(blocker_label(kind, indices))
     return np.array(texts, object)[inverse.reshape(-1)]
+
+
+_STEP = operator.attrgetter("step")
+_AGENT = operator.attrgetter("agent")
+_TRUTH = operator.attrgetter("truth")
+_ACTION = operator.attrgetter("action")
+_STATE_BEFORE = operator.attrgetter("state_before")
+_INTERNAL_STATE = operator.attrgetter("internal_state")
+_SENSATION = operator.attrgetter("sensation")
+_FEEDBACK = operator.attrgetter("feedback")
+_MODEL_VERSION = operator.attrgetter("model_version")
+_NO_TRANSITION = operator.attrgetter("no_transition")
+
+_WIDTHS = (np.int8, np.int16, np.int32, np.int64)
+
+
+class _IntColumn:
+    """An integer column filled batch by batch, kept in the narrowest of int8 .. int64 that
+    holds every value put so far (copied into a wider one when a batch needs it): a long run's
+    state ids and versions take two or four bytes a step, not eight."""
+
+    def __init__(self, n_rows: int) -> None:
+        self.values: npt.NDArray[np.signedinteger[Any]] = np.empty(n_rows, np.int8)
+
+    def put(self, rows: slice, values: npt.ArrayLike) -> None:
+        batch = np.asarray(values, np.int64)
+        if len(batch):
+            low, high = int(batch.min()), int(batch.max())
+            limits = np.iinfo(self.values.dtype)
+            if low < limits.min or high > limits.max:
+                fits = (w for w in _WIDTHS if np.iinfo(w).min <= low and high <= np.iinfo(w).max)
+                self.values = self.values.astype(np.result_type(next(fits), self.values.dtype))
+        self.values[rows] = batch
 
 
 def _nullable(values: list[int | None], first: int, nulls: list[int]) -> list[int] | Any:

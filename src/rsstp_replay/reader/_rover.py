@@ -59,7 +59,7 @@ class _RoverColumns:
                 index=index,
             )
 
-    def columns(self, part: slice, *, geometry: bool) -> dict[str, Any]:
+    def columns(self, part: slice, *, geometry: bool, narrow: bool = False) -> dict[str, Any]:
         columns: dict[str, Any] = {
             name: values[part] for name, values in zip(POSE_COLUMNS, self.values, strict=True)
         }

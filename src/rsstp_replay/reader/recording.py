@@ -44,7 +44,7 @@ from rsstp_replay.errors import (
 from rsstp_replay.reader._chunks import Messages, gc_paused, message_times
 from rsstp_replay.reader._container import ChunkRef, open_container
 from rsstp_replay.reader._contract import CheckedFile, check_file
-from rsstp_replay.reader._decode import StepColumns, body_reader
+from rsstp_replay.reader._decode import LogTimes, StepColumns, body_reader
 from rsstp_replay.reader._models import (
     HEADS,
     ChainCheck,
@@ -128,7 +128,7 @@ class Recording:
         self.scenario = file.scenario
         self._step_chunks: dict[int, tuple[ChunkRef, bytes, Messages]] = {}
         self._agent: StepColumns | None = None
-        self._log_times: _Ints | None = None
+        self._log_times: LogTimes | None = None
         self._models: Sequence[ModelRecord] | None = None
         self._version_steps: list[int] | None = None
         self._events: pd.DataFrame | None = None
@@ -220,7 +220,7 @@ class Recording:
         """
         self._check_open()
         columns = self._step_columns(truth=True, numbers=geometry)
-        self._log_times = columns.log_time  # kept: the contract check needs no second pass
+        self._log_times = columns.log_times()  # kept: the contract check needs no second pass
         frame = columns.frame(geometry=geometry)
         if truth:
             frame["true_class"] = self.ground_truth().classes_of_table(frame)
@@ -230,8 +230,8 @@ class Recording:
         """The log time of each step message, in step order (the contract wants step x
         1,000,000 ns: :func:`~rsstp_replay.audits.contract.check_contract`)."""
         if self._log_times is None:
-            self._log_times = self._agent_columns().log_time
-        return self._log_times
+            self._log_times = self._agent_columns().log_times()
+        return self._log_times.values()
 
     def ground_truth(self, *, cache: bool = True) -> GroundTruth:
         """The scenario's ground truth, once per recording: read from the truth cache on disk
@@ -246,7 +246,10 @@ class Recording:
         columns = self._agent_columns()
         try:
             return Memory.from_arrays(
-                columns.action, columns.internal_state, columns.sensation, columns.feedback
+                columns.action.values,
+                columns.internal_state.values,
+                columns.sensation,
+                columns.feedback,
             )
         except MemoryRangeError as exc:
             raise CorruptRecording(f"{self.path}: the steps do not make a memory: {exc}") from None
@@ -258,23 +261,29 @@ class Recording:
         self._check_open()
         if self._events is None:
             self._events = self._event_table()
-        return self._events.copy()
+        return _event_texts(self._events)
 
     def steps_and_events(
-        self, *, geometry: bool = True, blockers: bool = True
+        self, *, geometry: bool = True, blockers: bool = True, narrow: bool = False
     ) -> tuple[pd.DataFrame, pd.DataFrame]:
         """:meth:`steps` and :meth:`events` in one read of the chunks (each alone reads
         every chunk, the events being among the steps): what an audit reads.
         ``blockers=False`` leaves out of the steps table what blocked a move
         (``blocked_kind`` and its indices; ``blocked`` stays): no audit reads them, and
-        they are a third of the table's memory without the geometry."""
+        they are a third of the table's memory without the geometry; ``narrow=True``: the
+        integer columns in the narrowest dtype that holds their values (the agent's ids and
+        versions, an arm's angles), not int64, and the events' ``text`` and ``data``
+        categorical (each distinct one once: a long run's blocked events repeat a few), in
+        the table the recording keeps (not a copy)."""
         self._check_open()
         events = _EventParts() if self._events is None else None
         columns = self._step_columns(truth=True, events=events, numbers=geometry)
-        self._log_times = columns.log_time
+        self._log_times = columns.log_times()
         if events is not None:
             self._events = events.table()
-        steps = columns.frame(geometry=geometry, blockers=blockers)
+        steps = columns.frame(geometry=geometry, blockers=blockers, narrow=narrow)
+        if narrow and self._events is not None:
+            return steps, self._events
         return steps, self.events()
 
     def _event_table(self) -> pd.DataFrame:
@@ -509,7 +518,7 @@ class Recording:
                 yield columns.frame(rows=slice(done, done + rows))
                 done += rows
         self._check_steps(columns)
-        self._log_times = columns.log_time
+        self._log_times = columns.log_times()
         if done < columns.n_rows:
             yield columns.frame(rows=slice(done, columns.n_rows))
 
@@ -583,7 +592,7 @@ class Recording:
         if index >= len(messages.times) or messages.times[index] != step * STEP_NS:
             return None
         part = memoryview(data)[messages.starts[index] : messages.ends[index]]
-        columns = StepColumns(1)
+        columns = StepColumns(1, keep_steps=True)
         try:
             columns.add([part], messages.times[index : index + 1])
         except BadStep as exc:
@@ -601,14 +610,14 @@ class _AgentRow(NamedTuple):
 
 
 def _row(columns: StepColumns, step: int) -> _AgentRow | None:
-    steps = columns.step[: columns.rows]
+    steps = columns.step
     index = int(np.searchsorted(steps, step))
     if index >= columns.rows or steps[index] != step:
         return None
     return _AgentRow(
-        int(columns.state_before[index]),
-        int(columns.internal_state[index]),
-        int(columns.model_version[index]),
+        int(columns.state_before.values[index]),
+        int(columns.internal_state.values[index]),
+        int(columns.model_version.values[index]),
     )
 
 
@@ -617,14 +626,21 @@ _EVENT_KIND_DTYPE = pd.CategoricalDtype(list(EVENT_KINDS))
 
 class _EventParts:
     """The events table built as its records are read, a part of at least :attr:`ROWS` rows
-    at a time, its text in Arrow strings: a long run has millions of events, and kept as
-    records until the end they took most of the memory of reading it."""
+    at a time: a long run has millions of events (a blocked move is one), and kept as records
+    until the end they took most of the memory of reading it. Their texts and data repeat (a
+    blocked event's are its action's and blocker's), so each distinct one is kept once, and
+    each event holds its index among them."""
 
     ROWS = 1 << 16
 
     def __init__(self) -> None:
         self.count = 0
-        self._parts: list[pd.DataFrame] = []
+        self._steps: list[npt.NDArray[np.int64]] = []
+        self._kinds: list[npt.NDArray[np.int8]] = []
+        self._texts: list[npt.NDArray[np.int32]] = []
+        self._datas: list[npt.NDArray[np.int32]] = []
+        self._text_codes: dict[str, int] = {}
+        self._data_codes: dict[str, int] = {}
         self._pending: list[Any] = []
 
     def add(self, records: list[Any]) -> None:
@@ -635,23 +651,58 @@ class _EventParts:
 
     def _flush(self) -> None:
         events, self._pending = self._pending, []
-        self._parts.append(
-            pd.DataFrame(
-                {
-                    "step": np.array([e.step for e in events], np.int64),
-                    "kind": pd.Categorical([e.kind for e in events], dtype=_EVENT_KIND_DTYPE),
-                    "text": pd.array([e.text for e in events], dtype="str"),
-                    "data": pd.array(
-                        [msgspec.json.encode(e.data).decode() for e in events], dtype="str"
-                    ),
-                }
+        k = len(events)
+        texts, datas = self._text_codes, self._data_codes
+        encode = msgspec.json.encode
+        self._steps.append(np.fromiter((e.step for e in events), np.int64, k))
+        self._kinds.append(np.fromiter((_EVENT_KIND_CODES[e.kind] for e in events), np.int8, k))
+        self._texts.append(
+            np.fromiter((texts.setdefault(e.text, len(texts)) for e in events), np.int32, k)
+        )
+        self._datas.append(
+            np.fromiter(
+                (datas.setdefault(encode(e.data).decode(), len(datas)) for e in events),
+                np.int32,
+                k,
             )
         )
 
     def table(self) -> pd.DataFrame:
-        """One row per event, in order, indexed ``0 .. n - 1``."""
-        if self._pending or not self._parts:
+        """One row per event, in order, indexed ``0 .. n - 1``; ``text`` and ``data`` are
+        categorical (their distinct values, once: :func:`_event_texts` makes them text)."""
+        if self._pending:
             self._flush()
-        if len(self._parts) == 1:
-            return self._parts[0]
-        return pd.concat(self._parts, ignore_index=True)
+
+        def joined(parts: list[npt.NDArray[Any]], dtype: type) -> npt.NDArray[Any]:
+            return np.concatenate(parts) if parts else np.empty(0, dtype)
+
+        def categorical(codes: npt.NDArray[np.int32], values: dict[str, int]) -> Any:
+            categories = pd.Index(list(values), dtype="str")
+            return pd.Categorical.from_codes(codes, dtype=pd.CategoricalDtype(categories))
+
+        return pd.DataFrame(
+            {
+                "step": joined(self._steps, np.int64),
+                "kind": pd.Categorical.from_codes(
+                    joined(self._kinds, np.int8), dtype=_EVENT_KIND_DTYPE
+                ),
+                "text": categorical(joined(self._texts, np.int32), self._text_codes),
+                "data": categorical(joined(self._datas, np.int32), self._data_codes),
+            }
+        )
+
+
+_EVENT_KIND_CODES = {kind: code for code, kind in enumerate(EVENT_KINDS)}
+
+
+def _event_texts(events: pd.DataFrame) -> pd.DataFrame:
+    """The events table of :meth:`Recording.events`: its categorical ``text`` and ``data``
+    as text columns (a new table)."""
+    return pd.DataFrame(
+        {
+            "step": events["step"].to_numpy(copy=True),
+            "kind": events["kind"].array.copy(),
+            "text": pd.array(events["text"].to_numpy(object), dtype="str"),
+            "data": pd.array(events["data"].to_numpy(object), dtype="str"),
+        }
+    )
