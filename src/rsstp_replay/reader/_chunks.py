@@ -30,7 +30,6 @@ __all__ = [
     "count_messages",
     "gc_paused",
     "message_channels",
-    "message_times",
     "Messages",
     "log_times_at",
     "message_bounds",
@@ -157,19 +156,6 @@ def log_times_at(data: bytes, offsets: npt.NDArray[np.int64]) -> npt.NDArray[np.
     raw = np.frombuffer(data, np.uint8)
     at = offsets[:, None] + np.arange(_LOG_TIME, _LOG_TIME + 8)
     times: npt.NDArray[np.int64] = raw[at].copy().view("<u8").ravel().astype(np.int64)
-    return times
-
-
-def message_times(data: bytes, channel: int) -> list[int]:
-    """The ``log_time`` of every message of ``channel`` in a chunk's records, in order
-    (slow: for error messages)."""
-    times = []
-    position = 0
-    while position + MESSAGE_TIME.size <= len(data):
-        opcode, length, found, _, log_time = MESSAGE_TIME.unpack_from(data, position)
-        if opcode == _MESSAGE_OP and found == channel:
-            times.append(log_time)
-        position += 9 + length
     return times
 
 

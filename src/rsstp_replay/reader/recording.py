@@ -41,7 +41,7 @@ from rsstp_replay.errors import (
     TableError,
     UnfinishedRecordingWarning,
 )
-from rsstp_replay.reader._chunks import Messages, gc_paused, message_times
+from rsstp_replay.reader._chunks import Messages, gc_paused
 from rsstp_replay.reader._container import ChunkRef, open_container
 from rsstp_replay.reader._contract import CheckedFile, check_file
 from rsstp_replay.reader._decode import LogTimes, StepColumns, body_reader
@@ -480,8 +480,7 @@ class Recording:
         try:
             columns.add(parts, log_times)
         except BadStep as exc:
-            times = message_times(data, self._file.channels["/rsstp/step"])
-            at = f"at step {times[exc.index] // STEP_NS} " if exc.index is not None else ""
+            at = f"at step {log_times[exc.index] // STEP_NS} " if exc.index is not None else ""
             raise CorruptRecording(
                 f"{self.path}: the step message {at}(chunk at byte {ref.offset}) is invalid: "
                 f"{exc.text}"
@@ -593,13 +592,7 @@ class Recording:
             return None
         part = memoryview(data)[messages.starts[index] : messages.ends[index]]
         columns = StepColumns(1, keep_steps=True)
-        try:
-            columns.add([part], messages.times[index : index + 1])
-        except BadStep as exc:
-            raise CorruptRecording(
-                f"{self.path}: the step message at step {step} (chunk at byte {ref.offset}) is "
-                f"invalid: {exc.text}"
-            ) from None
+        self._decode_steps(columns, ref, data, [part], messages.times[index : index + 1])
         return _row(columns, step)
 
 
