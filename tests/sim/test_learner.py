@@ -19,6 +19,8 @@ from rsstp_sim.runner import Runner
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies import AgentView
 from rsstp_sim.strategies._learner_hypothesis import Hypothesis
+from rsstp_sim.strategies._learner_identify import Identifier
+from rsstp_sim.strategies._learner_walk import Walker
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
@@ -744,3 +746,194 @@ def test_a_permutation_of_one_or_none_draws_nothing_from_the_generator() -> None
         before = rng.bit_generator.state
         assert rng.permutation(among).tolist() == among
         assert rng.bit_generator.state == before
+
+
+def _built_as_the_learner_builds(
+    world: list[list[int]], choices: list[tuple[int, int, bool]]
+) -> tuple[Hypothesis, dict[int, int]]:
+    """A hypothesis of ``world`` (``world[a][w]``: where action ``a`` leads from world state
+    ``w``; world state 0 senses) built by splits and confirmations as the learner makes them,
+    every confirmation right; each id stands for a world state (several for one: duplicates)."""
+    actions = tuple(range(len(world)))
+    h = Hypothesis(TransitionSystem.universal(actions), actions, landmark=0)
+    stands = {0: 0}
+    done: set[tuple[int, int]] = set()
+    for pick, _, fresh in choices:
+        open_pairs = [(s, a) for s in sorted(stands) for a in actions if (s, a) not in done]
+        if not open_pairs:
+            break
+        s, a = open_pairs[pick % len(open_pairs)]
+        target = world[a][stands[s]]
+        same = [t for t in sorted(stands) if stands[t] == target]
+        if fresh or not same:
+            t = h.create(s, a, target == 0, ())
+            stands[t] = target
+        else:
+            h.confirm(s, a, same[pick % len(same)])
+        done.add((s, a))
+    return h, stands
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.integers(2, 9).flatmap(
+        lambda w: st.tuples(
+            st.lists(st.permutations(range(w)), min_size=2, max_size=3),
+            st.lists(st.sets(st.integers(0, w - 1)), min_size=3, max_size=3),
+            st.lists(st.tuples(st.integers(0, 10**6), st.just(0), st.booleans()), max_size=60),
+        )
+    )
+)
+def test_only_states_of_one_world_state_are_merged_as_twins(
+    case: tuple[list[list[int]], list[set[int]], list[tuple[int, int, bool]]],
+) -> None:
+    # A world whose moves come from one state only (each action a permutation), except blocked
+    # moves (a blocked state stays where it is, so two states lead to it): the learner merges
+    # two states of its hypothesis when they lead by one action to a third that its confirmed
+    # transitions show to be another state than either, and then their successors by each
+    # action (Hypothesis.unify). Every merge joins ids of one world state, and the model keeps
+    # one transition per state and action: the confirmed one where there is one.
+    permutations, blocked, choices = case
+    world = [
+        [w if w in blocked[a] else p[w] for w in range(len(p))] for a, p in enumerate(permutations)
+    ]
+    h, stands = _built_as_the_learner_builds(world, choices)
+    merges = h.unify()
+    gone = {g for _, g in merges}
+    assert all(stands[keep] == stands[g] for keep, g in merges)
+    for s in stands:
+        assert h.alive[s] == (s not in gone)
+        if s in gone:
+            continue
+        for k, a in enumerate(h.actions):
+            successors = tuple(h.model.successors(s, a))
+            assert len(successors) == 1
+            t = int(h.next[s, k])
+            if t >= 0:
+                assert successors == (t,)
+                assert stands[t] == world[a][stands[s]]
+
+
+def test_a_state_taken_as_new_is_merged_once_it_leads_where_its_twin_does() -> None:
+    # A ring of four world states, two actions (one turning each way), state 0 sensed. The
+    # learner took 0 -a-> for a new state (1), then 1 -a-> (2), 2 -a-> (3), and 3 -a-> for a
+    # new state again (4: the world's 0). Once 4 -a-> is confirmed to lead to 1, where 0 -a->
+    # leads, 4 and 0 are one state; and so are their successors by the other action.
+    world = [[1, 2, 3, 0], [3, 0, 1, 2]]
+    actions = (0, 1)
+    h = Hypothesis(TransitionSystem.universal(actions), actions, landmark=0)
+    one = h.create(0, 0, False, (0,))
+    two = h.create(one, 0, False, (0, 0))
+    three = h.create(two, 0, False, (0, 0, 0))
+    four = h.create(three, 0, True, (0, 0, 0, 0))
+    h.confirm(one, 1, 0)
+    h.confirm(four, 1, three)
+    assert h.twins == []
+    h.confirm(four, 0, one)
+    assert h.twins == [(0, four)]
+    assert h.unify() == [(0, four)]
+    assert not h.alive[four]
+    assert h.confirmed(0, 1) == three
+    assert h.confirmed(three, 0) == 0
+    assert world[1][0] == 3 and world[0][3] == 0
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.integers(2, 10).flatmap(
+        lambda n: st.tuples(
+            st.lists(
+                st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
+            ),
+            st.lists(st.integers(0, n - 1), min_size=1, max_size=2 * n),
+            st.integers(0, 2),
+            st.integers(0, 2**32 - 1),
+        )
+    )
+)
+def test_a_lost_agent_takes_the_move_that_brings_its_candidates_together(
+    case: tuple[list[list[int]], list[int], int, int],
+) -> None:
+    # Searching for the landmark, the agent takes the action that brings its candidate states
+    # to the fewest states, each by a confirmed transition (-1: not confirmed), if fewer than
+    # they are; else the action it was about to take. Ties: the first in the run's order.
+    successors, candidates, planned, seed = case
+    actions = (7, 3, 5)
+    model = TransitionSystem.universal(actions)
+    memory = Memory()
+    memory.reset(model.current, False, 0.0)
+    agent = AgentView(memory, model, actions, np.random.default_rng(seed), lambda _text: None)
+    walker = Walker(agent)
+    h = walker.h
+    n = len(successors)
+    h._grow(n)
+    h.next[:n] = successors
+    h.alive[:n] = True
+    order = [int(k) for k in np.random.default_rng(seed).permutation(3)]
+    expected, fewest = actions[planned], len(set(candidates))
+    for k in order:
+        reached = [successors[c][k] for c in candidates]
+        if -1 not in reached and len(set(reached)) < fewest:
+            expected, fewest = actions[k], len(set(reached))
+    ids = np.asarray(candidates, dtype=np.int64)
+    assert walker.narrowing(ids, actions[planned]) == expected
+
+
+def test_a_candidate_is_ruled_out_when_a_third_state_already_moves_to_it_by_the_action() -> None:
+    # A ring of four world states, action 0 turning one way, 1 the other; state 0 sensed. The
+    # hypothesis knows 0 -0-> 1 -0-> 2 -0-> 3, each undone by 1. Where 3 -0-> leads, a path to
+    # the landmark may point at 2 (a walk that blocked moves brought to it); but 1 -0-> 2
+    # already, and the states are shown apart: two states would move to 2 by one action, so 2
+    # is ruled out; 0, whose move by 1 is not confirmed yet, is not.
+    actions = (0, 1)
+    model = TransitionSystem.universal(actions)
+    memory = Memory()
+    memory.reset(model.current, True, 1.0)
+    agent = AgentView(memory, model, actions, np.random.default_rng(0), lambda _text: None)
+    identifier = Identifier(agent, doubts=1)
+    h = identifier.h
+    one = h.create(0, 0, False, (0,))
+    two = h.create(one, 0, False, (0, 0))
+    three = h.create(two, 0, False, (0, 0, 0))
+    h.confirm(one, 1, 0)
+    h.confirm(two, 1, one)
+    h.confirm(three, 1, two)
+    assert h.inverses() == {0: 1, 1: 0}
+    assert h.apart(one, two) and h.apart(one, three) and h.apart(two, three)
+    assert not identifier.plausible(three, 0, two, 1)
+    assert identifier.plausible(three, 0, 0, 1)
+    assert identifier.plausible(three, 0, three, 1)  # (blocked: another question)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.integers(2, 12).flatmap(
+        lambda n: st.lists(
+            st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
+        )
+    )
+)
+def test_actions_are_found_not_to_commute_by_four_confirmed_squares_or_more(
+    successors: list[list[int]],
+) -> None:
+    # The learner draws on squares (a then b, b then a, one state) to guess where a move leads,
+    # except for two actions whose confirmed squares, four or more, mostly do not close (a
+    # rover's turn and step): counted here state by state.
+    actions = (7, 3, 5)
+    h = Hypothesis(TransitionSystem.universal(actions), actions, landmark=0)
+    n = len(successors)
+    h._grow(n)
+    h.next[:n] = successors
+    h.alive[:n] = True
+    h._changed()
+    shown = h.not_commuting()
+    for ka in range(3):
+        for kb in range(3):
+            closed = squares = 0
+            for s in range(n):
+                r, q = successors[s][ka], successors[s][kb]
+                if r < 0 or q < 0 or successors[r][kb] < 0 or successors[q][ka] < 0:
+                    continue
+                squares += 1
+                closed += successors[r][kb] == successors[q][ka]
+            assert shown[ka, kb] == (ka != kb and squares >= 4 and 2 * closed < squares)

@@ -110,9 +110,18 @@ class Hypothesis:
         self._toward: IntArray | None = None
         self._edits = 0
         self._inverse: tuple[int, dict[int, int]] = (-1, {})
+        self._commuting: tuple[int, BoolArray] = (-1, np.zeros((0, 0), dtype=bool))
         self._matched: tuple[tuple[int, bool], IntArray] = ((-1, False), np.zeros(0, np.int64))
         self.near_states = 1024
         """How many states a search meets one at a time before it goes a level at a time."""
+        self.twins: list[tuple[int, int]] = []
+        """Pairs of states found to be one world state, moves being one-to-one: both
+        lead by one action to a third state (:meth:`confirm`); :meth:`unify` merges them."""
+        self.one_to_one = not feels
+        """Whether a move that changes the state is taken to come from one state only (no two
+        states lead by the same action to a third): twins are looked for and merged, and
+        candidates checked against it. Not with ``feels`` (the states are then poses, told
+        apart by what is felt)."""
 
     # ----------------------------------------------------------------- queries
 
@@ -502,6 +511,28 @@ class Hypothesis:
         self._inverse = (self._edits, inverse)
         return inverse
 
+    def not_commuting(self) -> BoolArray:
+        """``[ka, kb]``: the confirmed squares show actions ``ka`` and ``kb`` do not commute:
+        of the states ``s`` with ``s -a-> -b->`` and ``s -b-> -a->`` both confirmed, at least
+        :data:`EVIDENCE`, fewer than half reach one state both ways (a rover's turn and step,
+        unlike two joints' turns). Too few squares show nothing."""
+        if self._commuting[0] == self._edits:
+            return self._commuting[1]
+        m = len(self.actions)
+        shown = np.zeros((m, m), dtype=bool)
+        rows = self.next[np.flatnonzero(self.alive)]
+        for ka in range(m):
+            for kb in range(ka + 1, m):
+                r, q = rows[:, ka], rows[:, kb]
+                both = (r >= 0) & (q >= 0)
+                y, z = self.next[r[both], kb], self.next[q[both], ka]
+                known = (y >= 0) & (z >= 0)
+                count = int(known.sum())
+                if count >= EVIDENCE and 2 * int((y[known] == z[known]).sum()) < count:
+                    shown[ka, kb] = shown[kb, ka] = True
+        self._commuting = (self._edits, shown)
+        return shown
+
     def reversible(self) -> bool:
         """Whether the confirmed transitions show an action undoing each action
         (:meth:`inverses`): then no move leads into a part of the world the agent cannot leave."""
@@ -616,6 +647,87 @@ class Hypothesis:
             self._added(s, t)
         elif before != t:
             self._changed()
+        if self.one_to_one and t != s:
+            self._look_for_twins(t, k)
+
+    def _look_for_twins(self, t: int, k: int) -> None:
+        """Queue as twins the states leading to ``t`` by column ``k`` that are shown to be
+        other states than ``t`` (:meth:`apart`): a move from them, not a blocked one."""
+        sources = [u for u, column in self.incoming.predecessors(t) if column == k and u != t]
+        if len(sources) < 2:
+            return
+        moved = [u for u in sources if self.apart(u, t)]
+        for u in moved[1:]:
+            self.twins.append((min(moved[0], u), max(moved[0], u)))
+
+    def apart(self, s: int, t: int) -> bool:
+        """Whether the confirmed transitions show ``s`` and ``t`` are two world states: their
+        labels differ, or one's path to the landmark, walked from the other, predicts another
+        sensation on the way."""
+        if self.labels[s] != self.labels[t]:
+            return True
+        distance, toward, label = self.distance, self.toward, self.label
+        for first, second in ((s, t), (t, s)):
+            if distance[first] >= FAR:
+                continue
+            a, b = first, second
+            while a != self.landmark:
+                k = int(toward[a])
+                a, b = int(self.next[a, k]), int(self.next[b, k])
+                if b < 0:
+                    break
+                if label[a] != label[b]:
+                    return True
+        return False
+
+    def unify(self) -> list[tuple[int, int]]:
+        """Merge the :attr:`twins` found, and the twins their merges show (their successors by
+        one action, both confirmed, are twins too); the merges done, as ``(kept, gone)``.
+
+        A pair the confirmed transitions show apart (:meth:`apart`) is not merged: a
+        confirmation is wrong somewhere, which the counterexamples and the verification find."""
+        merges: list[tuple[int, int]] = []
+        alias: dict[int, int] = {}
+
+        def find(s: int) -> int:
+            while s in alias:
+                s = alias[s]
+            return s
+
+        while self.twins and self.one_to_one:
+            a, b = self.twins.pop()
+            a, b = find(a), find(b)
+            if a == b:
+                continue
+            keep, gone = min(a, b), max(a, b)
+            if self.apart(keep, gone):  # (a wrong confirmation somewhere: not merged)
+                continue
+            model = self.model
+            for k, action in enumerate(self.actions):
+                tk, tg = int(self.next[keep, k]), int(self.next[gone, k])
+                if tg < 0:
+                    continue
+                tg = keep if tg == gone else tg
+                if tk < 0:
+                    self.confirm(keep, action, tg)
+                elif find(tk) != find(tg):
+                    self.twins.append((tk, tg))
+            self.merge(keep, gone)
+            alias[gone] = keep
+            merges.append((keep, gone))
+            for k, action in enumerate(self.actions):  # one successor by each action
+                targets = model.successors(keep, action)
+                wanted = int(self.next[keep, k])
+                wanted = wanted if wanted >= 0 else targets[0]
+                for v in targets:
+                    if v != wanted:
+                        model.delete(keep, v, action)
+                if wanted not in targets:
+                    model.add(keep, wanted, action)
+            for k in range(len(self.actions)):
+                self._look_for_twins(keep, k)
+            self.twins = [(find(x), find(y)) for x, y in self.twins if find(x) != find(y)]
+        return merges
 
     def unconfirm(self, s: int, action: int) -> None:
         """Withdraw a confirmed successor; the model keeps it as a conjecture."""

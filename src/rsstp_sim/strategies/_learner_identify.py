@@ -183,6 +183,13 @@ class Identifier(Walker):
                 ranked = sorted(survivors) + ranked
                 continue
             if at_landmark and survivors:
+                ruled = {c for c in survivors if not self.plausible(q, a, c, undo)}
+                if ruled:
+                    self.count("implausible", len(ruled))
+                    candidates -= ruled
+                    survivors -= ruled
+                    if not survivors:
+                        continue
                 # The predicted first: if nothing confirmed tells two apart, the likelier.
                 ordered = sorted(
                     survivors, key=lambda c: (ranked.index(c) if c in ranked else len(ranked), c)
@@ -199,11 +206,32 @@ class Identifier(Walker):
                 separate = word
                 tried -= survivors  # each may need its own path again after the separation
 
+    def plausible(self, q: int, a: int, c: int, undo: int | None) -> bool:
+        """Whether ``q -a-> c`` fits the confirmed transitions, moves being one-to-one
+        (:attr:`~Hypothesis.one_to_one`): not when ``a`` moves (``c`` shown apart from ``q``)
+        and another state shown apart from both already leads to ``c`` by ``a`` (two states
+        would), nor, while every action has an undoing one, when ``c``'s confirmed undo leads
+        to a state shown apart from ``q``. A path to the landmark can reach it from a state it
+        was not planned from, where blocked moves bring two walks together; these do not."""
+        h = self.h
+        if not h.one_to_one or c == q or not h.apart(q, c):
+            return True
+        k = h.column[a]
+        for u, column in h.incoming.predecessors(c):
+            if column == k and u not in (q, c) and h.apart(u, c) and h.apart(u, q):
+                return False
+        if undo is not None and h.reversible():
+            back = int(h.next[c, h.column[undo]])
+            if back >= 0 and back != q and h.apart(back, q):
+                return False
+        return True
+
     def predict(self, q: int, a: int, candidates: set[int], undo: int | None) -> list[int]:
         """Candidates for ``q -a->`` that confirmed transitions point at, most votes first.
 
         Two votes for ``c`` when ``c -undo-> q``; one for the far corner ``y`` of each square
-        ``p -b-> q``, ``p -a-> r -b-> y`` (actions that commute, as two joints' turns do).
+        ``p -b-> q``, ``p -a-> r -b-> y`` (actions that commute, as two joints' turns do: not
+        where the confirmed squares show ``a`` and ``b`` do not, :meth:`~Hypothesis.not_commuting`).
         """
         h = self.h
         votes: dict[int, int] = {}
@@ -213,7 +241,10 @@ class Identifier(Walker):
                 if h.next[c, k] == q:
                     votes[c] = votes.get(c, 0) + 2
         column = h.column[a]
+        apart = h.not_commuting()[column]
         for p, kb in h.incoming.predecessors(q):
+            if apart[kb]:
+                continue
             r = int(h.next[p, column])
             if r >= 0:
                 y = int(h.next[r, kb])

@@ -82,6 +82,17 @@ class Learning(Identifier):
         """One exploration, or the end game: forced deferrals, clean-up, minimisation,
         verification; then done, and a random walk that checks every prediction."""
         h = self.h
+        if h.twins:
+            merges = h.unify()
+            for keep, gone in merges:
+                self.forget(gone, keep)
+                if self.belief == gone:
+                    self.belief = keep
+            if merges:
+                self.count("twins", len(merges))
+            if self.belief is not None and not h.alive[self.belief]:
+                self.belief = None
+            return
         goal = self.goal()
         if goal is not None:
             word, pair = goal
@@ -232,6 +243,7 @@ class Learning(Identifier):
         """State ``gone`` merged into ``keep`` (or discarded): move or drop what names it."""
         self.made_by.pop(gone, None)
         for a in self.h.actions:
+            self.deferred.pop((gone, a), None)
             traces = self.drop_traces(gone, a)
             if traces and keep is not None:  # (the merge changed the edits: all are replayed)
                 self.traces.setdefault((keep, a), []).extend(traces)

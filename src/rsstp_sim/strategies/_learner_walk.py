@@ -12,7 +12,7 @@ from collections.abc import Generator
 import numpy as np
 
 from rsstp_sim.strategies._base import AgentView
-from rsstp_sim.strategies._learner_hypothesis import FAR, Hypothesis
+from rsstp_sim.strategies._learner_hypothesis import FAR, Hypothesis, IntArray
 
 __all__ = [
     "CONFINED_STEPS",
@@ -55,6 +55,10 @@ world of a thousand classes, lost early, can take thousands of steps to find it 
 UNPROVEN = 16
 """How many times longer the search lasts before the agent takes itself as confined when its
 confirmed transitions show no move that cannot be undone (:meth:`Walker.check_confined`)."""
+
+NARROWED = 64
+"""The most candidates for where it is that a lost agent brings together (:meth:`Walker.narrowing`)
+before it follows their paths: more would cost more per step than the walks they save."""
 
 Plan = Generator[int, bool, None]
 """A plan: yields the next action, receives the sensation that followed it."""
@@ -241,6 +245,8 @@ class Walker:
                 action = self.random_action()
             elif usable >= 0:
                 action = h.actions[int(h.toward[ids[usable]])]
+                if not climbing and 1 < len(ids) <= NARROWED:
+                    action = self.narrowing(ids, action)
             elif climbing:  # climb the feedback for a while, instead of a random run
                 if (yield from self.climb(LONGEST_RUN * len(h.actions))):
                     self.phase = phase
@@ -275,6 +281,23 @@ class Walker:
                         failed += 1
                 widened = True
                 ids = h.matching_ids(sensation, feel)
+
+    def narrowing(self, ids: IntArray, action: int) -> int:
+        """The action that brings the candidates ``ids`` to the fewest states, every one of
+        them by a confirmed transition (blocked moves bring several to one, as walking into an
+        obstacle brings every pose on the way to the pose against it), if fewer than they are
+        now; else ``action``. Walked on, the candidates become one and the agent is located."""
+        h = self.h
+        now = len(np.unique(ids))
+        best, fewest = action, now
+        for k in h._columns:
+            moved = h.next[ids, k]
+            if (moved < 0).any():
+                continue
+            count = len(np.unique(moved))
+            if count < fewest:
+                best, fewest = h.actions[k], count
+        return best
 
     def check_confined(self) -> None:
         """After a step of a search for the landmark: raise :class:`Confined` when the search

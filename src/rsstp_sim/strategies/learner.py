@@ -35,6 +35,12 @@ class LearnerStrategy(StrategyBase):
     the confirmed transitions and only order the tests. A wrong prediction on a confirmed path
     is a counterexample: the landmark serves as the reset of Rivest and Schapire's analysis,
     which finds the wrong transition.
+    With boolean feedback, taking moves to be one-to-one (a move that changes the state comes
+    from one state only, as the arm's and the rover's do), two states leading by one action to
+    a third shown apart from both are merged as one, with their successors (``twins``); a
+    candidate that a third state already moves to by the same action is ruled out
+    (``implausible``); squares of actions shown not to commute cast no votes; and, lost among at
+    most 64 candidates, the agent first takes the move that brings them together.
     When every transition is confirmed the hypothesis is minimised (``merge``), the tests kept
     for each transition are replayed against it and the doubtful ones taken again; then
     :attr:`done` is set and the learner ends the run (``agent.stop``): the recording ends
