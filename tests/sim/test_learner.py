@@ -31,6 +31,22 @@ LEARNER_SOURCES = sorted(
 )
 
 
+def _successors(n: int) -> st.SearchStrategy[list[list[int]]]:
+    """Tables of ``n`` states by three actions: each state's successor by each (-1: not
+    confirmed)."""
+    return st.lists(
+        st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
+    )
+
+
+def _agent_view(actions: tuple[int, ...], sensation: bool, seed: int) -> AgentView:
+    """An agent at the start of a run: the one-state model, the first sensation felt."""
+    model = TransitionSystem.universal(actions)
+    memory = Memory()
+    memory.reset(model.current, sensation, float(sensation))
+    return AgentView(memory, model, actions, np.random.default_rng(seed), lambda _text: None)
+
+
 def learn(
     scenario: Scenario, budget: int, *, seed: int = 0, stop: bool = True
 ) -> tuple[LearnerStrategy, Runner]:
@@ -455,9 +471,7 @@ def _first_shortest_word(
 @given(
     st.integers(2, 14).flatmap(
         lambda n: st.tuples(
-            st.lists(
-                st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
-            ),
+            _successors(n),
             st.integers(0, n - 1),
             st.sets(st.integers(0, n - 1), max_size=n),
             st.integers(0, 2**32 - 1),
@@ -530,9 +544,7 @@ def _separating_word_pair_by_pair(
 @given(
     st.integers(2, 12).flatmap(
         lambda n: st.tuples(
-            st.lists(
-                st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
-            ),
+            _successors(n),
             st.lists(st.booleans(), min_size=n, max_size=n),
             st.integers(0, n - 1),
             st.integers(0, n - 1),
@@ -842,9 +854,7 @@ def test_a_state_taken_as_new_is_merged_once_it_leads_where_its_twin_does() -> N
 @given(
     st.integers(2, 10).flatmap(
         lambda n: st.tuples(
-            st.lists(
-                st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
-            ),
+            _successors(n),
             st.lists(st.integers(0, n - 1), min_size=1, max_size=2 * n),
             st.integers(0, 2),
             st.integers(0, 2**32 - 1),
@@ -859,11 +869,7 @@ def test_a_lost_agent_takes_the_move_that_brings_its_candidates_together(
     # they are; else the action it was about to take. Ties: the first in the run's order.
     successors, candidates, planned, seed = case
     actions = (7, 3, 5)
-    model = TransitionSystem.universal(actions)
-    memory = Memory()
-    memory.reset(model.current, False, 0.0)
-    agent = AgentView(memory, model, actions, np.random.default_rng(seed), lambda _text: None)
-    walker = Walker(agent)
+    walker = Walker(_agent_view(actions, False, seed))
     h = walker.h
     n = len(successors)
     h._grow(n)
@@ -885,12 +891,7 @@ def test_a_candidate_is_ruled_out_when_a_third_state_already_moves_to_it_by_the_
     # the landmark may point at 2 (a walk that blocked moves brought to it); but 1 -0-> 2
     # already, and the states are shown apart: two states would move to 2 by one action, so 2
     # is ruled out; 0, whose move by 1 is not confirmed yet, is not.
-    actions = (0, 1)
-    model = TransitionSystem.universal(actions)
-    memory = Memory()
-    memory.reset(model.current, True, 1.0)
-    agent = AgentView(memory, model, actions, np.random.default_rng(0), lambda _text: None)
-    identifier = Identifier(agent, doubts=1)
+    identifier = Identifier(_agent_view((0, 1), True, 0), doubts=1)
     h = identifier.h
     one = h.create(0, 0, False, (0,))
     two = h.create(one, 0, False, (0, 0))
@@ -906,13 +907,7 @@ def test_a_candidate_is_ruled_out_when_a_third_state_already_moves_to_it_by_the_
 
 
 @settings(max_examples=200, deadline=None)
-@given(
-    st.integers(2, 12).flatmap(
-        lambda n: st.lists(
-            st.lists(st.integers(-1, n - 1), min_size=3, max_size=3), min_size=n, max_size=n
-        )
-    )
-)
+@given(st.integers(2, 12).flatmap(_successors))
 def test_actions_are_found_not_to_commute_by_four_confirmed_squares_or_more(
     successors: list[list[int]],
 ) -> None:
