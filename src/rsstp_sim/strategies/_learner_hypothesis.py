@@ -694,7 +694,7 @@ class Hypothesis:
                 s = alias[s]
             return s
 
-        while self.twins and self.one_to_one:
+        while self.twins:  # (queued only while one_to_one)
             a, b = self.twins.pop()
             a, b = find(a), find(b)
             if a == b:
