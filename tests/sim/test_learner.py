@@ -20,6 +20,7 @@ from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies import AgentView
 from rsstp_sim.strategies._learner_hypothesis import Hypothesis
 from rsstp_sim.strategies._learner_identify import Identifier
+from rsstp_sim.strategies._learner_plan import Learning
 from rsstp_sim.strategies._learner_walk import Walker
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.transition_system import Operation, TransitionSystem
@@ -883,6 +884,27 @@ def test_a_lost_agent_takes_the_move_that_brings_its_candidates_together(
             expected, fewest = actions[k], len(set(reached))
     ids = np.asarray(candidates, dtype=np.int64)
     assert walker.narrowing(ids, actions[planned]) == expected
+
+
+def test_what_is_left_to_explore_out_of_the_landmarks_reach_is_dropped_not_searched_for() -> None:
+    # A counterexample can withdraw the only confirmed transition into a state: its open
+    # actions are then out of reach of every confirmed path from the landmark. At the
+    # landmark, the agent does not take itself for lost (it would search for the landmark it
+    # is at, for ever): there is nothing to walk to, and the states no confirmed path from
+    # the landmark reaches are discarded, the agent still located.
+    learning = Learning(_agent_view((0, 1), True, 0), doubts=1)
+    h = learning.h
+    stray = h.create(h.landmark, 0, False, (0,))
+    h.confirm(h.landmark, 0, h.landmark)
+    h.confirm(h.landmark, 1, h.landmark)
+    assert h.incoming.open[stray] == 2  # (both of its actions still to explore)
+    learning.belief = h.landmark
+    assert learning.goal() is None
+    with pytest.raises(StopIteration):
+        next(learning.advance())  # (it discards without taking a step)
+    assert not h.alive[stray]
+    assert learning.belief == h.landmark
+    assert h.is_complete()
 
 
 def test_a_candidate_is_ruled_out_when_a_third_state_already_moves_to_it_by_the_action() -> None:

@@ -205,6 +205,8 @@ class Learning(Identifier):
             word = h.path(belief, h.landmark)
             if word is not None:
                 return word, None
+        if belief == h.landmark:
+            return None  # (what is left to explore is out of the landmark's reach: garbage)
         self.belief = None  # nothing reachable from here: find the landmark again
         return [], None
 
