@@ -940,9 +940,11 @@ def test_actions_are_found_not_to_commute_by_four_confirmed_squares_or_more(
     h = Hypothesis(TransitionSystem.universal(actions), actions, landmark=0)
     n = len(successors)
     h._grow(n)
-    h.next[:n] = successors
     h.alive[:n] = True
-    h._changed()
+    for s, row in enumerate(successors):  # (written as the learner writes them, edit by edit)
+        for k, t in enumerate(row):
+            h.incoming.set(h.next, s, k, t)
+    h._edits += 1
     shown = h.not_commuting()
     for ka in range(3):
         for kb in range(3):

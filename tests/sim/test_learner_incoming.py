@@ -13,12 +13,15 @@ from rsstp_sim.strategies._learner_incoming import Incoming
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.transition_system import TransitionSystem
 
+Counts = list[list[int]]
+
 
 def recount(
     rows: list[list[int]], alive: set[int]
-) -> tuple[dict[int, set[tuple[int, int]]], list[list[int]], list[list[int]], list[int]]:
+) -> tuple[dict[int, set[tuple[int, int]]], Counts, Counts, list[int], Counts, Counts]:
     """What :class:`Incoming` keeps, counted from scratch in plain Python: the transitions into
-    each state, ``back`` and ``known`` by pair of columns, the open columns of each state."""
+    each state, ``back`` and ``known`` by pair of columns, the open columns of each state, and
+    the squares (``a < b``) confirmed and closed."""
     width = len(rows[0]) if rows else 0
     into: dict[int, set[tuple[int, int]]] = {}
     back = [[0] * width for _ in range(width)]
@@ -35,17 +38,29 @@ def recount(
                     known[a][b] += 1
                     back[a][b] += u == s
     opened = [sum(t < 0 for t in row) if s in alive else 0 for s, row in enumerate(rows)]
-    return into, back, known, opened
+    squares = [[0] * width for _ in range(width)]
+    closed = [[0] * width for _ in range(width)]
+    for row in rows:
+        for a in range(width):
+            for b in range(a + 1, width):
+                r, q = row[a], row[b]
+                if r < 0 or q < 0 or rows[r][b] < 0 or rows[q][a] < 0:
+                    continue
+                squares[a][b] += 1
+                closed[a][b] += rows[r][b] == rows[q][a]
+    return into, back, known, opened, squares, closed
 
 
 def assert_kept(incoming: Incoming, next_: np.ndarray, alive: set[int], n: int) -> None:
     rows = next_[:n].tolist()
-    into, back, known, opened = recount(rows, alive)
+    into, back, known, opened, squares, closed = recount(rows, alive)
     kept = {t: set(incoming.predecessors(t)) for t in range(n)}
     assert {t: v for t, v in kept.items() if v} == into
     assert incoming.back == back
     assert incoming.known == known
     assert incoming.open[:n].tolist() == opened
+    assert incoming.squares == squares
+    assert incoming.closed == closed
 
 
 @settings(max_examples=200, deadline=None)

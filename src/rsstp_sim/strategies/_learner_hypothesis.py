@@ -518,18 +518,10 @@ class Hypothesis:
         unlike two joints' turns). Too few squares show nothing."""
         if self._commuting[0] == self._edits:
             return self._commuting[1]
-        m = len(self.actions)
-        shown = np.zeros((m, m), dtype=bool)
-        rows = self.next[np.flatnonzero(self.alive)]
-        for ka in range(m):
-            for kb in range(ka + 1, m):
-                r, q = rows[:, ka], rows[:, kb]
-                both = (r >= 0) & (q >= 0)
-                y, z = self.next[r[both], kb], self.next[q[both], ka]
-                known = (y >= 0) & (z >= 0)
-                count = int(known.sum())
-                if count >= EVIDENCE and 2 * int((y[known] == z[known]).sum()) < count:
-                    shown[ka, kb] = shown[kb, ka] = True
+        squares = np.asarray(self.incoming.squares, dtype=np.int64)
+        closed = np.asarray(self.incoming.closed, dtype=np.int64)
+        shown = (squares >= EVIDENCE) & (2 * closed < squares)
+        shown |= shown.T
         self._commuting = (self._edits, shown)
         return shown
 

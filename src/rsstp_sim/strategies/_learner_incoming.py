@@ -10,6 +10,10 @@ confirmed successor through :meth:`Incoming.set`, which keeps, beside its ``next
 - for each pair of action columns ``(a, b)``, among the confirmed moves ``s -a-> t`` with
   ``t != s``: how many have ``t -b-> s`` (``back``) and how many have a confirmed ``t -b->``
   at all (``known``), the counts that tell which action undoes which;
+- for each pair of action columns ``(a, b)``, ``a < b``, among the states ``s`` with
+  ``s -a-> r -b-> y`` and ``s -b-> q -a-> z`` all confirmed (a *square*): how many there are
+  (``squares``) and how many close, ``y == z`` (``closed``), the counts that tell which actions
+  commute;
 - for each state, how many of its actions have no confirmed successor (``open``).
 """
 
@@ -26,6 +30,8 @@ class Incoming:
 
     ``into[t]``: the codes ``s * width + k`` of the confirmed ``s -k-> t`` (k an action column).
     ``back[a][b]`` and ``known[a][b]``: the counts of the module docstring, by column.
+    ``squares[a][b]`` and ``closed[a][b]`` (``a < b``; 0 elsewhere): the squares of the module
+    docstring, over every row of ``next_`` (a state gone has an empty row).
     ``open[s]``: the columns of ``s`` with no confirmed successor, for the states
     :meth:`open_row` was told are alive (0 for the others).
     """
@@ -35,6 +41,8 @@ class Incoming:
         self.into: dict[int, set[int]] = {}
         self.back = [[0] * width for _ in range(width)]
         self.known = [[0] * width for _ in range(width)]
+        self.squares = [[0] * width for _ in range(width)]
+        self.closed = [[0] * width for _ in range(width)]
         self.open: NDArray[np.int64] = np.zeros(capacity, dtype=np.int64)
         self._alive: set[int] = set()
 
@@ -68,6 +76,10 @@ class Incoming:
         into = self.into
         back, known = self.back, self.known
         code = s * width + k
+        # The squares s -k-> is a side of: those from s, and from each state leading to s.
+        corners = {s, *(other // width for other in into.get(s, ()))}
+        for p in corners:
+            self._squares(next_, p, -1)
         if old >= 0:
             if old != s:
                 self._count(next_, s, k, old, -1)
@@ -90,6 +102,26 @@ class Incoming:
                 self._count(next_, s, k, t, 1)
         if s in self._alive:
             self.open[s] += (t < 0) - (old < 0)
+        for p in corners:
+            self._squares(next_, p, 1)
+
+    def _squares(self, next_: NDArray[np.int64], p: int, sign: int) -> None:
+        """Count the squares from ``p`` in or out (``sign``) of ``squares``/``closed``."""
+        row = next_[p].tolist()
+        after = next_[row].tolist()  # (the rows of -1 read the last row: not used)
+        squares, closed = self.squares, self.closed
+        width = self.width
+        for a in range(width - 1):
+            if row[a] < 0:
+                continue
+            after_r = after[a]
+            for b in range(a + 1, width):
+                if row[b] < 0:
+                    continue
+                y, z = after_r[b], after[b][a]
+                if y >= 0 and z >= 0:
+                    squares[a][b] += sign
+                    closed[a][b] += sign * (y == z)
 
     def _count(self, next_: NDArray[np.int64], s: int, a: int, t: int, sign: int) -> None:
         """Count the move ``s -a-> t`` (``t != s``) in or out (``sign``) of ``back``/``known``."""
