@@ -114,6 +114,9 @@ class Hypothesis:
         self._matched: tuple[tuple[int, bool], IntArray] = ((-1, False), np.zeros(0, np.int64))
         self.near_states = 1024
         """How many states a search meets one at a time before it goes a level at a time."""
+        self._far = False
+        """The last search met more than :attr:`near_states` states: the next goes a level at a
+        time from the start (searches late in a run go far, one after another)."""
         self.twins: list[tuple[int, int]] = []
         """Pairs of states found to be one world state, moves being one-to-one: both
         lead by one action to a third state (:meth:`confirm`); :meth:`unify` merges them."""
@@ -416,18 +419,21 @@ class Hypothesis:
         numpy pass per distance from ``source``: each level's successors in the order the
         first-in first-out search meets them (state by state in the level's order, action by
         action), each state kept where it is first met; so the state found, and its word, are
-        the same either way."""
+        the same either way. After a search that met more than that, the next goes a level at
+        a time from the start, until one meets fewer again."""
         if wanted[source]:
             return [], source
-        near = self._search_near(source, wanted)
-        if not isinstance(near, _TooFar):
-            return near
+        if not self._far:
+            near = self._search_near(source, wanted)
+            if not isinstance(near, _TooFar):
+                return near
         width = len(self.actions)
         columns = np.asarray(self._columns, dtype=np.int64)
         seen = np.zeros(len(self.label), dtype=bool)
         seen[source] = True
         level = np.asarray([source], dtype=np.int64)
         reached: list[IntArray] = []  # per level: where in the level before each state came from
+        count = 1  # (the states met)
         while len(level):
             met = self.next[level[:, None], columns].ravel()  # (the level's rows only)
             where = np.flatnonzero(met >= 0)
@@ -437,8 +443,10 @@ class Hypothesis:
             level = met[where]
             seen[level] = True
             reached.append(where)
+            count += len(level)
             goals = np.flatnonzero(wanted[level])
             if len(goals):
+                self._far = count > self.near_states
                 at = int(goals[0])
                 found = int(level[at])
                 word: list[int] = []
@@ -447,6 +455,7 @@ class Hypothesis:
                     at = int(came[at]) // width
                 word.reverse()
                 return word, found
+        self._far = count > self.near_states
         return None
 
     def _search_near(
