@@ -4,7 +4,7 @@
     PYTHONPATH=src python bench/worlds.py --max-n 2000 --seeds 1       # the small ones, seed 0
     PYTHONPATH=src python bench/worlds.py --worlds 60 --seeds 3 --aalpy-seconds 120
     PYTHONPATH=src python bench/worlds.py --scheduler tcp://host:8786  # an existing cluster
-    PYTHONPATH=src python bench/worlds.py --write worlds/              # the scenario files
+    PYTHONPATH=src python bench/worlds.py --write worlds/              # the scenario files, no runs
 
 The generator (:func:`generate`) draws world ``i`` of family seed ``--family`` (default 0)
 from its own generator, ``default_rng([family, i])``: 2 to 4 joints, a step of 5 to 30
@@ -304,7 +304,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--scheduler", help="an existing Dask scheduler's address")
     parser.add_argument("--aalpy-seconds", type=float, default=0.0)
     parser.add_argument("--list", action="store_true", help="the worlds only, no runs")
-    parser.add_argument("--write", type=Path, help="write the scenario files to this folder")
+    parser.add_argument(
+        "--write", type=Path, help="write the scenario files to this folder, no runs"
+    )
     parser.add_argument("--only", nargs="*", help="these worlds only (by name)")
     parser.add_argument("--out", type=Path, default=Path("bench-worlds"))
     args = parser.parse_args(argv)
@@ -343,7 +345,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             for w in worlds:
                 (args.write / f"{w.name}.toml").write_text(w.source, encoding="utf-8")
                 (args.write / f"{w.name}-float.toml").write_text(w.twin(), encoding="utf-8")
-        if args.list:
+        if args.list or args.write:  # (the worlds only: no runs)
             return 0
         modes = ("bool", "float") if args.mode == "both" else (args.mode,)
         tasks = [(w, s, m) for w in worlds for s in range(args.seeds) for m in modes]
