@@ -140,6 +140,12 @@ class Hypothesis:
         them alone holds while it stays the same."""
         return self._edits
 
+    @property
+    def columns(self) -> list[int]:
+        """The action columns in the run's order (drawn once by ``rng``): the order in which
+        searches and ties try the actions."""
+        return self._columns
+
     def states(self) -> list[int]:
         return [int(s) for s in np.flatnonzero(self.alive)]
 

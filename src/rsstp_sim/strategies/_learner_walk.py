@@ -290,7 +290,7 @@ class Walker:
         h = self.h
         now = len(np.unique(ids))
         best, fewest = action, now
-        for k in h._columns:
+        for k in h.columns:
             moved = h.next[ids, k]
             if (moved < 0).any():
                 continue
