@@ -135,24 +135,29 @@ class Identifier(Walker):
                     if way_back is not None:
                         script, follow, returned = [undo, *way_back], False, True
                 if first is None and not script:
-                    untried = [c for c in candidates if c not in tried and distance[c] < FAR]
+                    pool = np.fromiter(candidates, dtype=np.int64, count=len(candidates))
+                    pool = pool[distance[pool] < FAR]
+                    if tried:
+                        pool = pool[~np.isin(pool, list(tried))]
                     if came_back:
                         # The way back reached the landmark: a candidate whose confirmed
                         # transition by ``undo`` leads elsewhere is not it.
                         column = h.column[undo] if undo is not None else 0
-                        untried = [c for c in untried if h.next[c, column] < 0]
-                        if not untried or len(untried) > self.doubts or tried - set(ranked):
+                        pool = pool[h.next[pool, column] < 0]
+                    pool.sort()
+                    if came_back:
+                        if not len(pool) or len(pool) > self.doubts or tried - set(ranked):
                             self.count("taken_as_new")
                             self.new(q, a, label, access, here=False, feel=feel)
                             return
-                    if not untried:  # nothing can tell these candidates apart yet
+                    if not len(pool):  # nothing can tell these candidates apart yet
                         self.count("deferred")
                         self.deferred[(q, a)] = Deferral(
                             frozenset(candidates), access, label, h.version, feel
                         )
                         return
-                    nearest = min(distance[c] for c in untried)
-                    first = self.pick(sorted(c for c in untried if distance[c] == nearest))
+                    far = distance[pool]
+                    first = self.pick(pool[far == far.min()].tolist())
                 if first is not None:
                     tried.add(first)
             if not here:
@@ -237,8 +242,8 @@ class Identifier(Walker):
         votes: dict[int, int] = {}
         if undo is not None:
             k = h.column[undo]
-            for c in candidates:
-                if h.next[c, k] == q:
+            for c, column in h.incoming.predecessors(q):  # (the states c -undo-> q)
+                if column == k and c in candidates:
                     votes[c] = votes.get(c, 0) + 2
         column = h.column[a]
         apart = h.not_commuting()[column]
@@ -329,8 +334,8 @@ class Identifier(Walker):
                 self.belief = int(position[0])
                 self.beliefs[-1] = self.belief
                 return {int(ids[0])}, {int(ids[0])}, False, int(ids[0])
-        survivors = {int(s) for s in ids[tracked]} if at_landmark else set()
-        return survivors, {int(s) for s in ids}, at_landmark, None
+        survivors = set(ids[tracked].tolist()) if at_landmark else set()
+        return survivors, set(ids.tolist()), at_landmark, None
 
     def _session_few(
         self,
