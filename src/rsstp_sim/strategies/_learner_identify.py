@@ -144,8 +144,6 @@ class Identifier(Walker):
                         # transition by ``undo`` leads elsewhere is not it.
                         column = h.column[undo] if undo is not None else 0
                         pool = pool[h.next[pool, column] < 0]
-                    pool.sort()
-                    if came_back:
                         if not len(pool) or len(pool) > self.doubts or tried - set(ranked):
                             self.count("taken_as_new")
                             self.new(q, a, label, access, here=False, feel=feel)
@@ -156,6 +154,7 @@ class Identifier(Walker):
                             frozenset(candidates), access, label, h.version, feel
                         )
                         return
+                    pool.sort()  # (a choice among equals, by id)
                     far = distance[pool]
                     first = self.pick(pool[far == far.min()].tolist())
                 if first is not None:
