@@ -120,6 +120,10 @@ class Hypothesis:
         self.twins: list[tuple[int, int]] = []
         """Pairs of states found to be one world state, moves being one-to-one: both
         lead by one action to a third state (:meth:`confirm`); :meth:`unify` merges them."""
+        self.shown_apart: dict[tuple[int, int], int] = {}
+        """Pairs of states (the lower id first) the world showed to be two world states, a
+        counterexample's analysis (:meth:`~Learning.analyse`): its transition ``q -a->`` led to
+        the other state, not to the wrong one, the value. :meth:`apart` holds for them."""
         self.one_to_one = not feels
         """Whether a move that changes the state is taken to come from one state only (no two
         states lead by the same action to a third): twins are looked for and merged, and
@@ -245,19 +249,23 @@ class Hypothesis:
         outputs: tuple[bool, ...],
         via: tuple[int, int],
         feels: tuple[float, ...] = (),
-    ) -> list[int]:
+        among: IntArray | None = None,
+    ) -> IntArray:
         """The states ``c`` from which ``word`` yields ``outputs`` (the first: ``c``'s own
         label) and ``feels`` (with :attr:`feels`), if ``via`` leads to ``c`` (see
-        :meth:`step`)."""
+        :meth:`step`); of ``among`` only, if given (live states, in increasing order)."""
         felt = feels if self.feels and feels else (0.0,) * len(outputs)
-        start = self.matching_ids(outputs[0], felt[0])
+        if among is None:
+            start = self.matching_ids(outputs[0], felt[0])
+        else:
+            start = among[self.agree(among, outputs[0], felt[0])]
         position = start.copy()
         for action, sensation, feel in zip(word, outputs[1:], felt[1:], strict=True):
             moved = self.step(start, position, action, via)
             keep = moved >= 0
             keep[keep] = self.agree(moved[keep], sensation, feel)
             start, position = start[keep], moved[keep]
-        return [int(s) for s in start]
+        return start
 
     def set_feel(self, s: int, feel: float) -> None:
         """What is felt at the world state ``s`` stands for (first felt now)."""
@@ -671,7 +679,7 @@ class Hypothesis:
         """Whether the confirmed transitions show ``s`` and ``t`` are two world states: their
         labels differ, or one's path to the landmark, walked from the other, predicts another
         sensation on the way."""
-        if self.labels[s] != self.labels[t]:
+        if self.labels[s] != self.labels[t] or (min(s, t), max(s, t)) in self.shown_apart:
             return True
         distance, toward, label = self.distance, self.toward, self.label
         for first, second in ((s, t), (t, s)):
@@ -707,7 +715,10 @@ class Hypothesis:
             if a == b:
                 continue
             keep, gone = min(a, b), max(a, b)
-            if self.apart(keep, gone):  # (a wrong confirmation somewhere: not merged)
+            if self.apart(keep, gone) or self.separating_word(keep, gone) is not None:
+                # A wrong confirmation somewhere: not merged (a merge would merge their
+                # successors too, and spread the error).
+                self._withdraw_shared((keep, gone))
                 continue
             model = self.model
             for k, action in enumerate(self.actions):
@@ -735,6 +746,19 @@ class Hypothesis:
                 self._look_for_twins(keep, k)
             self.twins = [(find(x), find(y)) for x, y in self.twins if find(x) != find(y)]
         return merges
+
+    def _withdraw_shared(self, pair: tuple[int, int]) -> None:
+        """Two states the world showed apart (:attr:`shown_apart`) lead by one action to one
+        state: moves being one-to-one, one of the two is wrong. The wrong state's is withdrawn
+        (its transitions were confirmed before the counterexample, the other's after)."""
+        wrong = self.shown_apart.get(pair)
+        if wrong is None:
+            return
+        other = pair[0] if wrong == pair[1] else pair[1]
+        for k, action in enumerate(self.actions):
+            t = int(self.next[wrong, k])
+            if t >= 0 and t not in pair and t == self.next[other, k]:
+                self.unconfirm(wrong, action)
 
     def unconfirm(self, s: int, action: int) -> None:
         """Withdraw a confirmed successor; the model keeps it as a conjecture."""

@@ -187,7 +187,11 @@ class Identifier(Walker):
                 ranked = sorted(survivors) + ranked
                 continue
             if at_landmark and survivors:
-                ruled = {c for c in survivors if not self.plausible(q, a, c, undo)}
+                # (The verification tests against the complete hypothesis, not these rules:
+                # Learning.reverify.)
+                ruled = set()
+                if not self.checking:
+                    ruled = {c for c in survivors if not self.plausible(q, a, c, undo)}
                 if ruled:
                     self.count("implausible", len(ruled))
                     candidates -= ruled
@@ -461,11 +465,14 @@ class Identifier(Walker):
         """Replay the tests kept for ``(s, k)``: whether they single out its successor."""
         h = self.h
         a = h.actions[k]
-        agreeing: set[int] | None = None
+        target = int(h.next[s, k])
+        agreeing: NDArray[np.int64] | None = None  # (each test replayed from those left)
         for word, outputs, felt in self.traces.get((s, a), ()):
-            found = set(h.consistent(word, outputs, (s, a), felt))
-            agreeing = found if agreeing is None else agreeing & found
-        self._singles[s, k] = agreeing == {int(h.next[s, k])}
+            agreeing = h.consistent(word, outputs, (s, a), felt, among=agreeing)
+            if not (agreeing == target).any():
+                break
+        single = agreeing is not None and len(agreeing) == 1 and int(agreeing[0]) == target
+        self._singles[s, k] = single
 
     def return_to(
         self, q: int, a: int, route: tuple[int, ...] | None
