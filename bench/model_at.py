@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from rsstp_replay import open_recording
+from rsstp_replay.reader import version_heads
 
 
 def main() -> None:
@@ -32,7 +33,7 @@ def main() -> None:
         started = time.perf_counter()
         recording.model_at(recording.n_steps)
         first = time.perf_counter() - started
-        versions = recording.model_versions()
+        versions = version_heads(recording.model_versions())  # (not each version rebuilt)
         keyframes = sum(record.keyframe for record in versions)
         steps = np.linspace(0, recording.n_steps, args.samples).astype(np.int64).tolist()
         times = []

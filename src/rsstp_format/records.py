@@ -706,9 +706,13 @@ _OPERATION_ARGS = _schema(
 )
 
 
-class OperationRecord(_Record, frozen=True, kw_only=True):
+class OperationRecord(_Record, frozen=True, kw_only=True, gc=False):
     """One model operation, as :class:`~rsstp_sim.transition_system.Operation` (``result``
-    None, absent, for the operations that create nothing)."""
+    None, absent, for the operations that create nothing).
+
+    Not tracked by the garbage collector (``gc=False``, as :class:`ModelRecord`): frozen and
+    holding ids alone, it can be part of no reference cycle, and a reader keeps one per
+    operation of a run (tens of thousands), which every full collection walked."""
 
     kind: Annotated[
         OperationKind, _schema("split a state, merge two states, add or delete a transition")
@@ -737,7 +741,7 @@ class OperationRecord(_Record, frozen=True, kw_only=True):
         return Operation(self.kind, self.args, self.result, self.changed)
 
 
-class ModelRecord(_Record, frozen=True, kw_only=True):
+class ModelRecord(_Record, frozen=True, kw_only=True, gc=False):
     """``rsstp.Model`` on ``/rsstp/model``: a model version, as a keyframe (the whole model)
     or as a change (the operations since the previous message, the whole model left out)."""
 

@@ -12,6 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from rsstp_format.records import ModelRecord, TransitionsRecord
+from rsstp_format.vocabulary import Operation
 from rsstp_replay import open_recording
 from rsstp_replay.audits import audit_truth, run_audits
 from rsstp_replay.audits._equivalence import ModelTable, TrackedTable
@@ -68,19 +69,38 @@ def start_model(data: st.DataObject) -> TransitionSystem:
     return model
 
 
+def same_model(rebuilt: TransitionSystem, expected: TransitionSystem) -> bool:
+    """The same model: states, transitions, current state, version, next id and the count of
+    pairs with several successors."""
+    return (
+        rebuilt == expected
+        and rebuilt.states == expected.states
+        and rebuilt.transitions() == expected.transitions()
+        and (rebuilt.version, rebuilt.next_id) == (expected.version, expected.next_id)
+        and rebuilt.nondeterministic_pairs == expected.nondeterministic_pairs
+    )
+
+
 @settings(max_examples=200, deadline=None)
 @given(st.data())
 def test_a_history_of_changes_gives_every_version_whole_in_any_order(data: st.DataObject) -> None:
+    """Each version, as a record (indexing) and as a model (:meth:`ModelHistory.model`, the
+    operations applied to arrays), is the model the operations made, asked for in any order;
+    the whole models kept are patched from the last one when the touched states are told
+    (or not told: taken whole from the model)."""
     model = start_model(data)
-    history = ModelHistory(share=data.draw(st.sampled_from([1, 8])))
+    history = ModelHistory(share=data.draw(st.sampled_from([1, 8, 32])))
+    told = data.draw(st.booleans())
     copies = [model.copy()]
     history.add(model_record(model, step=0, operations=()), model)
     for step in range(1, data.draw(st.integers(1, 30))):
-        random_operations(data, model)
+        touched = random_operations(data, model)
         model.current = data.draw(st.sampled_from(model.states))
         change = model_record(model, step=step, operations=model.drain_operations(), keyframe=False)
-        history.add(change, model)
+        history.add(change, model, touched=touched if told else None)
         copies.append(model.copy())
+    for k in data.draw(st.permutations(range(len(copies)))):
+        assert same_model(history.model(k), copies[k]), f"version {k}"
     for k in data.draw(st.permutations(range(len(copies)))):
         record, expected = history[k], copies[k]
         assert record.keyframe == (k == 0)
@@ -151,6 +171,45 @@ def test_a_version_that_outgrows_two_byte_ids_is_rebuilt_in_wider_columns() -> N
     wide = history[1]
     assert wide.triples() == tuple(first.transitions())
     assert 32_767 in wide.states
+
+
+def test_a_no_op_operation_changes_no_version() -> None:
+    """An operation that changed nothing (``changed`` false: an add of a transition there, a
+    delete of one missing), as a file may hold, leaves the version rebuilt as it was."""
+    model = TransitionSystem.from_snapshot(
+        {"states": [0, 1], "next_id": 2, "current": 0, "actions": [0, 1],
+         "transitions": [[0, 0, 1], [1, 1, 0]]}
+    )  # fmt: skip
+    history = ModelHistory()
+    history.add(model_record(model, step=0, operations=()), model)
+    model.split(1)
+    operations = [
+        Operation("add", (0, 1, 0), None, False),
+        *model.drain_operations(),
+        Operation("delete", (2, 2, 1), None, False),
+    ]
+    model.delete(0, 2, 0)
+    operations += model.drain_operations()
+    history.add(model_record(model, step=1, operations=operations, keyframe=False), model)
+    assert same_model(history.model(1), model)
+    assert same_model(history.model(0), TransitionSystem.from_snapshot(history[0].snapshot()))
+
+
+def test_a_model_with_ids_too_wide_for_the_keys_is_rebuilt_all_the_same() -> None:
+    """State ids of 32 bits leave no room for a transition in a 63-bit key: the version is
+    rebuilt from the model applied the operations instead."""
+    wide = 1 << 32
+    model = TransitionSystem.from_snapshot(
+        {"states": [0, wide], "next_id": wide + 1, "current": 0, "actions": [0, 1],
+         "transitions": [[0, 0, wide], [wide, 1, 0], [wide, 0, wide]]}
+    )  # fmt: skip
+    history = ModelHistory()
+    history.add(model_record(model, step=0, operations=()), model)
+    model.split(wide)
+    model.delete(0, wide, 0)
+    change = model_record(model, step=1, operations=model.drain_operations(), keyframe=False)
+    history.add(change, model)
+    assert same_model(history.model(1), model)
 
 
 def test_the_audits_and_the_viewer_rebuild_the_first_and_last_versions_only(

@@ -34,6 +34,7 @@ from rsstp_replay.errors import (
     UnfinishedRecordingWarning,
 )
 from rsstp_replay.reader._container import Container
+from rsstp_replay.reader._models import ModelHistory
 from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording.recorder import record
 from rsstp_sim.transition_system import TransitionSystem
@@ -365,6 +366,50 @@ def test_model_at_every_step_equals_the_live_model(refined_run: LiveRun) -> None
     recording.memory()  # now from the cached columns
     for step in (0, 1, 600, 601, STEPS - 1, STEPS):
         assert _same_model(recording.model_at(step), live[step]), f"step {step}"
+
+
+LEARNER = Path(__file__).resolve().parents[2] / "recordings" / "two-joint-30-learner.mcap"
+
+
+def _versions_from_the_messages(path: Path) -> list[tuple[int, TransitionSystem]]:
+    """Each model version and its step, rebuilt here from the messages read with the ``mcap``
+    reader and the record types: the first message's snapshot, then every message's
+    operations applied in turn."""
+    found: list[tuple[int, TransitionSystem]] = []
+    model: TransitionSystem | None = None
+    for message in _decoded(path, "/rsstp/model"):
+        assert isinstance(message, records.ModelRecord)
+        if model is None:
+            model = TransitionSystem.from_snapshot(message.snapshot(), version=message.version)
+        for operation in message.operations if found else ():
+            model.apply(operation.to_operation())
+        model.drain_operations()
+        found.append((message.step, model.copy()))
+    return found
+
+
+def test_model_at_next_to_each_kept_model_and_keyframe(refined_run: LiveRun) -> None:
+    """The model at the step of the first and the last version, and of the versions just
+    before, at and after each whole model the reader keeps and each keyframe of the file,
+    asked for newest first (no version rebuilt from the one asked before it), is the version
+    rebuilt from version 0 with every change, its current state the step's."""
+    for path in (LEARNER, refined_run.path):
+        expected = _versions_from_the_messages(path)
+        internal = [step.agent.internal_state for step in steps_of(path)]
+        with open_recording(path) as recording:
+            versions = recording.model_versions()
+            assert isinstance(versions, ModelHistory)
+            heads = versions.heads
+            keyframes = [k for k, head in enumerate(heads) if head.keyframe]
+            kept = versions._kept  # (the whole models the reader keeps)
+            assert 1 < len(keyframes) < len(kept) < len(heads)
+            near = {k + d for k in [0, len(heads) - 1, *keyframes, *kept] for d in (-1, 0, 1)}
+            for k in sorted(near & set(range(len(heads))), reverse=True):
+                step, model = expected[k]
+                model.current = internal[step]
+                rebuilt = recording.model_at(step)
+                assert _same_model(rebuilt, model), f"version {k}"
+                assert rebuilt.nondeterministic_pairs == model.nondeterministic_pairs
 
 
 def test_model_at_refuses_steps_out_of_range(random_run: tuple[Path, Any]) -> None:

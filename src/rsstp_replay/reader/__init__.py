@@ -3,7 +3,8 @@
 (:mod:`~rsstp_replay.reader._chunks`), the recording contract
 (:mod:`~rsstp_replay.reader._contract`), and the :class:`~rsstp_replay.reader.recording.Recording`
 (its steps decoded by :mod:`~rsstp_replay.reader._decode`, its model versions by
-:mod:`~rsstp_replay.reader._models`). Reading never imports the audits.
+:mod:`~rsstp_replay.reader._models`, a version rebuilt on arrays by
+:mod:`~rsstp_replay.reader._replay`). Reading never imports the audits.
 """
 
 from rsstp_replay.reader._decode import (

@@ -24,6 +24,7 @@ import numpy.typing as npt
 from rsstp_format.records import ModelRecord, RecordFormatError, TransitionsRecord, encode
 from rsstp_replay.errors import CorruptRecording
 from rsstp_replay.reader._chunks import gc_paused
+from rsstp_replay.reader._replay import KeyedVersion, KeyLayout
 from rsstp_sim.errors import ModelError
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -82,6 +83,7 @@ class ChainCheck:
         self._model: TransitionSystem | None = None
         self._columns: _Compact | None = None  # the last keyframe's transitions
         self._touched: set[int] = set()  # the states whose rows changed since
+        self._record_touched: set[int] = set()  # ... by the last message's operations
         self.history = ModelHistory()
 
     def __call__(self, record: ModelRecord) -> None:
@@ -160,9 +162,10 @@ class ChainCheck:
                 f"{path}: {_name(record)} comes after the model message of step "
                 f"{previous.step}: expected the steps in order"
             )
+        touched: set[int] = set()
         for k, operation in enumerate(record.operations):
             try:
-                self._touched |= model.sources_changed_by(operation.kind, operation.args)
+                touched |= model.sources_changed_by(operation.kind, operation.args)
                 model.apply(operation.to_operation())
             except ModelError as exc:
                 raise CorruptRecording(
@@ -170,6 +173,8 @@ class ChainCheck:
                     f"{list(operation.args)}) does not apply to version {previous.version}: {exc}"
                 ) from None
         model.drain_operations()
+        self._touched |= touched
+        self._record_touched = touched
 
     def _patch(self) -> _Compact:
         """The rebuilt model's transitions, from the last keyframe's with the touched rows
@@ -204,7 +209,7 @@ class ChainCheck:
         self._previous = record
         if columns is not None:
             self._columns = columns
-        self.history.add(record, model, columns=columns)
+        self.history.add(record, model, columns=columns, touched=self._record_touched)
 
     def finish(self) -> ModelHistory:
         """After the last message: there must have been one. The versions checked."""
@@ -215,10 +220,12 @@ class ChainCheck:
         return self.history
 
 
-CHECKPOINT_SHARE = 8
+CHECKPOINT_SHARE = 32
 """A :class:`ModelHistory` keeps a whole model once the operations since the last one reach
-an eighth of the model's size (states and transitions): rebuilding a version applies at most
-that many operations, and the whole models kept hold about eight values per operation."""
+a 32nd of the model's size (states and transitions): rebuilding a version applies at most
+that many operations (about 750 at 4,841 states and 19,364 transitions), and the whole models
+kept hold about 32 values per operation (6 bytes per transition and 8 per state below 32,768
+states: 150 to 200 bytes per operation, about what the operations themselves take)."""
 
 
 class ModelHistory(Sequence[ModelRecord]):
@@ -226,13 +233,16 @@ class ModelHistory(Sequence[ModelRecord]):
 
     Indexing gives a version whole (states and transitions, in tuples as a decoded message
     has them; its ``keyframe`` says whether the file held it whole), rebuilt from the nearest
-    whole model kept before it by applying the operations since. ``share``: a whole model is
-    kept once the operations since the last reach ``1/share`` of the model's size
-    (:data:`CHECKPOINT_SHARE`). Walking forward reuses the model rebuilt last, so each
-    version costs its own operations and the copy of its transitions. What the audits read
-    of every version needs no rebuilding: :attr:`heads` (each message as the file holds a
-    change, no states or transitions; the first one whole), :meth:`sizes` and :meth:`alive`.
-    Memory follows the operations, not the versions times the model's size.
+    whole model kept before it by applying the operations since; :meth:`model` gives it as a
+    model, the operations applied to sorted arrays (:mod:`~rsstp_replay.reader._replay`).
+    ``share``: a whole model is kept once the operations since the last reach ``1/share`` of
+    the model's size (:data:`CHECKPOINT_SHARE`); it is the last one kept with the rows of the
+    states the operations since touched replaced, when :meth:`add` is told them. Walking
+    forward reuses the version rebuilt last, so each version costs its own operations and
+    the copy of its transitions. What the audits read of every version needs no rebuilding:
+    :attr:`heads` (each message as the file holds a change, no states or transitions; the
+    first one whole), :meth:`sizes` and :meth:`alive`. Memory follows the operations, not
+    the versions times the model's size.
     """
 
     def __init__(self, *, share: int = CHECKPOINT_SHARE) -> None:
@@ -245,7 +255,12 @@ class ModelHistory(Sequence[ModelRecord]):
         self._kept: list[int] = []
         self._whole: list[ModelRecord] = []
         self._since = 0
+        self._touched: set[int] | None = set()  # the states whose rows changed since (None:
+        # not known)
+        self._id_bound = 0  # above every state id of every version
+        self._action_bound = 0  # above every action
         self._cache: tuple[int, TransitionSystem] | None = None
+        self._keyed: tuple[int, KeyedVersion] | None = None
 
     def add(
         self,
@@ -253,16 +268,27 @@ class ModelHistory(Sequence[ModelRecord]):
         model: TransitionSystem,
         *,
         columns: TransitionsRecord | None = None,
+        touched: set[int] | None = None,
     ) -> None:
         """The next version: its message (checked), the model it gives (rebuilt) and, when
-        known, that model's transitions (compact columns)."""
+        known, that model's transitions (compact columns) and the states whose transitions
+        out its operations changed (:meth:`TransitionSystem.sources_changed_by`)."""
         k = len(self._heads)
         self._since += len(record.operations)
+        if touched is None or self._touched is None:
+            self._touched = None
+        else:
+            self._touched |= touched
+        self._id_bound = max(self._id_bound, record.next_id)
+        self._action_bound = max(self._action_bound, max(record.actions, default=-1) + 1)
         size = len(model) + model.n_transitions
         if k == 0 or self._since * self._share >= size:
+            if columns is None and k > 0 and self._touched is not None:
+                columns = self._patched(model, self._touched)
             self._kept.append(k)
             self._whole.append(_whole(record, model, columns=columns))
             self._since = 0
+            self._touched = set()
         if k == 0:
             self._heads.append(self._whole[0])
             self._born.update(dict.fromkeys(model.states, 0))
@@ -324,12 +350,54 @@ class ModelHistory(Sequence[ModelRecord]):
         return inside & (born[safe] <= at) & (at < gone[safe])
 
     def model(self, index: int) -> TransitionSystem:
-        """Version ``index`` (0 .. len - 1) as a model of its own (the caller's to change).
-        The garbage collector is paused meanwhile: the rebuilding makes tens of thousands of
-        acyclic dicts, sets and tuples, and each collection would walk every object the
-        reader holds (a third to a half of the time at 4,841 states)."""
+        """Version ``index`` (0 .. len - 1) as a model of its own (the caller's to change):
+        the operations since the nearest whole model kept applied to arrays, one model made
+        at the end (from the model rebuilt last, copied, when the ids are too wide for the
+        arrays' keys). The garbage collector is paused meanwhile: the model is tens of
+        thousands of acyclic dicts and tuples, and each collection would walk every object
+        the reader holds."""
+        k = range(len(self._heads))[index]
         with gc_paused():
-            return self._rebuilt_model(range(len(self._heads))[index]).copy()
+            keyed = self._keyed_version(k)
+            if keyed is None:
+                return self._rebuilt_model(k).copy()
+            head = self._heads[k]
+            return keyed.model(
+                actions=head.actions,
+                next_id=head.next_id,
+                current=head.current,
+                version=head.version,
+            )
+
+    def _keyed_version(self, k: int) -> KeyedVersion | None:
+        """Version ``k``'s transitions as sorted keys, from the last whole model kept at or
+        before it (or from the version rebuilt so last, when that lies between); None when
+        the keys would not fit in 63 bits."""
+        layout = KeyLayout.fitting(id_bound=self._id_bound, action_bound=self._action_bound)
+        if layout is None:
+            return None
+        slot = bisect.bisect_right(self._kept, k) - 1
+        kept = self._kept[slot]
+        cache = self._keyed
+        if cache is not None and kept <= cache[0] <= k and cache[1].layout == layout:
+            done, keyed = cache
+        else:
+            whole = self._whole[slot]
+            transitions = whole.transitions
+            keys = layout.keys(transitions.source, transitions.action, transitions.target)
+            states = np.asarray(whole.states, np.int64)
+            keyed = KeyedVersion(layout, states, keys, whole.next_id)
+            done = kept
+        for later in self._heads[done + 1 : k + 1]:
+            keyed.apply(later.operations)
+        self._keyed = (k, keyed)
+        return keyed
+
+    def _patched(self, model: TransitionSystem, touched: set[int]) -> _Compact | None:
+        """``model``'s transitions from the last whole model kept, the rows of the
+        ``touched`` states replaced (None when that does not give them all)."""
+        patched = _patched(self._whole[-1].transitions, model, touched)
+        return patched if len(patched.source) == model.n_transitions else None
 
     def _rebuilt(self, k: int) -> ModelRecord:
         """Version ``k`` whole."""
