@@ -285,6 +285,37 @@ def test_range_minima_and_nearest_smaller_against_brute_force(values: list[int],
 
 @settings(max_examples=40, deadline=None)
 @given(
+    period=st.lists(st.integers(0, 5), min_size=1, max_size=40),
+    repeats=st.integers(2, 30),
+    changes=st.lists(st.tuples(st.integers(0, 2000), st.integers(0, 5)), max_size=4),
+    counted=st.sampled_from([0, 1, 1000]),
+)
+def test_suffix_order_of_repetitive_walks_against_plain_sorting(
+    period: list[int], repeats: int, changes: list[tuple[int, int]], counted: int
+) -> None:
+    """A walk that repeats one loop, with a few changes, keeps long groups of suffixes
+    together for many rounds: the ranks of every level, whether its round counted the pairs,
+    sorted every suffix or only those still sharing a rank, are those of the prefixes
+    sorted by plain Python; the last level orders the suffixes as Python's sort does."""
+    from rsstp_replay.audits import _suffixes
+
+    symbols = period * repeats
+    for at, value in changes:
+        symbols[at % len(symbols)] = value
+    with mock.patch.object(_suffixes, "_COUNTED_PAIRS", counted):
+        levels = _suffixes.suffix_ranks(np.array(symbols, dtype=np.int64))
+    for level, ranks in enumerate(levels):
+        prefixes = [tuple(symbols[p : p + 2**level]) for p in range(len(symbols))]
+        rank_of = {prefix: rank for rank, prefix in enumerate(sorted(set(prefixes)))}
+        assert ranks.tolist() == [rank_of[prefix] for prefix in prefixes]
+    distinct = [len(set(ranks.tolist())) for ranks in levels]
+    assert distinct[-1] == len(symbols) and all(d < len(symbols) for d in distinct[:-1])
+    suffix_order = sorted(range(len(symbols)), key=lambda p: symbols[p:])
+    assert np.argsort(levels[-1]).tolist() == suffix_order
+
+
+@settings(max_examples=40, deadline=None)
+@given(
     symbols=st.lists(st.integers(0, 3), min_size=2, max_size=600)
     | st.lists(st.integers(0, 700), min_size=2, max_size=600),
     seed=st.integers(0, 2**32 - 1),

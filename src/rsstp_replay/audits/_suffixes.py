@@ -49,8 +49,16 @@ def suffix_ranks(symbols: _AnyInts) -> list[_AnyInts]:
     iff the suffixes at ``p`` and ``q`` agree on their first ``2**e`` symbols (shorter suffixes
     sort first). Stops as soon as all ranks differ: the last level is the suffix order.
 
+    A round ranks each suffix by the pair (its rank, the rank ``2**e`` further on). While the
+    pairs are few (:data:`_COUNTED_PAIRS` per position: the first rounds, over a few
+    actions), a count of each pair ranks them, with no sort. Then the pairs are sorted, and
+    after the first sorted round only the suffixes that still share their rank with another
+    are (Manber and Myers' doubling, skipping the finished groups): in a long walk most
+    suffixes are told apart within a few rounds, a few run on for many.
+
     Each level is kept in :func:`_narrowest` type of its ranks; besides the levels, a round
-    holds the ranks (int32) and the 64-bit sort key, its order and the sorted keys."""
+    holds the ranks (int32), the suffix order, and the 64-bit sort key of the suffixes
+    sorted, its order and the sorted keys."""
     size = len(symbols)
     positions = index_type(size)
     inverse = np.unique(symbols, return_inverse=True)[1]
@@ -59,26 +67,104 @@ def suffix_ranks(symbols: _AnyInts) -> list[_AnyInts]:
     distinct = int(rank.max()) + 1
     levels: list[_AnyInts] = [rank.astype(_narrowest(distinct, size))]
     half = 1
+    order: npt.NDArray[np.integer[Any]] | None = None  # the suffixes in rank order
     while distinct < size:
-        # key = rank * (size + 1) + (rank of the suffix ``half`` further on, + 1; 0 past the end)
+        if order is None and distinct * (distinct + 1) <= _COUNTED_PAIRS * size:
+            rank, distinct = _counted_round(rank, half, distinct)
+        elif order is None:
+            rank, order, distinct = _sorted_round(rank, half)
+        else:
+            rank, distinct = _unfinished_round(rank, order, half)
+        levels.append(rank.astype(_narrowest(distinct, size), copy=False))
+        half *= 2
+    return levels
+
+
+_COUNTED_PAIRS = 1
+"""A doubling round counts its pairs of ranks (an array of one count per possible pair)
+while there are at most this many possible pairs per position; past that it sorts them."""
+
+
+def _pair_keys(rank: _AnyInts, half: int, indices: _AnyInts | None = None) -> _IntArray:
+    """``rank[p] * (size + 1) + rank[p + half] + 1`` (0 in place of the second past the end)
+    for every position, or for ``indices``: ordered as the pairs are."""
+    size = len(rank)
+    if indices is None:
         key = rank.astype(np.int64)
         key *= size + 1
         key[: size - half] += rank[half:]
         key[: size - half] += 1
-        by_key = np.argsort(key)
-        sorted_key = key[by_key]
-        del key
-        new_group = np.empty(size, dtype=np.bool_)
-        new_group[0] = False
-        np.not_equal(sorted_key[1:], sorted_key[:-1], out=new_group[1:])
-        del sorted_key
-        rank = np.empty(size, dtype=positions)
-        rank[by_key] = np.cumsum(new_group, dtype=positions)
-        del by_key, new_group
-        distinct = int(rank.max()) + 1
-        levels.append(rank.astype(_narrowest(distinct, size), copy=False))
-        half *= 2
-    return levels
+        return key
+    key = rank[indices].astype(np.int64)
+    key *= size + 1
+    further = indices.astype(np.int64) + half
+    inside = further < size
+    key[inside] += rank[further[inside]].astype(np.int64) + 1
+    return key
+
+
+def _counted_round(rank: _AnyInts, half: int, distinct: int) -> tuple[_AnyInts, int]:
+    """The next level's ranks when the pairs are few: each pair's rank is the number of
+    distinct pairs below it, counted over all ``distinct * (distinct + 1)`` possible pairs."""
+    size = len(rank)
+    key = rank.astype(np.int64)
+    key *= distinct + 1
+    key[: size - half] += rank[half:]
+    key[: size - half] += 1
+    present = np.bincount(key, minlength=distinct * (distinct + 1)) > 0
+    ranks_of_keys = np.cumsum(present, dtype=index_type(size))
+    ranks_of_keys -= 1
+    new_rank: _AnyInts = ranks_of_keys[key]
+    return new_rank, int(ranks_of_keys[-1]) + 1
+
+
+def _sorted_round(rank: _AnyInts, half: int) -> tuple[_AnyInts, _AnyInts, int]:
+    """The next level's ranks, every suffix sorted by its pair; and the suffix order."""
+    size = len(rank)
+    key = _pair_keys(rank, half)
+    order = np.argsort(key).astype(rank.dtype, copy=False)
+    sorted_key = key[order]
+    del key
+    head = np.empty(size, dtype=np.bool_)
+    head[0] = False
+    np.not_equal(sorted_key[1:], sorted_key[:-1], out=head[1:])
+    del sorted_key
+    new_rank = np.empty(size, dtype=rank.dtype)
+    new_rank[order] = np.cumsum(head, dtype=rank.dtype)
+    return new_rank, order, int(new_rank[order[-1]]) + 1
+
+
+def _unfinished_round(rank: _AnyInts, order: _AnyInts, half: int) -> tuple[_AnyInts, int]:
+    """The next level's ranks (``order`` kept the suffix order, in place), by sorting only
+    the groups of suffixes that share a rank (the others keep their place); and the number of
+    distinct ranks."""
+    size = len(rank)
+    in_order = rank[order]
+    head = np.empty(size, dtype=np.bool_)
+    head[0] = True
+    np.not_equal(in_order[1:], in_order[:-1], out=head[1:])
+    del in_order
+    # A slot is unfinished when its group has another slot: it is not both a head and
+    # followed by a head.
+    finished = head.copy()
+    finished[:-1] &= head[1:]
+    unfinished = np.flatnonzero(~finished)
+    del finished
+    suffixes = order[unfinished]
+    key = _pair_keys(rank, half, suffixes)
+    by_key = np.argsort(key)
+    sorted_key = key[by_key]
+    del key
+    order[unfinished] = suffixes[by_key]
+    del suffixes, by_key
+    # Inside the unfinished slots a new group starts where the pair changes (between two
+    # old groups the first rank differs).
+    head[unfinished[1:]] = sorted_key[1:] != sorted_key[:-1]
+    del sorted_key, unfinished
+    new_rank = np.empty(size, dtype=rank.dtype)
+    new_rank[order] = np.cumsum(head, dtype=rank.dtype)
+    new_rank[order] -= 1
+    return new_rank, int(new_rank[order[-1]]) + 1
 
 
 def common_prefix_lengths(left: _AnyInts, right: _AnyInts, rank_levels: list[_AnyInts]) -> _AnyInts:

@@ -343,7 +343,13 @@ def _contradictions_of(
     # Every time p = 0..T-1 (time T has nothing after it), sorted by (state, suffix rank).
     state_ids, state_codes = np.unique(state_column[:steps], return_inverse=True)
     state_codes = state_codes.astype(positions)
-    order = np.lexsort((rank_levels[-1], state_codes)).astype(positions)
+    # One int64 key per time (the suffix ranks are distinct and below ``steps``): one sort,
+    # a third of the time of a lexsort over the two columns, the same order.
+    key = state_codes.astype(np.int64)
+    key *= steps
+    key += rank_levels[-1]
+    order = np.argsort(key).astype(positions)
+    del key
     sorted_codes = state_codes[order]
     del state_codes
     same_state = sorted_codes[1:] == sorted_codes[:-1]
@@ -453,16 +459,24 @@ def _per_state(
     starts = np.flatnonzero(np.r_[True, states_in_order[1:] != states_in_order[:-1]])
     first_step = np.minimum.reduceat((witness_j + k)[best], starts)
     pair_total = np.add.reduceat(pairs[best], starts)
-    findings = []
-    for index, boundary in enumerate(best[starts]):
-        i, j, length = int(witness_i[boundary]), int(witness_j[boundary]), int(k[boundary])
-        state = state_ids[states_in_order[starts[index]]]
-        findings.append(
-            StateContradiction(
-                state=int(state),
-                witness=Witness(i, j, tuple(int(a) for a in action_column[i + 1 : i + length + 1])),
-                first_step=int(first_step[index]),
-                pairs=int(pair_total[index]),
-            )
+    chosen = best[starts]
+    # Plain ints, a column at a time (not a numpy scalar per value: a witness runs to
+    # hundreds of actions, and a long run has thousands of states).
+    columns = zip(
+        witness_i[chosen].tolist(),
+        witness_j[chosen].tolist(),
+        k[chosen].tolist(),
+        state_ids[states_in_order[starts]].tolist(),
+        first_step.tolist(),
+        pair_total.tolist(),
+        strict=True,
+    )
+    return tuple(
+        StateContradiction(
+            state=int(state),
+            witness=Witness(i, j, tuple(action_column[i + 1 : i + length + 1].tolist())),
+            first_step=first,
+            pairs=pairs,
         )
-    return tuple(findings)
+        for i, j, length, state, first, pairs in columns
+    )
