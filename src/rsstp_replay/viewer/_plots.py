@@ -77,16 +77,18 @@ def log_series(
     ``--from``/``--to`` window shows every change.
     """
     times = steps.index.to_numpy(np.int64)
-    series: list[tuple[str, list[str], npt.NDArray[np.float64]]] = [
-        (SENSATION, ["sensation"], steps[["sensation"]].to_numpy(np.float64)),
-        (FEEDBACK, ["feedback"], steps[["feedback"]].to_numpy(np.float64)),
+    series: list[tuple[str, list[str], list[str]]] = [
+        (SENSATION, ["sensation"], ["sensation"]),
+        (FEEDBACK, ["feedback"], ["feedback"]),
     ]
     if distances:
-        columns = [column for column, _ in distances]
-        names = [name for _, name in distances]
-        series.append((DISTANCE, names, steps[columns].to_numpy(np.float64)))
+        series.append(
+            (DISTANCE, [name for _, name in distances], [column for column, _ in distances])
+        )
     logged, thinned = {}, []
-    for path, names, values in series:
+    for path, names, columns in series:
+        # One series' values at a time (a float64 copy of a column is 8 bytes a step).
+        values = steps[columns].to_numpy(np.float64)
         # A boolean drawn zoomed out: min and max per pixel, not their average (0.5 is no
         # sensation the agent ever had).
         aggregation = rr.components.AggregationPolicy.MinMax if path == SENSATION else None
@@ -122,14 +124,16 @@ def _extremes(
     of ``buckets`` equal runs of steps, and the first and last row: every extreme of every
     curve is drawn at its step with its value, the values between are the nearest kept
     ones (at most ``2 * buckets * columns + 2`` rows)."""
-    span = int(times[rows[-1]] - times[rows[0]]) + 1
+    bucket = times[rows]  # (in place below: each step-long array is 8 bytes a row)
+    span = int(bucket[-1] - bucket[0]) + 1
     width = -(-span // max(buckets, 1))
-    bucket = (times[rows] - times[rows[0]]) // width
+    bucket -= bucket[0]
+    bucket //= width
     starts = np.flatnonzero(np.r_[True, bucket[1:] != bucket[:-1]])
+    ends = np.r_[starts[1:], len(rows)] - 1
     kept = [rows[:1], rows[-1:]]
-    for column in values[rows].T:
-        order = np.lexsort((column, bucket))  # by bucket, then by value
-        ends = np.r_[starts[1:], len(rows)] - 1
+    for k in range(values.shape[1]):  # a column's changes at a time
+        order = np.lexsort((values[rows, k], bucket))  # by bucket, then by value
         kept += [rows[order[starts]], rows[order[ends]]]
     return np.unique(np.concatenate(kept))
 
