@@ -10,7 +10,7 @@ end (done, the budget spent, or ``--minutes`` of CPU time used): the steps (and 
 CPU seconds and steps per CPU second, the hypothesis's states, the share of the steps in each
 phase so far (home: searching for the landmark; explore; identify), and the learner's
 counters of new states, twins, counterexamples. At the end, whether the model is the truth's
-minimal model (from where the run started, :func:`rsstp_sim.truth.check_equivalence`).
+minimal model, judged from where the run ended as `bench/worlds.py` judges it.
 """
 
 from __future__ import annotations
@@ -24,7 +24,8 @@ from rsstp_sim.runner import Runner
 from rsstp_sim.scenario import load_scenario, parse_scenario
 from rsstp_sim.strategies._learner_walk import PHASES
 from rsstp_sim.strategies.learner import LearnerStrategy
-from rsstp_sim.truth import check_equivalence, compute_truth
+from rsstp_sim.truth import compute_truth
+from worlds import learned_exactly
 
 
 def progress(runner: Runner, learner: LearnerStrategy, n: int, started: float) -> str:
@@ -75,13 +76,7 @@ def main() -> int:
         if time.process_time() > limit:
             print(f"stopped: {args.minutes:g} CPU minutes used")
             break
-    start = learner.start_state
-    exact = (
-        learner.done
-        and len(runner.model) == n
-        and start is not None
-        and check_equivalence(runner.model, learner.labels(), truth, start_state=start) is None
-    )
+    exact = learned_exactly(runner, learner, truth)
     print(f"done: {learner.done}; the truth's minimal model: {'yes' if exact else 'no'}")
     return 0
 

@@ -42,7 +42,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -53,6 +53,10 @@ from rsstp_sim.errors import RsstpError  # noqa: E402
 from rsstp_sim.scenario import parse_scenario  # noqa: E402
 from rsstp_sim.truth import GroundTruth, compute_truth  # noqa: E402
 from scenarios import arm_toml  # noqa: E402 (the test suite's folder goes on the path first)
+
+if TYPE_CHECKING:
+    from rsstp_sim.runner import Runner
+    from rsstp_sim.strategies.learner import LearnerStrategy
 
 STEPS_DEG = (5, 6, 8, 9, 10, 12, 15, 18, 20, 24, 30)
 """The steps drawn from: divisors of 360 from 5 to 30 degrees."""
@@ -172,12 +176,30 @@ class Run:
     phases: str
 
 
+def learned_exactly(runner: Runner, learner: LearnerStrategy, truth: GroundTruth) -> bool:
+    """Whether the learner is done with the truth's minimal model. Judged from where the run
+    ended: the model's current state against the class of the arm's pose (the start may be
+    left open by the steps before the landmark was seen; in a world where every pose reaches
+    every other, the model then has the start's state too)."""
+    from rsstp_sim.truth import check_equivalence
+
+    model = runner.model
+    pose = int(np.searchsorted(truth.pose_codes, runner.world.pose_code))
+    return (
+        learner.done
+        and len(model) == truth.n_classes
+        and check_equivalence(
+            model, learner.labels(), truth, start_state=model.current,
+            start_class=int(truth.true_class[pose]),
+        ) is None
+    )  # fmt: skip
+
+
 def learn(world: World, seed: int, mode: str, cap: int | None) -> Run:
     """The learner on ``world`` (``mode``: bool or float) with seed ``seed``, 4 N^2 steps at
     most (``cap`` lower); whether its final model is the truth's minimal one from the start."""
     from rsstp_sim.runner import Runner
     from rsstp_sim.strategies.learner import LearnerStrategy
-    from rsstp_sim.truth import check_equivalence
 
     source = world.source if mode == "bool" else world.twin()
     scenario = parse_scenario(source, origin=world.name)
@@ -193,25 +215,13 @@ def learn(world: World, seed: int, mode: str, cap: int | None) -> Run:
         step()
         steps += 1
     seconds = time.perf_counter() - started
-    # Judged from where the run ended: the model's current state against the class of the
-    # arm's pose (the start may be left open by the steps before the landmark was seen; in a
-    # world where every pose reaches every other, the model then has the start's state too).
-    model = runner.model
-    pose = int(np.searchsorted(truth.pose_codes, runner.world.pose_code))
-    exact = (
-        learner.done
-        and len(model) == truth.n_classes
-        and check_equivalence(
-            model, learner.labels(), truth, start_state=model.current,
-            start_class=int(truth.true_class[pose]),
-        ) is None
-    )  # fmt: skip
+    exact = learned_exactly(runner, learner, truth)
     stats = learner.stats()
     spent = {k.removeprefix("steps_"): v for k, v in stats.items() if k.startswith("steps_")}
     phases = " ".join(f"{k}={v / max(steps, 1):.2f}" for k, v in sorted(spent.items()))
     return Run(
         world.name, world.n, seed, mode, budget, steps, exact, learner.done,
-        steps >= limit and limit < budget, seconds, len(model), phases,
+        steps >= limit and limit < budget, seconds, len(runner.model), phases,
     )  # fmt: skip
 
 

@@ -801,7 +801,7 @@ def test_entity_paths_are_documented() -> None:
 
 @pytest.fixture(scope="module")
 def learner(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Recording, Rrd]]:
-    """The learner's reference recording (it stops at step 8,480, equivalent from 8,217),
+    """The learner's reference recording (it stops at step 8,400, equivalent from 8,217),
     viewed."""
     out = tmp_path_factory.mktemp("viewer") / "learner.rrd"
     with open_recording(LEARNER) as recording:

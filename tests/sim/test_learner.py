@@ -21,7 +21,7 @@ from rsstp_sim.strategies import AgentView
 from rsstp_sim.strategies._learner_hypothesis import Hypothesis
 from rsstp_sim.strategies._learner_identify import Identifier
 from rsstp_sim.strategies._learner_plan import Learning
-from rsstp_sim.strategies._learner_walk import Plan, Refuted, Walker
+from rsstp_sim.strategies._learner_walk import Walker
 from rsstp_sim.strategies.learner import LearnerStrategy
 from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence, compute_truth
@@ -728,56 +728,6 @@ def test_a_wrong_transition_is_refuted_found_and_repaired(name: str) -> None:
     assert_minimal_and_equivalent(learner, runner.model, truth)
 
 
-def _play(plan: Plan, agent: AgentView, ring: _Ring) -> None:
-    """Run one part of the learner's plan against the ring, as :func:`drive` steps."""
-    model, memory = agent.model, agent.memory
-    try:
-        action = next(plan)
-        while True:
-            sensation = ring.move(action)
-            (after,) = model.successors(model.current, action)
-            model.current = after
-            memory.append(action, after, sensation, float(sensation))
-            action = plan.send(sensation)
-    except StopIteration:
-        return
-
-
-def test_the_verification_plays_the_word_that_shows_two_states_moving_to_one() -> None:
-    # White box: a ring of 25 places, learned; then a wrong confirmed transition u -0-> c,
-    # where q -0-> c rightly: two places moving to one by a turn, which never happens on a
-    # ring. Verifying q -0->, the learner plays the word that shows it (u's access word, the
-    # turn, the turn back, then a word telling u from q): the world comes back to u where the
-    # hypothesis predicts q, a counterexample; its analysis finds u -0-> and repairs it.
-    n, sensed = 25, 7
-    learner = LearnerStrategy(stop=False)
-    ring = _Ring(n, sensed=sensed, start=3)
-    agent = drive(learner, ring.move, False, 4 * n**2, seed=1)
-    learning = learner._learning
-    assert learning is not None and learner.done
-    h = learning.h
-    place = {s: (sensed + sum(1 if a == 0 else -1 for a in h.access[s])) % n for s in h.states()}
-    state = {p: s for s, p in place.items()}
-    q, c, u = state[12], state[13], state[18]
-    h.confirm(u, 0, c)
-    h.twins.clear()  # (the merge they call for is refused: u and q are shown apart)
-
-    word = learning.contradiction(q, 0, c)
-    assert word is not None
-    access = h.access[u]
-    assert word[: len(access) + 2] == (*access, 0, 1)
-    rest = word[len(access) + 2 :]
-    from_u, from_q = _Ring(n, sensed, start=18), _Ring(n, sensed, start=12)
-    assert [from_u.move(a) for a in rest][-1] != [from_q.move(a) for a in rest][-1]
-
-    with pytest.raises(Refuted) as refuted:
-        _play(learning.reverify(q, 0), agent, ring)
-    assert learning.stats["contradictions"] == 1
-    _play(learning.analyse(refuted.value), agent, ring)
-    assert place[h.confirmed(u, 0)] == 19
-    assert h.confirmed(q, 0) == c
-
-
 @pytest.mark.parametrize("mode", ["bool", "float"])
 def test_a_test_takes_the_same_steps_with_arrays_or_one_candidate_at_a_time(
     mode: str, monkeypatch: pytest.MonkeyPatch
@@ -955,35 +905,6 @@ def test_what_is_left_to_explore_out_of_the_landmarks_reach_is_dropped_not_searc
     assert not h.alive[stray]
     assert learning.belief == h.landmark
     assert h.is_complete()
-
-
-def test_states_a_counterexample_showed_apart_are_not_merged_as_twins() -> None:
-    # A ring of six world states, action 0 turning one way, 1 the other; state 0 sensed. The
-    # hypothesis: 0 -0-> 1 -0-> 2 -0-> 3, each undone by 1, and 3 -0-> 0, wrong (3 -0-> leads
-    # to the world's 4). A counterexample's analysis found 0 -1-> the world's 5, a new state,
-    # not 3: the world showed them apart. Once 5 -0-> 0 is confirmed, 3 and 5 both lead to 0
-    # by action 0: not merged as twins (it would undo the analysis); 3 -0-> 0, confirmed
-    # before the counterexample, is withdrawn, to be explored again.
-    actions = (0, 1)
-    h = Hypothesis(TransitionSystem.universal(actions), actions, landmark=0)
-    h.label[0] = True
-    one = h.create(0, 0, False, (0,))
-    two = h.create(one, 0, False, (0, 0))
-    three = h.create(two, 0, False, (0, 0, 0))
-    h.confirm(one, 1, 0)
-    h.confirm(two, 1, one)
-    h.confirm(three, 1, two)
-    h.confirm(three, 0, 0)  # (wrong)
-    five = h.create(0, 1, False, (1,))
-    h.shown_apart[(three, five)] = three
-    assert h.apart(three, five) and h.apart(five, three)
-    h.confirm(five, 0, 0)
-    assert h.twins  # (moves being one-to-one, 3 and 5 would be one state)
-    assert h.unify() == []
-    assert h.alive[three] and h.alive[five]
-    assert h.confirmed(three, 0) == -1
-    assert h.confirmed(five, 0) == 0
-    assert [h.confirmed(s, 1) for s in (one, two, three)] == [0, one, two]  # (the others stay)
 
 
 def test_a_candidate_is_ruled_out_when_a_third_state_already_moves_to_it_by_the_action() -> None:

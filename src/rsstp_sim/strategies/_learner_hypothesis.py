@@ -120,10 +120,6 @@ class Hypothesis:
         self.twins: list[tuple[int, int]] = []
         """Pairs of states found to be one world state, moves being one-to-one: both
         lead by one action to a third state (:meth:`confirm`); :meth:`unify` merges them."""
-        self.shown_apart: dict[tuple[int, int], int] = {}
-        """Pairs of states (the lower id first) the world showed to be two world states, a
-        counterexample's analysis (:meth:`~Learning.analyse`): its transition ``q -a->`` led to
-        the other state, not to the wrong one, the value. :meth:`apart` holds for them."""
         self.one_to_one = not feels
         """Whether a move that changes the state is taken to come from one state only (no two
         states lead by the same action to a third): twins are looked for and merged, and
@@ -679,7 +675,7 @@ class Hypothesis:
         """Whether the confirmed transitions show ``s`` and ``t`` are two world states: their
         labels differ, or one's path to the landmark, walked from the other, predicts another
         sensation on the way."""
-        if self.labels[s] != self.labels[t] or (min(s, t), max(s, t)) in self.shown_apart:
+        if self.labels[s] != self.labels[t]:
             return True
         distance, toward, label = self.distance, self.toward, self.label
         for first, second in ((s, t), (t, s)):
@@ -715,10 +711,7 @@ class Hypothesis:
             if a == b:
                 continue
             keep, gone = min(a, b), max(a, b)
-            if self.apart(keep, gone) or self.separating_word(keep, gone) is not None:
-                # A wrong confirmation somewhere: not merged (a merge would merge their
-                # successors too, and spread the error).
-                self._withdraw_shared((keep, gone))
+            if self.apart(keep, gone):  # (a wrong confirmation somewhere: not merged)
                 continue
             model = self.model
             for k, action in enumerate(self.actions):
@@ -746,19 +739,6 @@ class Hypothesis:
                 self._look_for_twins(keep, k)
             self.twins = [(find(x), find(y)) for x, y in self.twins if find(x) != find(y)]
         return merges
-
-    def _withdraw_shared(self, pair: tuple[int, int]) -> None:
-        """Two states the world showed apart (:attr:`shown_apart`) lead by one action to one
-        state: moves being one-to-one, one of the two is wrong. The wrong state's is withdrawn
-        (its transitions were confirmed before the counterexample, the other's after)."""
-        wrong = self.shown_apart.get(pair)
-        if wrong is None:
-            return
-        other = pair[0] if wrong == pair[1] else pair[1]
-        for k, action in enumerate(self.actions):
-            t = int(self.next[wrong, k])
-            if t >= 0 and t not in pair and t == self.next[other, k]:
-                self.unconfirm(wrong, action)
 
     def unconfirm(self, s: int, action: int) -> None:
         """Withdraw a confirmed successor; the model keeps it as a conjecture."""

@@ -187,11 +187,7 @@ class Identifier(Walker):
                 ranked = sorted(survivors) + ranked
                 continue
             if at_landmark and survivors:
-                # (The verification tests against the complete hypothesis, not these rules:
-                # Learning.reverify.)
-                ruled = set()
-                if not self.checking:
-                    ruled = {c for c in survivors if not self.plausible(q, a, c, undo)}
+                ruled = {c for c in survivors if not self.plausible(q, a, c, undo)}
                 if ruled:
                     self.count("implausible", len(ruled))
                     candidates -= ruled

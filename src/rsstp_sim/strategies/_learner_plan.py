@@ -298,66 +298,25 @@ class Learning(Identifier):
         return s, h.actions[int(np.flatnonzero(doubtful[s])[0])]
 
     def reverify(self, q: int, a: int) -> Plan:
-        """Take ``q -a->`` again and identify where it leads with the complete hypothesis.
-
-        The hypothesis is complete: every step has a prediction, through ``q -a-> before``,
-        and one the world refutes is a counterexample (:meth:`analyse` finds the transition
-        that is wrong, this one or one further on), not a new state. (A state taken as new here
-        would copy ``before``'s transitions, and the minimisation would merge it back: the same
-        doubt to take again.) Where ``before`` does not fit the moves being one-to-one, the
-        word that would show it (:meth:`contradiction`) is played first.
-        """
+        """Take ``q -a->`` again and identify where it leads with the complete hypothesis."""
         h = self.h
         self.count("reverified")
+        yield from self.navigate(q)
+        self.phase = "verify"
         before = h.confirmed(q, a)
-        self.checking = True
-        try:
-            word = self.contradiction(q, a, before)
-            if word is not None:
-                self.count("contradictions")
-                yield from self.query(word)
-            yield from self.navigate(q)
-            self.phase = "verify"
-            sensation = yield from self.move(a)
-            self.drop_traces(q, a)
-            if sensation:
-                self.confirm(q, a, h.landmark)
-            else:
-                word = tuple(self.word)
-                yield from self.identify(q, a, sensation, word, here=True, feel=self.feel())
-        finally:
-            self.checking = False
+        sensation = yield from self.move(a)
+        self.belief = None
+        self.drop_traces(q, a)
+        if sensation:
+            self.confirm(q, a, h.landmark)
+        else:
+            yield from self.identify(q, a, sensation, tuple(self.word), here=True, feel=self.feel())
         if h.confirmed(q, a) != before:
             self.count("corrected")
             self.agent.note(f"verification: state {q} by action {a} leads elsewhere")
         self._checked_for(len(h.label))[q, h.column[a]] = True
         self._checked_version = h.version
         self.retested.add((q, h.column[a]))
-
-    def contradiction(self, q: int, a: int, c: int) -> tuple[int, ...] | None:
-        """A word from the landmark that tests ``q -a-> c`` against the moves being one-to-one
-        and undone by their inverse (:attr:`~Hypothesis.one_to_one`), or None.
-
-        For ``p`` = ``q``, or another state leading to ``c`` by ``a``, each moved by ``a``
-        (shown apart from ``c``): ``p``'s access word, ``a``, the undoing move, then a word
-        telling ``p`` from the state ``c``'s undo leads to. The world comes back to ``p``; the
-        hypothesis predicts the other state, so one of its transitions is wrong and the word
-        is a counterexample, unless the world agrees with it."""
-        h = self.h
-        undo = h.inverses().get(a)
-        if undo is None or not h.one_to_one or not h.reversible():
-            return None
-        back = int(h.next[c, h.column[undo]])
-        if back < 0:
-            return None
-        k = h.column[a]
-        froms = [q, *(u for u, column in h.incoming.predecessors(c) if column == k and u != q)]
-        for p in froms:
-            if p != c and p != back and h.apart(p, c) and h.apart(p, back):
-                word = h.separating_word(p, back)
-                if word is not None:
-                    return (*h.access[p], a, undo, *word)
-        return None
 
     def _checked_for(self, n: int) -> NDArray[np.bool_]:
         """The checked transitions of states ``0 .. n-1``, by action column."""
@@ -434,9 +393,6 @@ class Learning(Identifier):
             exclude=frozenset(excluded),
             route=access,
         )
-        found = h.confirmed(q, a)
-        if found >= 0 and found != wrong and h.alive[wrong]:
-            h.shown_apart[(min(found, wrong), max(found, wrong))] = wrong
 
     def query(self, word: tuple[int, ...]) -> Generator[int, bool, tuple[list[bool], list[float]]]:
         """From the landmark, play ``word``; the sensations after each action, and what was

@@ -115,9 +115,6 @@ class Walker:
         self.felt: list[float] = []
         self.beliefs: list[int] = []
         self.belief: int | None = None
-        self.checking = False
-        """While set, every move checks the belief's prediction, as ``move(check=True)`` does:
-        the verification's, where the hypothesis is complete."""
         self.phase = "search"
         self.stats: dict[str, int] = {}
         self._run_action = 0
@@ -135,9 +132,8 @@ class Walker:
         return self.agent.memory.last_feedback if self.h.feels else 0.0
 
     def move(self, action: int, *, check: bool = False) -> Generator[int, bool, bool]:
-        """Take ``action``; follow the belief. With ``check`` (or while :attr:`checking`), a
-        wrong prediction of a confirmed transition raises :class:`Refuted` (else the agent is
-        just lost)."""
+        """Take ``action``; follow the belief. With ``check``, a wrong prediction of a
+        confirmed transition raises :class:`Refuted` (else the agent is just lost)."""
         sensation = yield action
         phase, stats, agent = self.phase, self.stats, self.agent
         key = _STEPS[phase]
@@ -156,7 +152,7 @@ class Walker:
                 self.belief = t
             else:
                 self.belief = None
-                if t >= 0 and (check or self.checking):
+                if t >= 0 and check:
                     refuted = Refuted(tuple(self.word), tuple(self.trace), tuple(self.felt))
                     if sensation:
                         self.at_landmark()

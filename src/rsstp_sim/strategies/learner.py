@@ -42,8 +42,7 @@ class LearnerStrategy(StrategyBase):
     (``implausible``); squares of actions shown not to commute cast no votes; and, lost among at
     most 64 candidates, the agent first takes the move that brings them together.
     When every transition is confirmed the hypothesis is minimised (``merge``), the tests kept
-    for each transition are replayed against it and the doubtful ones taken again, each step
-    checked against the hypothesis (a wrong prediction is a counterexample); then
+    for each transition are replayed against it and the doubtful ones taken again; then
     :attr:`done` is set and the learner ends the run (``agent.stop``): the recording ends
     there, with an event saying so.
 
