@@ -87,20 +87,14 @@ class KeyedVersion:
         added, deleted = self._added, self._deleted
         for operation in operations:
             kind, args = operation.kind, operation.args
-            if kind == "add":
-                if operation.changed:
+            if kind in ("add", "delete"):
+                if operation.changed:  # (an add undoes a delete still pending, and back)
                     k = key(args[0], args[2], args[1])
-                    if k in deleted:
-                        deleted.discard(k)
+                    undone, done = (deleted, added) if kind == "add" else (added, deleted)
+                    if k in undone:
+                        undone.discard(k)
                     else:
-                        added.add(k)
-            elif kind == "delete":
-                if operation.changed:
-                    k = key(args[0], args[2], args[1])
-                    if k in added:
-                        added.discard(k)
-                    else:
-                        deleted.add(k)
+                        done.add(k)
             elif kind == "split":
                 self._flush()
                 self._split(args[0])
