@@ -32,7 +32,15 @@ from rsstp_sim.strategies import AgentView, Strategy, StrategyBase
 from rsstp_sim.transition_system import Operation, TransitionSystem
 from rsstp_sim.words import counted
 
-__all__ = ["Event", "RunSummary", "Runner", "StepOutcome", "stop_text"]
+__all__ = [
+    "Event",
+    "RunSummary",
+    "Runner",
+    "StepOutcome",
+    "check_strategy",
+    "start_agent",
+    "stop_text",
+]
 
 EventKind = Literal["no_transition", "note"]
 
@@ -98,6 +106,44 @@ class RunSummary:
         )
 
 
+def start_agent(
+    strategy: Strategy,
+    actions: tuple[int, ...],
+    rng: np.random.Generator,
+    sensation: bool,
+    feedback: float,
+    *,
+    float_feedback: bool,
+    notes: Callable[[str], None],
+    phases: Callable[[str], None],
+) -> AgentView:
+    """The agent at the start of a run: the strategy's initial model, the memory's entry 0
+    (what was sensed and felt at the start pose) and the strategy reset on its view."""
+    model = strategy.initial_model(actions)
+    model.drain_operations()
+    memory = Memory()
+    memory.reset(model.current, sensation, feedback)
+    agent = AgentView(memory, model, actions, rng, notes, phases, float_feedback=float_feedback)
+    strategy.reset(agent)
+    return agent
+
+
+def check_strategy(scenario: AnyScenario, strategy: Strategy) -> None:
+    """Raise the strategy's error if it does not accept ``scenario`` (its actions, its kind
+    of feedback): the strategy reset on an agent at a start that senses nothing. No world is
+    built (a sweep checks every pair before any run)."""
+    start_agent(
+        strategy,
+        scenario.actions,
+        np.random.default_rng(0),
+        False,
+        0.0,
+        float_feedback=scenario.feedback_mode == "float",
+        notes=lambda _text: None,
+        phases=lambda _phase: None,
+    )
+
+
 def stop_text(step: int, budget: int | None) -> str:
     """How a run the strategy ended is told (the recording's stop event, info, the audit)."""
     of = "" if budget is None else f" of a budget of {budget:,}"
@@ -143,23 +189,21 @@ class Runner:
         """Start over: world at the start pose, fresh model and memory, entry 0 written."""
         self.rng = np.random.default_rng(self.seed)
         pose = self.world.reset()
-        self.model: TransitionSystem = self.strategy.initial_model(self.scenario.actions)
-        self.model.drain_operations()
-        self.memory = Memory()
-        self.memory.reset(self.model.current, pose.sensation, pose.feedback)
-        self.agent = AgentView(
-            self.memory,
-            self.model,
-            self.scenario.actions,
-            self.rng,
-            self._note,
-            self._phase,
-            float_feedback=self.scenario.feedback_mode == "float",
-        )
         self.blocked = 0
         self.no_transition = 0
         self._step = 0
-        self.strategy.reset(self.agent)
+        self.agent = start_agent(
+            self.strategy,
+            self.scenario.actions,
+            self.rng,
+            pose.sensation,
+            pose.feedback,
+            float_feedback=self.scenario.feedback_mode == "float",
+            notes=self._note,
+            phases=self._phase,
+        )
+        self.model: TransitionSystem = self.agent.model
+        self.memory = self.agent.memory
         self._choose = self.strategy.choose_action
         # A strategy that keeps StrategyBase's refine does not refine: no call, and no check
         # for a re-localised state after each step.

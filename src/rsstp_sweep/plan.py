@@ -33,7 +33,7 @@ from typing import Any
 
 from rsstp_sim.errors import RsstpError
 from rsstp_sim.nesting import too_deep
-from rsstp_sim.runner import Runner
+from rsstp_sim.runner import check_strategy
 from rsstp_sim.scenario import AnyScenario, load_scenario
 from rsstp_sim.strategies import make_strategy
 from rsstp_sweep.errors import SweepError
@@ -132,7 +132,7 @@ def parse_sweep(text: str, *, origin: str = "<string>", base: Path | None = None
     for given, scenario in scenarios:  # each strategy must accept each scenario
         for name, params in strategies:
             try:
-                Runner(scenario, make_strategy(name, params), seed=0)
+                check_strategy(scenario, make_strategy(name, params))
             except RsstpError as exc:
                 raise SweepError(
                     f"{origin}: scenario {given!r}, strategy {name!r}: {exc}"

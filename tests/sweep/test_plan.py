@@ -85,6 +85,22 @@ def test_a_bad_sweep_is_one_error_naming_the_key(change: tuple[str, str], messag
         parse_sweep(BASE.replace(old, new), origin="sweep.toml")
 
 
+def test_checking_a_sweep_builds_no_world(monkeypatch: pytest.MonkeyPatch) -> None:
+    # Each strategy is checked against each scenario before any run, without building its
+    # world (a table of every pose, seconds for a large arm): the workers build it once each.
+    import rsstp_sim.bodies as bodies
+    import rsstp_sim.runner as runner
+
+    def refuse(*_args: object, **_kwargs: object) -> object:
+        raise AssertionError("a world was built")
+
+    monkeypatch.setattr(bodies, "make_world", refuse)
+    monkeypatch.setattr(runner, "make_world", refuse)
+    assert len(parse_sweep(BASE).runs) == 12
+    with pytest.raises(SweepError, match=r"strategy 'script'.*actions \[7\]"):
+        parse_sweep(BASE.replace("actions = [0]", "actions = [7]"), origin="sweep.toml")
+
+
 def test_a_missing_sweep_file_is_named(tmp_path: Path) -> None:
     with pytest.raises(SweepError, match=r"nothere.toml: no such sweep file"):
         load_sweep(tmp_path / "nothere.toml")
