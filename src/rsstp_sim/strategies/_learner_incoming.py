@@ -76,10 +76,15 @@ class Incoming:
         into = self.into
         back, known = self.back, self.known
         code = s * width + k
-        # The squares s -k-> is a side of: those from s, and from each state leading to s.
-        corners = {s, *(other // width for other in into.get(s, ()))}
-        for p in corners:
-            self._squares(next_, p, -1)
+        # The squares s -k-> is a side of: from s, by k and another action; from each state
+        # p leading to s by c, by c and k (s -k-> their second side).
+        sides = {(s, min(k, b), max(k, b)) for b in range(width) if b != k}
+        for other in into.get(s, ()):
+            p, c = divmod(other, width)
+            if p != s and c != k:
+                sides.add((p, min(c, k), max(c, k)))
+        for p, a, b in sides:
+            self._square(next_, p, a, b, -1)
         if old >= 0:
             if old != s:
                 self._count(next_, s, k, old, -1)
@@ -102,26 +107,19 @@ class Incoming:
                 self._count(next_, s, k, t, 1)
         if s in self._alive:
             self.open[s] += (t < 0) - (old < 0)
-        for p in corners:
-            self._squares(next_, p, 1)
+        for p, a, b in sides:
+            self._square(next_, p, a, b, 1)
 
-    def _squares(self, next_: NDArray[np.int64], p: int, sign: int) -> None:
-        """Count the squares from ``p`` in or out (``sign``) of ``squares``/``closed``."""
-        row = next_[p].tolist()
-        after = next_[row].tolist()  # (the rows of -1 read the last row: not used)
-        squares, closed = self.squares, self.closed
-        width = self.width
-        for a in range(width - 1):
-            if row[a] < 0:
-                continue
-            after_r = after[a]
-            for b in range(a + 1, width):
-                if row[b] < 0:
-                    continue
-                y, z = after_r[b], after[b][a]
-                if y >= 0 and z >= 0:
-                    squares[a][b] += sign
-                    closed[a][b] += sign * (y == z)
+    def _square(self, next_: NDArray[np.int64], p: int, a: int, b: int, sign: int) -> None:
+        """Count the square from ``p`` by actions ``a < b`` in or out (``sign``) of
+        ``squares``/``closed``, if its four sides are confirmed."""
+        r, q = int(next_[p, a]), int(next_[p, b])
+        if r < 0 or q < 0:
+            return
+        y, z = int(next_[r, b]), int(next_[q, a])
+        if y >= 0 and z >= 0:
+            self.squares[a][b] += sign
+            self.closed[a][b] += sign * (y == z)
 
     def _count(self, next_: NDArray[np.int64], s: int, a: int, t: int, sign: int) -> None:
         """Count the move ``s -a-> t`` (``t != s``) in or out (``sign``) of ``back``/``known``."""
