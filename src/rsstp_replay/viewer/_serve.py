@@ -24,6 +24,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from rsstp_replay.errors import ReplayError
 
@@ -102,10 +103,19 @@ def ctrl_c_remembered(*, interrupt: bool = True) -> Iterator[CtrlC]:
     if threading.current_thread() is not threading.main_thread():
         yield pressed
         return
+    unraisable = sys.unraisablehook
+
+    def quiet(found: Any) -> None:
+        # A Ctrl-C lost in a finaliser: the flag has it; Python would print it as a traceback.
+        if not (pressed.pressed and isinstance(found.exc_value, KeyboardInterrupt)):
+            unraisable(found)
+
     previous = {sig: signal.signal(sig, handler) for sig in STOP_SIGNALS}
+    sys.unraisablehook = quiet
     try:
         yield pressed
     finally:
+        sys.unraisablehook = unraisable
         for sig, before in previous.items():
             signal.signal(sig, before)
 
