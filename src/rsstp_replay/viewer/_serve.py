@@ -24,7 +24,6 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
 
 from rsstp_replay.errors import ReplayError
 
@@ -105,7 +104,7 @@ def ctrl_c_remembered(*, interrupt: bool = True) -> Iterator[CtrlC]:
         return
     unraisable = sys.unraisablehook
 
-    def quiet(found: Any) -> None:
+    def quiet(found: sys.UnraisableHookArgs) -> None:
         # A Ctrl-C lost in a finaliser: the flag has it; Python would print it as a traceback.
         if not (pressed.pressed and isinstance(found.exc_value, KeyboardInterrupt)):
             unraisable(found)
