@@ -128,17 +128,18 @@ def start_agent(
     return agent
 
 
-def check_strategy(scenario: AnyScenario, strategy: Strategy) -> None:
-    """Raise the strategy's error if it does not accept ``scenario`` (its actions, its kind
-    of feedback): the strategy reset on an agent at a start that senses nothing. No world is
-    built (a sweep checks every pair before any run)."""
+def check_strategy(strategy: Strategy, actions: tuple[int, ...], *, float_feedback: bool) -> None:
+    """Raise the strategy's error if it does not accept a world of ``actions`` and of float
+    (else boolean) feedback, what its agent sees of a scenario: the strategy reset on an agent
+    at a start that senses nothing. No world is built (a sweep checks every pair before any
+    run)."""
     start_agent(
         strategy,
-        scenario.actions,
+        actions,
         np.random.default_rng(0),
         False,
         0.0,
-        float_feedback=scenario.feedback_mode == "float",
+        float_feedback=float_feedback,
         notes=lambda _text: None,
         phases=lambda _phase: None,
     )

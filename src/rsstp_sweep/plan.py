@@ -132,7 +132,11 @@ def parse_sweep(text: str, *, origin: str = "<string>", base: Path | None = None
     for given, scenario in scenarios:  # each strategy must accept each scenario
         for name, params in strategies:
             try:
-                check_strategy(scenario, make_strategy(name, params))
+                check_strategy(
+                    make_strategy(name, params),
+                    scenario.actions,
+                    float_feedback=scenario.feedback_mode == "float",
+                )
             except RsstpError as exc:
                 raise SweepError(
                     f"{origin}: scenario {given!r}, strategy {name!r}: {exc}"
