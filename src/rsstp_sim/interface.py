@@ -137,7 +137,13 @@ class Body(Protocol):
     """The scenario table that picks it (``[arm]``, ``[rover]``)."""
 
     def parse(self, data: Mapping[str, object], text: str, origin: str) -> Any:
-        """The validated scenario of a parsed TOML document that has this body's table."""
+        """The validated scenario of a parsed TOML document that has this body's table: every
+        key checked, not the start pose's geometry (:meth:`check_start`)."""
+
+    def check_start(self, scenario: Any) -> None:
+        """Raise :class:`~rsstp_sim.errors.ScenarioError` (one line naming the file and the
+        key) when the body cannot stand at the scenario's start pose: what building its world
+        finds, without building it."""
 
     def world(self, scenario: Any) -> Any:
         """A :class:`World` at the scenario's start pose."""

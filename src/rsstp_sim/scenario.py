@@ -4,7 +4,11 @@ A scenario file is part of the public contract. Its body's table (``[arm]``, or 
 registered body's) picks the body (:mod:`rsstp_sim.bodies`), whose parser checks every key at
 the boundary; a bad file raises :class:`~rsstp_sim.errors.ScenarioError` whose message names
 the file, the key path and what was expected. Each body's keys are its own scenario module's
-(the arm's: :mod:`rsstp_sim.arm.scenario`).
+(the arm's: :mod:`rsstp_sim.arm.scenario`). Whether the body can stand at its start pose is
+the body's geometry (:meth:`~rsstp_sim.interface.Body.check_start`), checked when a world is
+built; :func:`load_scenario` and :func:`parse_scenario` check it too, unless asked only to
+parse (``check_start=False``: a sweep's plan, its workers and the reader, whose worlds check
+it where they are built).
 
 Built-in scenarios ship as package data and can be named instead of a path.
 """
@@ -61,12 +65,14 @@ def builtin_scenarios() -> dict[str, str]:
     return out
 
 
-def load_scenario(name_or_path: str | Path) -> AnyScenario:
-    """Load a built-in scenario by name, or a scenario file by path."""
+def load_scenario(name_or_path: str | Path, *, check_start: bool = True) -> AnyScenario:
+    """Load a built-in scenario by name, or a scenario file by path; ``check_start``: see
+    :func:`parse_scenario`."""
     text_name = str(name_or_path)
     if isinstance(name_or_path, str) and text_name in builtin_scenarios():
         resource = resources.files("rsstp_sim.scenarios").joinpath(f"{text_name}.toml")
-        return parse_scenario(resource.read_text(encoding="utf-8"), origin=text_name)
+        text = resource.read_text(encoding="utf-8")
+        return parse_scenario(text, origin=text_name, check_start=check_start)
     path = Path(name_or_path)
     if not path.exists():
         known = ", ".join(builtin_scenarios())
@@ -86,11 +92,13 @@ def load_scenario(name_or_path: str | Path) -> AnyScenario:
         text = path.read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ScenarioError(f"{path}: cannot read scenario file: {exc}") from None
-    return parse_scenario(text, origin=str(path))
+    return parse_scenario(text, origin=str(path), check_start=check_start)
 
 
-def parse_scenario(text: str, *, origin: str = "<string>") -> AnyScenario:
-    """Parse and validate a scenario from TOML text; ``origin`` names it in errors."""
+def parse_scenario(text: str, *, origin: str = "<string>", check_start: bool = True) -> AnyScenario:
+    """Parse and validate a scenario from TOML text; ``origin`` names it in errors.
+    ``check_start=False`` only parses: the body's start pose is then checked where its world
+    is built (:meth:`~rsstp_sim.interface.Body.check_start`)."""
     deep = too_deep(text)
     if deep is not None:
         raise ScenarioError(f"{origin}: {deep}")
@@ -103,5 +111,8 @@ def parse_scenario(text: str, *, origin: str = "<string>") -> AnyScenario:
         tables = " or ".join(f"[{name}]" for name in BODIES)
         found = "none" if not present else " and ".join(f"[{name}]" for name in present)
         raise ScenarioError(f"{origin}: expected one body table, {tables}; found {found}")
-    scenario: AnyScenario = body_named(present[0]).parse(data, text, origin)
+    body = body_named(present[0])
+    scenario: AnyScenario = body.parse(data, text, origin)
+    if check_start:
+        body.check_start(scenario)
     return scenario

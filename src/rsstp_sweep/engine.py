@@ -32,7 +32,7 @@ from typing import Any
 import pandas as pd
 
 from rsstp_sweep.execute import ROW_FIELDS, execute_run, failed_row, finished_row
-from rsstp_sweep.plan import Run, Sweep
+from rsstp_sweep.plan import Run, Sweep, check_starts
 
 __all__ = ["RUNS_TABLE", "SweepResult", "run_sweep", "runs_frame"]
 
@@ -80,10 +80,13 @@ def run_sweep(
 ) -> SweepResult:
     """Run every run of ``sweep`` into ``output`` (a folder or fsspec URL); see the module
     docstring. ``on_row`` is called with each row as its run ends. Ctrl-C cancels the runs
-    not finished and returns with ``interrupted`` set; the finished runs are kept."""
+    not finished and returns with ``interrupted`` set; the finished runs are kept. A scenario
+    whose body cannot stand at its start pose is refused first (:func:`~rsstp_sweep.plan.
+    check_starts`)."""
     import dask
     import fsspec
 
+    check_starts(sweep)
     fs, root = fsspec.core.url_to_fs(output)
     fs.makedirs(root, exist_ok=True)
     _write_metadata(fs, root, sweep)

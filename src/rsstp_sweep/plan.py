@@ -15,8 +15,11 @@ A sweep file is TOML::
 A run is one scenario x one strategy (with one combination of its grid) x one seed. Scenario
 files are read relative to the sweep file, here, before anything runs: the workers receive the
 scenario's text, so they need not see the file. Everything a run needs is checked here (the
-scenario parses, the strategy builds with its parameters and accepts the scenario), so a bad
-sweep is one error before any work starts.
+scenario parses, the strategy builds with its parameters and accepts the scenario), but for
+the body's start pose, which needs its geometry and is checked where the world is built: by
+each worker, and once for all by :func:`check_starts`, which
+:func:`~rsstp_sweep.engine.run_sweep` calls before the cluster starts. So a bad sweep is one
+error before any work starts.
 """
 
 from __future__ import annotations
@@ -34,11 +37,11 @@ from typing import Any
 from rsstp_sim.errors import RsstpError
 from rsstp_sim.nesting import too_deep
 from rsstp_sim.runner import check_strategy
-from rsstp_sim.scenario import AnyScenario, load_scenario
+from rsstp_sim.scenario import AnyScenario, load_scenario, parse_scenario
 from rsstp_sim.strategies import make_strategy
 from rsstp_sweep.errors import SweepError
 
-__all__ = ["Run", "Sweep", "SweepError", "load_sweep", "parse_sweep"]
+__all__ = ["Run", "Sweep", "SweepError", "check_starts", "load_sweep", "parse_sweep"]
 
 _TOP_LEVEL = frozenset({"steps", "seeds", "scenarios", "strategy"})
 _STRATEGY_KEYS = frozenset({"name", "params", "grid"})
@@ -144,6 +147,21 @@ def parse_sweep(text: str, *, origin: str = "<string>", base: Path | None = None
     return Sweep(text, origin, steps, seeds, tuple(runs))
 
 
+def check_starts(sweep: Sweep) -> None:
+    """Raise :class:`SweepError` when a scenario's body cannot stand at its start pose (its
+    world refuses to be built): what each of its runs' workers would find, told once before
+    any run."""
+    seen: set[tuple[str, str]] = set()
+    for run in sweep.runs:
+        key = (run.scenario_source, run.scenario_origin)
+        if key not in seen:
+            seen.add(key)
+            try:
+                parse_scenario(run.scenario_source, origin=run.scenario_origin)
+            except RsstpError as exc:
+                raise SweepError(f"{sweep.origin}: scenarios: {exc}") from None
+
+
 def _seeds(origin: str, value: object) -> tuple[int, ...]:
     if isinstance(value, int) and not isinstance(value, bool) and value >= 1:
         return tuple(range(value))
@@ -167,7 +185,7 @@ def _scenarios(origin: str, value: object, base: Path) -> list[tuple[str, AnySce
     for given in value:
         path = base / given
         try:
-            scenario = load_scenario(path if given.endswith(".toml") else given)
+            scenario = load_scenario(path if given.endswith(".toml") else given, check_start=False)
         except RsstpError as exc:
             raise SweepError(f"{origin}: scenarios: {exc}") from None
         loaded.append((given, scenario))

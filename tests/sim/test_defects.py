@@ -127,6 +127,8 @@ def test_defect_04_feedback_matches_poses_with_unround_coordinates() -> None:
             f"[arm]\nlengths = {lengths}\ninitial_deg = [0, 0, 0]\nstep_deg = 1\n"
             f"[feedback]\npoints = {_float_tips(target, lengths)!r}\n"
         )
+        if geometry.pose_blocker(aimed, target) is not None:
+            continue  # links crossing: no world starts there (its table refuses the pose)
         assert World(dataclasses.replace(aimed, initial_deg=tuple(target))).sensation, target
 
 

@@ -238,6 +238,15 @@ def test_a_bad_rover_file_is_one_line_naming_the_key(text: str, message: str) ->
         parse_scenario(text, origin="bad.toml")
 
 
+def test_a_rover_that_cannot_stand_at_its_start_is_refused_where_its_world_is_built() -> None:
+    text = _SMALL + "[[obstacles]]\ncenter = [0.5, 0.5]\nradius = 0.2\n"
+    scenario = parse_scenario(text, origin="bad.toml", check_start=False)  # only parsed
+    message = r"^bad\.toml: rover\.start: the robot at cell \[0, 0\] touches a wall, a door"
+    for build in (make_world, body_of(scenario).check_start, compute_truth):
+        with pytest.raises(ScenarioError, match=message):
+            build(scenario)
+
+
 def _sim(*args: str) -> subprocess.CompletedProcess[str]:
     env = dict(os.environ)
     env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(SRC), env.get("PYTHONPATH")]))

@@ -16,6 +16,7 @@ from builtin_worlds import builtins_of
 from rsstp_sim import scenario as scenario_module
 from rsstp_sim.arm import geometry
 from rsstp_sim.arm.world import World
+from rsstp_sim.bodies import body_of, make_world
 from rsstp_sim.errors import ScenarioError
 from rsstp_sim.scenario import Obstacle, builtin_scenarios, load_scenario, parse_scenario
 from waiting import HANG_S
@@ -500,6 +501,31 @@ def test_invalid_file_names_file_key_and_expectation(
     path = write_scenario(scenario_text(scenario_data))
     with pytest.raises(ScenarioError, match=rf"^{re.escape(str(path))}: {message}"):
         load_scenario(path)
+
+
+START_CASES = [case for case in INVALID if case[0].startswith("start-")]
+
+
+@pytest.mark.parametrize(
+    ("mutate", "message"),
+    [case[1:] for case in START_CASES],
+    ids=[case[0] for case in START_CASES],
+)
+def test_a_bad_start_pose_is_refused_where_the_world_is_built(
+    mutate: Mutation, message: str, scenario_data, scenario_text, write_scenario
+) -> None:
+    """Only parsed (a sweep's plan, its workers, the reader), a scenario whose arm cannot
+    stand at its start is refused with the same line by its world, its ground truth's table
+    and the body's check."""
+    from rsstp_sim.truth import compute_truth
+
+    mutate(scenario_data)
+    path = write_scenario(scenario_text(scenario_data))
+    scenario = load_scenario(path, check_start=False)
+    assert parse_scenario(scenario.source, origin=str(path), check_start=False) == scenario
+    for build in (make_world, body_of(scenario).check_start, compute_truth):
+        with pytest.raises(ScenarioError, match=rf"^{re.escape(str(path))}: {message}"):
+            build(scenario)
 
 
 def test_invalid_cases_start_from_a_valid_scenario(scenario_data, scenario_text) -> None:

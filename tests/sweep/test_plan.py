@@ -101,6 +101,31 @@ def test_checking_a_sweep_builds_no_world(monkeypatch: pytest.MonkeyPatch) -> No
         parse_sweep(BASE.replace("actions = [0]", "actions = [7]"), origin="sweep.toml")
 
 
+def test_a_start_pose_the_arm_cannot_take_is_refused_before_any_run(tmp_path: Path) -> None:
+    """The plan only parses the scenarios; their start poses are checked where the world is
+    built (each worker), and once for all before the cluster starts, with the line the plan
+    gave when it checked them."""
+    from rsstp_sweep import run_sweep
+    from rsstp_sweep.plan import check_starts
+
+    scenario = Path("src/rsstp_sim/scenarios/thesis-roulette.toml").read_text()
+    blocked = scenario.replace('name = "thesis-roulette"', 'name = "blocked"')
+    blocked += "\n[[obstacles]]\ncenter = [1.0, 0.0]\nradius = 0.2\n"
+    (tmp_path / "blocked.toml").write_text(blocked)
+    (tmp_path / "sweep.toml").write_text(BASE.replace('"one-joint-10"', '"blocked.toml"'))
+    sweep = load_sweep(tmp_path / "sweep.toml")
+    line = (
+        rf"^{re.escape(str(tmp_path / 'sweep.toml'))}: scenarios: "
+        rf"{re.escape(str(tmp_path / 'blocked.toml'))}: arm\.initial_deg: the start pose "
+        r"\[\d+\] is invalid \(link 0 meets obstacle 0\)$"
+    )
+    with pytest.raises(SweepError, match=line):
+        check_starts(sweep)
+    with pytest.raises(SweepError, match=line):
+        run_sweep(sweep, str(tmp_path / "out"))
+    assert not (tmp_path / "out").exists()
+
+
 def test_a_missing_sweep_file_is_named(tmp_path: Path) -> None:
     with pytest.raises(SweepError, match=r"nothere.toml: no such sweep file"):
         load_sweep(tmp_path / "nothere.toml")

@@ -362,7 +362,8 @@ def rebuild_scenario(
                 f"{digest}"
             )
     try:
-        scenario = parse_scenario(text, origin=record.origin)
+        # Only parsed: the start pose is the world's to check, where the physics check builds it.
+        scenario = parse_scenario(text, origin=record.origin, check_start=False)
     except ScenarioError as exc:
         raise CorruptRecording(f"{path}: the {ATTACHMENT_NAME} attachment: {exc}") from None
     if record.schema_name != BODY_TOPICS[scenario.body]["/rsstp/scenario"]:

@@ -48,12 +48,14 @@ from rsstp_sim.arm import geometry
 from rsstp_sim.arm.geometry import ArmGeometry
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.arrays import BoolArray, FloatArray, Int32Array, IntArray, distinct
+from rsstp_sim.errors import ScenarioError
 
 __all__ = [
     "DENSE_LIMIT",
     "KEPT_DISTANCES",
     "MAX_TABULATION_CHECKS",
     "WorldTable",
+    "check_start",
     "lattice_sizes",
     "pose_space_size",
     "tabulation_checks",
@@ -130,6 +132,20 @@ def unsensable(scenario: Scenario) -> str | None:
     return None
 
 
+def check_start(scenario: Scenario, geo: ArmGeometry | None = None) -> None:
+    """Raise :class:`~rsstp_sim.errors.ScenarioError` when the arm cannot stand at its start
+    pose (a link meets an obstacle or another link, a joint folds back); ``geo``: the
+    scenario's geometry when already built (the table's)."""
+    geo = ArmGeometry.from_scenario(scenario) if geo is None else geo
+    initial = list(scenario.initial_deg)
+    blocker = geo.decode(int(geometry.pose_blockers(geo, [initial])[0]))
+    if blocker is not None:
+        raise ScenarioError(
+            f"{scenario.origin}: arm.initial_deg: the start pose {initial} is invalid "
+            f"({blocker.describe()})"
+        )
+
+
 def pose_space_size(scenario: Scenario) -> int:
     """An upper bound on the reachable poses, known before any geometry is computed."""
     return math.prod(lattice_sizes(scenario))
@@ -144,11 +160,14 @@ def tabulation_checks(scenario: Scenario) -> int:
 
 
 class WorldTable:
-    """The reachable poses of ``scenario`` found so far, and the moves computed so far."""
+    """The reachable poses of ``scenario`` found so far, and the moves computed so far.
+    Raises :class:`~rsstp_sim.errors.ScenarioError` when the start pose is invalid
+    (:func:`check_start`)."""
 
     def __init__(self, scenario: Scenario) -> None:
         self.scenario = scenario
         self.geometry = ArmGeometry.from_scenario(scenario)
+        check_start(scenario, self.geometry)
         n = scenario.n_joints
         self.actions: tuple[int, ...] = tuple(scenario.actions)
         self.radix = np.array([360**k for k in range(n)], dtype=np.int64)

@@ -32,6 +32,7 @@ from rsstp_sim.arm.scenario import Scenario, parse_arm
 from rsstp_sim.arm.table import (
     MAX_TABULATION_CHECKS,
     WorldTable,
+    check_start,
     pose_space_size,
     tabulation_checks,
     unsensable,
@@ -423,6 +424,9 @@ class _Arm:
 
     def parse(self, data: Mapping[str, object], text: str, origin: str) -> Scenario:
         return parse_arm(data, text, origin)
+
+    def check_start(self, scenario: Scenario) -> None:
+        check_start(scenario)
 
     def world(self, scenario: Scenario) -> World:
         return World(scenario)

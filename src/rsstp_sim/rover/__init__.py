@@ -20,12 +20,12 @@ from rsstp_format.records import (
     RoverScenarioRecord,
     SegmentRecord,
 )
-from rsstp_sim.errors import ScenarioError, TruthError
+from rsstp_sim.errors import TruthError
 from rsstp_sim.interface import PoseMachine
 from rsstp_sim.moore import reached
 from rsstp_sim.rover.picture import RoverPicture
 from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario, parse_rover
-from rsstp_sim.rover.table import RoverTable, cell_clearance
+from rsstp_sim.rover.table import RoverTable, check_start
 from rsstp_sim.rover.world import RoverBlocker, RoverPose, RoverWorld
 
 __all__ = ["ACTION_NAMES", "ROVER", "RoverBlocker", "RoverPose", "RoverScenario", "RoverWorld"]
@@ -37,14 +37,10 @@ class _Rover:
     name = "rover"
 
     def parse(self, data: Mapping[str, object], text: str, origin: str) -> RoverScenario:
-        scenario = parse_rover(data, text, origin)
-        x, y = scenario.start
-        if not cell_clearance(scenario, np.array([[x + 0.5], [y + 0.5]]))[0]:
-            raise ScenarioError(
-                f"{origin}: rover.start: the robot at cell {[x, y]} touches a wall, a door "
-                "or an obstacle"
-            )
-        return scenario
+        return parse_rover(data, text, origin)
+
+    def check_start(self, scenario: RoverScenario) -> None:
+        check_start(scenario)
 
     def scenario_record(
         self, scenario: RoverScenario, common: dict[str, Any]

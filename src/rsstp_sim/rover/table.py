@@ -18,9 +18,17 @@ from dataclasses import dataclass
 import numpy as np
 
 from rsstp_sim.arrays import BoolArray, FloatArray, IntArray
+from rsstp_sim.errors import ScenarioError
 from rsstp_sim.rover.scenario import Door, RoverScenario, Wall
 
-__all__ = ["ROOM_EDGES", "RoverTable", "cell_clearance", "headings_xy", "segment_distance"]
+__all__ = [
+    "ROOM_EDGES",
+    "RoverTable",
+    "cell_clearance",
+    "check_start",
+    "headings_xy",
+    "segment_distance",
+]
 
 ROOM_EDGES = 4
 """Blocker codes 1 to 4 are the room's edges: east (x = width), north, west, south."""
@@ -67,7 +75,9 @@ def segment_distance(p: FloatArray, q: FloatArray, a: FloatArray, b: FloatArray)
 class RoverTable:
     """Every pose of a rover scenario: ``next_code[c, k]`` is where action ``actions[k]``
     takes pose ``c`` (``c`` itself when blocked), ``blocker[c, k]`` why it was blocked (0: it
-    moved), ``free[c]`` whether the robot fits at the pose's cell."""
+    moved), ``free[c]`` whether the robot fits at the pose's cell. Raises
+    :class:`~rsstp_sim.errors.ScenarioError` when it does not fit at its start
+    (:func:`check_start`)."""
 
     scenario: RoverScenario
     next_code: IntArray
@@ -91,6 +101,7 @@ class RoverTable:
         y, heading = rest % height, rest // height
         centers = np.stack([x + 0.5, y + 0.5]).astype(np.float64)
         free = cell_clearance(scenario, centers)
+        check_start(scenario, bool(free[scenario.start[0] + width * scenario.start[1]]))
 
         steps = headings_xy(scenario.turn_deg)
         moves = {0: 1, 1: -1}  # forward, back: +/- the heading's cell step
@@ -158,6 +169,20 @@ def cell_clearance(scenario: RoverScenario, centers: FloatArray) -> BoolArray:
         a, b = np.array(segment.start), np.array(segment.end)
         free &= _point_segment(centers[0], centers[1], a, b) > r
     return free
+
+
+def check_start(scenario: RoverScenario, free: bool | None = None) -> None:
+    """Raise :class:`~rsstp_sim.errors.ScenarioError` when the robot at its start cell touches
+    a wall, a door or an obstacle; ``free``: whether it fits there, when already known (the
+    table's)."""
+    x, y = scenario.start
+    if free is None:
+        free = bool(cell_clearance(scenario, np.array([[x + 0.5], [y + 0.5]]))[0])
+    if not free:
+        raise ScenarioError(
+            f"{scenario.origin}: rover.start: the robot at cell {[x, y]} touches a wall, a "
+            "door or an obstacle"
+        )
 
 
 def _move_blocker(
