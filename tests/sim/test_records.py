@@ -32,6 +32,7 @@ from steps import step_record_after
 import rsstp_sim
 from rsstp_format import records, schemas
 from rsstp_sim.arm.scenario import Scenario
+from rsstp_sim.bodies import make_world
 from rsstp_sim.recording import builders
 from rsstp_sim.rover import RoverScenario
 from rsstp_sim.runner import Event, Runner, StepOutcome
@@ -249,7 +250,7 @@ def record_run(name: str) -> Corpus:
     messages.insert(
         0,
         builders.scenario_record(
-            scenario,
+            runner.world,
             seed=1,
             strategy_name="random",
             strategy_params={"block": 4096, "tags": ("a", "b")},
@@ -400,7 +401,7 @@ def test_origin_is_the_file_base_name_never_a_directory(tmp_path: Path, corpus: 
     path.parent.mkdir()
     path.write_text(text, encoding="utf-8")
     record = builders.scenario_record(
-        load_scenario(path),
+        make_world(load_scenario(path)),
         seed=3,
         strategy_name="random",
         strategy_params={},
@@ -622,7 +623,7 @@ def test_builders_refuse_what_cannot_be_recorded() -> None:
         records.RecordFormatError, match=r"^rsstp.Scenario: strategy.params: expected"
     ):
         builders.scenario_record(
-            scenario,
+            make_world(scenario),
             seed=0,
             strategy_name="x",
             strategy_params={"f": object()},

@@ -94,11 +94,12 @@ def check_physics(
     of every step); ``events`` likewise its events table (its ``text`` and ``data`` may be
     categorical)."""
     try:
-        _check_scenario_message(recording)
+        world = make_world(recording.scenario)
+        _check_scenario_message(recording, world)
         if steps is None:
             steps = recording.steps(geometry=False)
         actions = steps["action"].to_numpy(dtype=np.int64, na_value=-1)
-        world, rows, blockers = _simulate(recording, actions, steps)
+        rows, blockers = _simulate(recording, world, actions, steps)
         _check_agent_view(steps, world, rows)
         _check_truth(recording, world, rows, blockers)
         _check_blocked_events(
@@ -109,12 +110,13 @@ def check_physics(
     return PhysicsFindings(recording.n_steps, None, None, None)
 
 
-def _check_scenario_message(recording: Recording) -> None:
-    """The ``/rsstp/scenario`` message must be what the attached scenario file gives."""
+def _check_scenario_message(recording: Recording, world: Any) -> None:
+    """The ``/rsstp/scenario`` message must be what the attached scenario file gives (its
+    ``world``)."""
     found = recording.scenario_record
     strategy = found.strategy
     expected = builders.scenario_record(
-        recording.scenario,
+        world,
         seed=found.seed,
         strategy_name=strategy.name,
         strategy_params=strategy.param_values(),
@@ -137,17 +139,16 @@ def _plain(value: object) -> str:
 
 
 def _simulate(
-    recording: Recording, actions: IntArray, steps: pd.DataFrame
-) -> tuple[Any, IntArray, IntArray]:
-    """The world after the recorded actions, and the table row of every step's pose and the
-    blocker code of every move (step 0 is the start pose, not blocked)."""
-    world = make_world(recording.scenario)
+    recording: Recording, world: Any, actions: IntArray, steps: pd.DataFrame
+) -> tuple[IntArray, IntArray]:
+    """``world`` walked through the recorded actions: the table row of every step's pose and
+    the blocker code of every move (step 0 is the start pose, not blocked)."""
     try:
         rows, blockers = world.follow(actions, steps)
     except ActionError:
         raise _unknown_action(actions, recording.scenario.actions) from None
     # Kept for the whole check: a long run's rows and blockers in the narrowest dtypes.
-    return world, _narrowed(rows), _narrowed(blockers)
+    return _narrowed(rows), _narrowed(blockers)
 
 
 def _narrowed(values: IntArray) -> Any:

@@ -1,5 +1,5 @@
-"""Building records from the simulator's live objects: the scenario, a step's outcome and
-pose, a model version, and the events (blocked moves, missing transitions, refinements,
+"""Building records from the simulator's live objects: the world (its scenario), a step's
+outcome and pose, a model version, and the events (blocked moves, missing transitions, refinements,
 contradictions, notes). :mod:`rsstp_format.records` says what the records are.
 
 >>> note_event(3, "exploring joint 1")
@@ -31,15 +31,14 @@ from rsstp_format.records import (
     TransitionsRecord,
     encode_json,
 )
-from rsstp_sim.bodies import body_of
+from rsstp_sim.bodies import body_named
 from rsstp_sim.errors import RecordFormatError
 from rsstp_sim.runner import stop_text
 from rsstp_sim.transition_system import Operation
 
 if TYPE_CHECKING:
-    from rsstp_sim.interface import Blocker, Pose
+    from rsstp_sim.interface import Blocker, Pose, World
     from rsstp_sim.runner import Event
-    from rsstp_sim.scenario import AnyScenario
     from rsstp_sim.strategies import StrategyOrigin
     from rsstp_sim.transition_system import TransitionSystem
 
@@ -58,14 +57,15 @@ __all__ = [
 
 
 def scenario_record(
-    scenario: AnyScenario,
+    world: World,
     *,
     seed: int,
     strategy_name: str,
     strategy_params: Mapping[str, Any],
     strategy_origin: StrategyOrigin,
 ) -> ScenarioMessage:
-    """The scenario message of a run (``rsstp.Scenario``, a rover's ``rsstp.RoverScenario``).
+    """The scenario message of a run in ``world`` (``rsstp.Scenario``, a rover's
+    ``rsstp.RoverScenario``): its scenario, as its body writes it.
 
     ``origin`` keeps only the base name of a scenario file (recordings must not depend on
     the directory they were made in); ``strategy_params`` must be JSON-serialisable, and are
@@ -87,6 +87,7 @@ def scenario_record(
         version=strategy_origin.version,
         params=tuple(params),
     )
+    scenario = world.scenario
     common: dict[str, Any] = {
         "name": scenario.name,
         "description": scenario.description,
@@ -100,7 +101,7 @@ def scenario_record(
         "seed": int(seed),
         "strategy": strategy,
     }
-    record: ScenarioMessage = body_of(scenario).scenario_record(scenario, common)
+    record: ScenarioMessage = body_named(scenario.body).scenario_record(scenario, common)
     return record
 
 

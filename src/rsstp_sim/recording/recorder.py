@@ -214,7 +214,7 @@ class Recorder:
         self._writer = ChunkedWriter(self._file, chunk_size=chunk_size, compact=compact)
         self._closed = False
         try:
-            self._write_header(scenario, strategy, seed)
+            self._write_header(strategy, seed)
         except OSError as exc:
             self._abort()
             raise RecordingError(
@@ -245,7 +245,10 @@ class Recorder:
 
     # -- writing ----------------------------------------------------------------
 
-    def _write_header(self, scenario: AnyScenario, strategy: Strategy, seed: int) -> None:
+    def _write_header(self, strategy: Strategy, seed: int) -> None:
+        """The header, from the world the runner built (its scenario is the run's)."""
+        world = self.runner.world
+        scenario = world.scenario
         writer = self._writer
         writer.start(profile="", library=f"rsstp {self._versions['package_version']}")
         self._channels: dict[str, int] = {}
@@ -283,7 +286,7 @@ class Recorder:
             0, 0, ATTACHMENT_NAME, ATTACHMENT_MEDIA_TYPE, scenario.source.encode("utf-8")
         )
         record = builders.scenario_record(
-            scenario,
+            world,
             seed=seed,
             strategy_name=strategy.name,
             strategy_params=params,
