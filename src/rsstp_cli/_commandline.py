@@ -76,7 +76,7 @@ class Progress:
 
 def add_no_cache(parser: argparse.ArgumentParser) -> None:
     """``--no-cache``: compute the ground truth without reading or writing the truth cache
-    (:mod:`rsstp_sim.truth_cache`)."""
+    (:mod:`rsstp_sim.truth.cache`)."""
     parser.add_argument(
         "--no-cache",
         action="store_true",

@@ -267,7 +267,7 @@ def _cmd_record(args: argparse.Namespace) -> int:
 
 def _cmd_truth(args: argparse.Namespace) -> int:
     from rsstp_sim.truth import format_truth
-    from rsstp_sim.truth_cache import cache_info, load_truth
+    from rsstp_sim.truth.cache import cache_info, load_truth
 
     if args.cache_info:
         info = cache_info()

@@ -14,7 +14,7 @@ import pytest
 
 from rsstp_sim import parse_scenario
 from rsstp_sim.truth import compute_truth
-from rsstp_sim.truth_cache import cache_info, load_truth, truth_cache_dir, truth_key
+from rsstp_sim.truth.cache import cache_info, load_truth, truth_cache_dir, truth_key
 from scenarios import arm_toml
 
 WORLD = arm_toml([2.0, 1.0], [0, 0], 30, [((0.0, 2.5), 0.5)], name="cached")

@@ -21,7 +21,7 @@ from rsstp_replay import open_recording
 from rsstp_sim.recording.recorder import record
 from rsstp_sim.scenario import load_scenario
 from rsstp_sim.strategies import make_strategy
-from rsstp_sim.truth_cache import truth_cache_dir, truth_key
+from rsstp_sim.truth.cache import truth_cache_dir, truth_key
 from scenarios import sweep_toml
 from waiting import HANG_S, wait_until
 

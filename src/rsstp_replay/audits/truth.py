@@ -54,7 +54,7 @@ from rsstp_sim.arrays import distinct
 from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.truth import GroundTruth
-from rsstp_sim.truth_cache import load_truth
+from rsstp_sim.truth.cache import load_truth
 from rsstp_sim.words import counted
 
 __all__ = ["TruthFindings", "TruthSource", "audit_truth", "step_true_classes", "truth_table"]

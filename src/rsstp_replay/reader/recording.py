@@ -57,7 +57,7 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.recording.builders import model_record
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
-from rsstp_sim.truth_cache import load_truth
+from rsstp_sim.truth.cache import load_truth
 from rsstp_sim.words import counted
 
 __all__ = ["EVENT_KINDS", "Recording", "open_recording"]
@@ -235,7 +235,7 @@ class Recording:
 
     def ground_truth(self, *, cache: bool = True) -> GroundTruth:
         """The scenario's ground truth, once per recording: read from the truth cache on disk
-        (:func:`~rsstp_sim.truth_cache.load_truth`), or computed (seconds for a large world)
+        (:func:`~rsstp_sim.truth.cache.load_truth`), or computed (seconds for a large world)
         and kept there; ``cache=False`` computes it without the disk cache."""
         if self._ground_truth is None:
             self._ground_truth = load_truth(self.scenario, cache=cache)

@@ -66,7 +66,7 @@ from rsstp_sim.memory import Memory
 from rsstp_sim.scenario import AnyScenario
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
-from rsstp_sim.truth_cache import load_truth
+from rsstp_sim.truth.cache import load_truth
 from rsstp_sim.words import counted
 
 __all__ = [

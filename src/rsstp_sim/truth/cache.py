@@ -32,7 +32,7 @@ from pathlib import Path
 import numpy as np
 
 from rsstp_sim.interface import WorldScenario
-from rsstp_sim.truth import GroundTruth, check_truth_size, compute_truth
+from rsstp_sim.truth._ground_truth import GroundTruth, check_truth_size, compute_truth
 
 __all__ = ["CacheInfo", "cache_info", "truth_cache_dir", "load_truth", "truth_key"]
 
