@@ -6,7 +6,8 @@ and a float feedback in ``[0, 1]``. The runner drives a :class:`World` through
 :meth:`World.reset` and :meth:`World.move` and reads the current :class:`Pose`'s sensation and
 feedback; the ground truth reads the body's :class:`PoseMachine`. A body is registered in
 :mod:`rsstp_sim.bodies` as a :class:`Body`: how its scenario table is parsed, how its world is
-made, and how its reachable poses are enumerated.
+made, and how its reachable poses are enumerated (from a scenario before any world, or by
+the world built).
 """
 
 from __future__ import annotations
@@ -109,6 +110,14 @@ class World(Protocol):
     def truth_at(self, row: int, blocker_code: int) -> Any:
         """The truth record of a step ending at ``row`` after a move blocked by
         ``blocker_code``: what the recorder writes there."""
+
+    def check_size(self, *, max_poses: int, max_checks: int | None) -> None:
+        """:meth:`Body.check_size` of the world's scenario, read from the world: refuse
+        before enumerating it."""
+
+    def machine(self) -> PoseMachine:
+        """:meth:`Body.machine` of the world's scenario, from the world's own table (completed
+        in place), not another one: what the ground truth of a world already built reads."""
 
 
 @dataclass(frozen=True, eq=False)

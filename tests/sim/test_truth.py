@@ -249,6 +249,34 @@ def test_refuses_a_pose_space_larger_than_the_limit() -> None:
     assert issubclass(TruthError, RsstpError)
 
 
+@pytest.mark.parametrize(
+    ("name", "per_move"),
+    [
+        ("two-joint-30", False),
+        ("two-joint-30", True),
+        ("thesis-obstacles", False),
+        ("one-way", True),
+        ("rover-one-way", None),
+        ("rover-two-rooms", None),
+    ],
+)
+def test_the_truth_of_a_world_a_run_grew_is_its_bodys(name: str, per_move: bool | None) -> None:
+    """A sweep's worker hands its audit the truth of the world its run was recorded in: that
+    world's own table completed (grown in blocks or move by move) and its size read from it,
+    the truth and the refusal a fresh table of the body gives."""
+    from rsstp_sim.bodies import make_world
+    from rsstp_sim.runner import Runner
+    from rsstp_sim.strategies import RandomStrategy
+
+    scenario = load_scenario(name)
+    world = make_world(scenario) if per_move is None else World(scenario, per_move=per_move)
+    Runner(scenario, RandomStrategy(), seed=3, world=world).run(400)
+    assert compute_truth(scenario, world=world) == compute_truth(scenario)
+    poses = compute_truth(scenario).n_poses
+    with pytest.raises(TruthError, match=r"the pose space has [\d,]+ poses, more than the limit"):
+        compute_truth(scenario, max_poses=poses - 1, world=make_world(scenario))
+
+
 def test_pose_space_counts_only_turned_joints_and_the_step_lattice() -> None:
     only_first = parse_scenario(
         "[arm]\nlengths = [2.0, 1.0]\ninitial_deg = [0, 7]\nstep_deg = 40\nactions = [0, 1]"

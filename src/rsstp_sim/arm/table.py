@@ -49,6 +49,7 @@ from rsstp_sim.arm.geometry import ArmGeometry
 from rsstp_sim.arm.scenario import Scenario
 from rsstp_sim.arrays import BoolArray, FloatArray, Int32Array, IntArray, distinct
 from rsstp_sim.errors import ScenarioError
+from rsstp_sim.interface import PoseMachine
 
 __all__ = [
     "DENSE_LIMIT",
@@ -209,8 +210,12 @@ class WorldTable:
         self._unknown_distances = array.array(
             "d", [math.nan] * (n * self.geometry.m if self.keeps_distances else 0)
         )
-        self.dense = pose_space_size(scenario) <= DENSE_LIMIT
-        self.heavy = tabulation_checks(scenario) > MAX_TABULATION_CHECKS
+        self.pose_space = pose_space_size(scenario)
+        """:func:`pose_space_size`: the lattice poses, a bound on the reachable ones."""
+        self.checks = tabulation_checks(scenario)
+        """:func:`tabulation_checks`: what the whole table costs."""
+        self.dense = self.pose_space <= DENSE_LIMIT
+        self.heavy = self.checks > MAX_TABULATION_CHECKS
         """The whole table would cost more than :data:`MAX_TABULATION_CHECKS`: grow it move by
         move (see :class:`~rsstp_sim.arm.world.World`)."""
         # Rows by pose code: a dense array over a small lattice, else a dict of the poses
@@ -244,6 +249,27 @@ class WorldTable:
         return int(np.count_nonzero((self.next_array() >= 0).any(axis=1)))
 
     # -- growing ---------------------------------------------------------------
+
+    def machine(self) -> PoseMachine:
+        """Every reachable pose: the table completed (:meth:`complete`), its rows put in code
+        order."""
+        self.complete()
+        codes = np.frombuffer(self.codes, dtype=np.int64)
+        order = np.argsort(codes, kind="stable")
+        rank = np.empty(len(order), dtype=np.int64)
+        rank[order] = np.arange(len(order))
+        n = len(self.radix)
+        return PoseMachine(
+            codes=codes[order].copy(),
+            values=self.angles()[order],
+            next_pose=rank[self.next_array()[order]],
+            sensation=self.sensations()[order],
+            start_index=int(rank[0]),
+            value_names=tuple(f"angle_deg_{j}" for j in range(n)),
+            radices=(360,) * n,
+            units=(1,) * n,
+            wrap=True,
+        )
 
     def complete(self) -> None:
         """Compute every reachable pose and all its moves (breadth first from the start)."""

@@ -330,6 +330,15 @@ class World:
         ``blocker_code`` (0: it moved)."""
         return self.pose_at(row).truth_record(self.blocker_of(blocker_code))
 
+    def check_size(self, *, max_poses: int, max_checks: int | None) -> None:
+        s, table = self.scenario, self.table
+        counts = (len(s.actions), s.n_joints, len(s.obstacles))
+        _check_size(s.name, table.pose_space, table.checks, counts, max_poses, max_checks)
+
+    def machine(self) -> PoseMachine:
+        """The world's table completed (:meth:`~rsstp_sim.arm.table.WorldTable.machine`)."""
+        return self.table.machine()
+
     def cache_info(self) -> tuple[int, int]:
         """(poses in the world's table, poses with at least one move computed)."""
         return len(self.table), self.table.moves_computed()
@@ -494,44 +503,41 @@ class _Arm:
         return found
 
     def check_size(self, scenario: Scenario, *, max_poses: int, max_checks: int | None) -> None:
-        if max_checks is None:
-            max_checks = MAX_TABULATION_CHECKS
-        bound = pose_space_size(scenario)
-        if bound > max_poses:
-            raise TruthError(
-                f"{scenario.name}: the pose space has {bound:,} poses, more than the "
-                f"limit of {max_poses:,} (pass a larger max_poses)"
-            )
-        n_actions, n_links = len(scenario.actions), scenario.n_joints
-        checks = tabulation_checks(scenario)
-        if checks > max_checks:
-            raise TruthError(
-                f"{scenario.name}: refused: tabulating the world would take about {checks:,} "
-                f"link-obstacle checks ({bound:,} poses x {n_actions} moves x {n_links} links x "
-                f"{len(scenario.obstacles):,} obstacles), more than the {max_checks:,} (about "
-                "20 s) the ground truth takes on"
-            )
+        bound, checks = pose_space_size(scenario), tabulation_checks(scenario)
+        counts = (len(scenario.actions), scenario.n_joints, len(scenario.obstacles))
+        _check_size(scenario.name, bound, checks, counts, max_poses, max_checks)
 
     def machine(self, scenario: Scenario) -> PoseMachine:
         """The world table completed (breadth first, whole frontiers per vectorised batch),
-        its rows put in code order."""
-        table = WorldTable(scenario)
-        table.complete()
-        codes = np.frombuffer(table.codes, dtype=np.int64)
-        order = np.argsort(codes, kind="stable")
-        rank = np.empty(len(order), dtype=np.int64)
-        rank[order] = np.arange(len(order))
-        n = scenario.n_joints
-        return PoseMachine(
-            codes=codes[order].copy(),
-            values=table.angles()[order],
-            next_pose=rank[table.next_array()[order]],
-            sensation=table.sensations()[order],
-            start_index=int(rank[0]),
-            value_names=tuple(f"angle_deg_{j}" for j in range(n)),
-            radices=(360,) * n,
-            units=(1,) * n,
-            wrap=True,
+        its rows put in code order (:meth:`~rsstp_sim.arm.table.WorldTable.machine`)."""
+        return WorldTable(scenario).machine()
+
+
+def _check_size(
+    name: str,
+    bound: int,
+    checks: int,
+    counts: tuple[int, int, int],
+    max_poses: int,
+    max_checks: int | None,
+) -> None:
+    """Refuse the ground truth of the world ``name`` of ``bound`` lattice poses whose whole
+    table costs ``checks`` link-obstacle checks, ``counts`` its actions, links and obstacles
+    (:meth:`~rsstp_sim.interface.Body.check_size`)."""
+    if max_checks is None:
+        max_checks = MAX_TABULATION_CHECKS
+    if bound > max_poses:
+        raise TruthError(
+            f"{name}: the pose space has {bound:,} poses, more than the "
+            f"limit of {max_poses:,} (pass a larger max_poses)"
+        )
+    n_actions, n_links, n_obstacles = counts
+    if checks > max_checks:
+        raise TruthError(
+            f"{name}: refused: tabulating the world would take about {checks:,} "
+            f"link-obstacle checks ({bound:,} poses x {n_actions} moves x {n_links} links x "
+            f"{n_obstacles:,} obstacles), more than the {max_checks:,} (about "
+            "20 s) the ground truth takes on"
         )
 
 

@@ -10,8 +10,6 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-import numpy as np
-
 from rsstp_format.records import (
     DoorRecord,
     PointRecord,
@@ -20,13 +18,11 @@ from rsstp_format.records import (
     RoverScenarioRecord,
     SegmentRecord,
 )
-from rsstp_sim.errors import TruthError
 from rsstp_sim.interface import PoseMachine
-from rsstp_sim.moore import reached
 from rsstp_sim.rover.picture import RoverPicture
 from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario, parse_rover
 from rsstp_sim.rover.table import RoverTable, check_start
-from rsstp_sim.rover.world import RoverBlocker, RoverPose, RoverWorld
+from rsstp_sim.rover.world import RoverBlocker, RoverPose, RoverWorld, check_size
 
 __all__ = ["ACTION_NAMES", "ROVER", "RoverBlocker", "RoverPose", "RoverScenario", "RoverWorld"]
 
@@ -118,36 +114,12 @@ class _Rover:
         self, scenario: RoverScenario, *, max_poses: int, max_checks: int | None
     ) -> None:
         width, height = scenario.room
-        poses = width * height * scenario.headings
-        if poses > max_poses:
-            raise TruthError(
-                f"{scenario.name}: the pose space has {poses:,} poses, more than the "
-                f"limit of {max_poses:,} (pass a larger max_poses)"
-            )
+        check_size(scenario.name, width * height * scenario.headings, max_poses)
 
     def machine(self, scenario: RoverScenario) -> PoseMachine:
         """Every pose's moves at once (:class:`RoverTable`), then the poses reached from the
-        start, breadth first."""
-        table = RoverTable.of(scenario)
-        n_codes = len(table.next_code)
-        tail = np.repeat(np.arange(n_codes, dtype=np.int64), len(scenario.actions))
-        codes = np.flatnonzero(reached(tail, table.next_code.ravel(), table.start_code, n_codes))
-        rank = np.full(n_codes, -1, dtype=np.int64)
-        rank[codes] = np.arange(len(codes))
-        values = table.values_of(codes)
-        values[:, 2] *= scenario.turn_deg
-        width, height = scenario.room
-        return PoseMachine(
-            codes=codes.astype(np.int64),
-            values=values,
-            next_pose=rank[table.next_code[codes]],
-            sensation=table.sensation[codes],
-            start_index=int(rank[table.start_code]),
-            value_names=("cell_x", "cell_y", "heading_deg"),
-            radices=(width, height, scenario.headings),
-            units=(1, 1, scenario.turn_deg),
-            wrap=False,
-        )
+        start, breadth first (:meth:`RoverTable.machine`)."""
+        return RoverTable.of(scenario).machine()
 
 
 ROVER = _Rover()

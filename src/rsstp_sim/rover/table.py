@@ -19,6 +19,8 @@ import numpy as np
 
 from rsstp_sim.arrays import BoolArray, FloatArray, IntArray
 from rsstp_sim.errors import ScenarioError
+from rsstp_sim.interface import PoseMachine
+from rsstp_sim.moore import reached
 from rsstp_sim.rover.scenario import Door, RoverScenario, Wall
 
 __all__ = [
@@ -144,6 +146,29 @@ class RoverTable:
         s = self.scenario
         width, height = s.room
         return s.start[0] + width * (s.start[1] + height * s.start_heading)
+
+    def machine(self) -> PoseMachine:
+        """The poses reached from the start, breadth first, in code order."""
+        s = self.scenario
+        n_codes = len(self.next_code)
+        tail = np.repeat(np.arange(n_codes, dtype=np.int64), len(s.actions))
+        codes = np.flatnonzero(reached(tail, self.next_code.ravel(), self.start_code, n_codes))
+        rank = np.full(n_codes, -1, dtype=np.int64)
+        rank[codes] = np.arange(len(codes))
+        values = self.values_of(codes)
+        values[:, 2] *= s.turn_deg
+        width, height = s.room
+        return PoseMachine(
+            codes=codes.astype(np.int64),
+            values=values,
+            next_pose=rank[self.next_code[codes]],
+            sensation=self.sensation[codes],
+            start_index=int(rank[self.start_code]),
+            value_names=("cell_x", "cell_y", "heading_deg"),
+            radices=(width, height, s.headings),
+            units=(1, 1, s.turn_deg),
+            wrap=False,
+        )
 
     def values_of(self, codes: IntArray) -> IntArray:
         """The ``(x, y, heading)`` of pose codes, ``(B, 3)``."""

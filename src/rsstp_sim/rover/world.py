@@ -12,11 +12,12 @@ import numpy as np
 from rsstp_format.records import BlockedByRecord, PointRecord, RoverTruthRecord
 from rsstp_format.vocabulary import BlockerKind
 from rsstp_sim.arrays import BoolArray, FloatArray, IntArray
-from rsstp_sim.errors import ActionError
+from rsstp_sim.errors import ActionError, TruthError
+from rsstp_sim.interface import PoseMachine
 from rsstp_sim.rover.scenario import ACTION_NAMES, RoverScenario
 from rsstp_sim.rover.table import ROOM_EDGES, RoverTable
 
-__all__ = ["RoverBlocker", "RoverPose", "RoverWorld"]
+__all__ = ["RoverBlocker", "RoverPose", "RoverWorld", "check_size"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -182,6 +183,14 @@ class RoverWorld:
         ``blocker_code`` (0: it moved)."""
         return self.pose(code).truth_record(self.blocker_of(blocker_code))
 
+    def check_size(self, *, max_poses: int, max_checks: int | None) -> None:
+        width, height = self.scenario.room
+        check_size(self.scenario.name, width * height * self.scenario.headings, max_poses)
+
+    def machine(self) -> PoseMachine:
+        """The world's table's (:meth:`~rsstp_sim.rover.table.RoverTable.machine`)."""
+        return self.table.machine()
+
     @property
     def current(self) -> RoverPose:
         return self._pose
@@ -197,3 +206,13 @@ class RoverWorld:
     @property
     def feedback(self) -> float:
         return self._pose.feedback
+
+
+def check_size(name: str, poses: int, max_poses: int) -> None:
+    """Refuse the ground truth of the room ``name`` of ``poses`` poses (cells x headings) past
+    ``max_poses`` (:meth:`~rsstp_sim.interface.Body.check_size`)."""
+    if poses > max_poses:
+        raise TruthError(
+            f"{name}: the pose space has {poses:,} poses, more than the "
+            f"limit of {max_poses:,} (pass a larger max_poses)"
+        )

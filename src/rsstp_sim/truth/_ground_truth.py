@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 from rsstp_sim.arrays import BoolArray, IntArray
 from rsstp_sim.bodies import body_of
 from rsstp_sim.errors import ModelError, TruthError
-from rsstp_sim.interface import PoseMachine, WorldScenario
+from rsstp_sim.interface import PoseMachine, World, WorldScenario
 from rsstp_sim.moore import moore_classes, reached
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -259,27 +259,41 @@ def format_truth(truth: GroundTruth) -> str:
 
 
 def check_truth_size(
-    scenario: WorldScenario, *, max_poses: int = 2_000_000, max_checks: int | None = None
+    scenario: WorldScenario,
+    *,
+    max_poses: int = 2_000_000,
+    max_checks: int | None = None,
+    world: World | None = None,
 ) -> None:
     """Refuse (:class:`TruthError`), before any work, a world too large to enumerate: more
     than ``max_poses`` poses, or (an arm among obstacles) more than ``max_checks``
     link-obstacle checks (None: the body's own bound, the arm's about 20 s of checks); the
-    same whether the truth is computed or read from the cache."""
-    body_of(scenario).check_size(scenario, max_poses=max_poses, max_checks=max_checks)
+    same whether the truth is computed or read from the cache. ``world``: the scenario's
+    world when already built (a run's), asked instead of its body."""
+    if world is None:
+        body_of(scenario).check_size(scenario, max_poses=max_poses, max_checks=max_checks)
+    else:
+        world.check_size(max_poses=max_poses, max_checks=max_checks)
 
 
 def compute_truth(
-    scenario: WorldScenario, *, max_poses: int = 2_000_000, max_checks: int | None = None
+    scenario: WorldScenario,
+    *,
+    max_poses: int = 2_000_000,
+    max_checks: int | None = None,
+    world: World | None = None,
 ) -> GroundTruth:
     """Enumerate the reachable poses of ``scenario`` and minimise their Moore machine.
 
     Refuses (:class:`TruthError`, before any work) when the body's pose space exceeds
     ``max_poses``, or when checking every move of every pose against every obstacle would
     take more than ``max_checks`` link-obstacle checks (:func:`check_truth_size`).
+    ``world``: the scenario's world when already built (a run's): its own table is
+    completed (:meth:`~rsstp_sim.interface.World.machine`), not another one; the same truth.
     """
     started = time.perf_counter()
-    check_truth_size(scenario, max_poses=max_poses, max_checks=max_checks)
-    machine = body_of(scenario).machine(scenario)
+    check_truth_size(scenario, max_poses=max_poses, max_checks=max_checks, world=world)
+    machine = body_of(scenario).machine(scenario) if world is None else world.machine()
     return _minimised(scenario.name, tuple(scenario.actions), machine, started)
 
 

@@ -31,7 +31,7 @@ from pathlib import Path
 
 import numpy as np
 
-from rsstp_sim.interface import WorldScenario
+from rsstp_sim.interface import World, WorldScenario
 from rsstp_sim.truth._ground_truth import GroundTruth, check_truth_size, compute_truth
 
 __all__ = ["CacheInfo", "cache_info", "truth_cache_dir", "load_truth", "truth_key"]
@@ -77,22 +77,28 @@ def truth_key(scenario: WorldScenario) -> str:
 
 
 def load_truth(
-    scenario: WorldScenario, *, cache: bool = True, max_poses: int = 2_000_000
+    scenario: WorldScenario,
+    *,
+    cache: bool = True,
+    max_poses: int = 2_000_000,
+    world: World | None = None,
 ) -> GroundTruth:
     """The ground truth of ``scenario``: read from the cache when a sound entry is there,
     else computed (:func:`~rsstp_sim.truth.compute_truth`) and kept. ``cache=False`` neither
     reads nor writes the cache. A world over the size bounds is refused either way
-    (:func:`~rsstp_sim.truth.check_truth_size`)."""
+    (:func:`~rsstp_sim.truth.check_truth_size`). ``world``: the scenario's world when
+    already built (a sweep's worker has its run's): sized and enumerated itself instead of
+    by its body."""
     if not cache:
-        return compute_truth(scenario, max_poses=max_poses)
-    check_truth_size(scenario, max_poses=max_poses)
+        return compute_truth(scenario, max_poses=max_poses, world=world)
+    check_truth_size(scenario, max_poses=max_poses, world=world)
     key = truth_key(scenario)
     path = truth_cache_dir() / f"{key}.npz"
     started = time.perf_counter()
     found = _read(path, key, scenario)
     if found is not None:
         return dataclasses.replace(found, seconds=time.perf_counter() - started)
-    truth = compute_truth(scenario, max_poses=max_poses)
+    truth = compute_truth(scenario, max_poses=max_poses, world=world)
     _write(path, key, truth)
     return truth
 
