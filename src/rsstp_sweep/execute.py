@@ -1,7 +1,9 @@
 """One run of a sweep, as a worker does it: record, audit, keep the findings beside the file.
 
 :func:`execute_run` records the run to a local temporary file (byte for byte what
-``rsstp-sim record`` writes), audits it against the ground truth, copies it into the output
+``rsstp-sim record`` writes), audits it against the ground truth (of the world the run was
+recorded in: the world the recorder built is sized and enumerated for it, and the audit
+handed the truth, where it would load it again), copies it into the output
 directory under a temporary name and renames it there, then writes its findings to
 ``findings/<run>.json``. A recording in the output is therefore finished or absent under its
 own name; a run interrupted anywhere leaves nothing a later sweep would trust.
@@ -23,9 +25,12 @@ import warnings
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from rsstp_sweep.plan import Run
+
+if TYPE_CHECKING:
+    from rsstp_sim.interface import World
 
 __all__ = ["FINDINGS", "ROW_FIELDS", "execute_run", "failed_row", "finished_row"]
 
@@ -80,11 +85,12 @@ def execute_run(run: Run, output: str) -> dict[str, Any]:
         with tempfile.TemporaryDirectory(prefix="rsstp-sweep-", dir=_scratch()) as scratch:
             local = Path(scratch) / run.recording
             reused = _fetch_valid(fs, target, local, run)
-            seconds_record = 0.0
+            seconds_record, world = 0.0, None
             if not reused:
-                seconds_record = _record(run, local)
+                seconds_record, world = _record(run, local)
             started = time.perf_counter()
-            findings = _audit(local)
+            findings = _audit(local, world)
+            del world
             seconds_audit = time.perf_counter() - started
             if not reused:
                 part = f"{target}.part"
@@ -143,28 +149,34 @@ def _config(run: Run) -> dict[str, Any]:
     }
 
 
-def _record(run: Run, path: Path) -> float:
-    from rsstp_sim.recording.recorder import record
+def _record(run: Run, path: Path) -> tuple[float, World]:
+    """Record ``run`` to ``path``: the seconds it took, and the world it ran in."""
+    from rsstp_sim.recording.recorder import Recorder
     from rsstp_sim.scenario import parse_scenario
     from rsstp_sim.strategies import make_strategy
 
     # The plan checked the text; the start pose is checked where the world is built.
     scenario = parse_scenario(run.scenario_source, origin=run.scenario_origin, check_start=False)
     started = time.perf_counter()
-    record(path, scenario, make_strategy(run.strategy, run.params), steps=run.steps, seed=run.seed)
-    return time.perf_counter() - started
+    recorder = Recorder(path, scenario, make_strategy(run.strategy, run.params), seed=run.seed)
+    recorder.run(run.steps)  # what record() does, keeping the recorder's world at hand
+    return time.perf_counter() - started, recorder.runner.world
 
 
-def _audit(path: Path) -> dict[str, Any]:
+def _audit(path: Path, world: World | None) -> dict[str, Any]:
+    """The findings of the recording at ``path``; ``world``: the world it was recorded in
+    (None: a recording kept from an earlier sweep), whose truth the truth audit is handed."""
     from rsstp_replay.audits import audit_truth, run_audits
     from rsstp_replay.audits.loaded import load
     from rsstp_replay.reader.recording import open_recording
+    from rsstp_sim.truth.cache import load_truth
 
+    truth = None if world is None else load_truth(world.scenario, world=world)
     with open_recording(path) as recording:
         loaded = load(recording)
         report = run_audits(loaded)
-        truth = audit_truth(loaded, within_versions=report.within_versions)
-    summary, verdict = report.summary, truth.verdict
+        audited = audit_truth(loaded, truth=truth, within_versions=report.within_versions)
+    summary, verdict = report.summary, audited.verdict
     final = report.determinism.final.version
     return {
         "recorded_steps": summary.steps,
