@@ -240,6 +240,40 @@ def test_reading_a_recording_never_calls_back_up(finished: bool, tmp_path: Path)
     }
 
 
+WALK = SRC.parent / "bench" / "walk.py"
+
+
+@pytest.mark.parametrize(
+    ("scenario", "strategy", "body"),
+    [("thesis-algo", "random", "rsstp_sim/arm"), ("rover-room", "learner", "rsstp_sim/rover")],
+)
+def test_a_sweep_runs_scenario_goes_down_the_floors_without_coming_back(
+    scenario: str, strategy: str, body: str
+) -> None:
+    """The scenario of a sweep's run, planned and then recorded and audited as a worker does
+    (``bench/walk.py``), is handed to each floor once, top down: the plan, the recorder, the
+    run, the body (its world, checked at its start, and the header read from it), the ground
+    truth of that world, the reader. No floor goes back with it to one it has left (issue 31:
+    the plan, the worker and the reader each checked the start with the body's geometry,
+    the header and the audit's truth went back down to the registry and the body)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("walk", WALK)
+    assert spec is not None and spec.loader is not None
+    walk = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(walk)
+    visits = walk.walk(scenario, strategy, 300)
+    floors = [floor for floor, _ in walk.stops_of([(walk.floor_of(w), f) for w, f in visits])]
+    assert floors == [
+        "rsstp_sweep",
+        "rsstp_sim/recording",
+        "rsstp_sim",
+        body,
+        "rsstp_sim/truth",
+        "rsstp_replay/reader",
+    ]
+
+
 READING = """
 import sys
 from rsstp_replay import open_recording
