@@ -133,11 +133,11 @@ def unsensable(scenario: Scenario) -> str | None:
     return None
 
 
-def check_start(scenario: Scenario, geo: ArmGeometry | None = None) -> None:
-    """Raise :class:`~rsstp_sim.errors.ScenarioError` when the arm cannot stand at its start
-    pose (a link meets an obstacle or another link, a joint folds back); ``geo``: the
-    scenario's geometry when already built (the table's)."""
-    geo = ArmGeometry.from_scenario(scenario) if geo is None else geo
+def check_start(scenario: Scenario) -> ArmGeometry:
+    """The scenario's geometry, once it has checked the start pose: raise
+    :class:`~rsstp_sim.errors.ScenarioError` when the arm cannot stand there (a link meets an
+    obstacle or another link, a joint folds back)."""
+    geo = ArmGeometry.from_scenario(scenario)
     initial = list(scenario.initial_deg)
     blocker = geo.decode(int(geometry.pose_blockers(geo, [initial])[0]))
     if blocker is not None:
@@ -145,6 +145,7 @@ def check_start(scenario: Scenario, geo: ArmGeometry | None = None) -> None:
             f"{scenario.origin}: arm.initial_deg: the start pose {initial} is invalid "
             f"({blocker.describe()})"
         )
+    return geo
 
 
 def pose_space_size(scenario: Scenario) -> int:
@@ -167,8 +168,12 @@ class WorldTable:
 
     def __init__(self, scenario: Scenario) -> None:
         self.scenario = scenario
-        self.geometry = ArmGeometry.from_scenario(scenario)
-        check_start(scenario, self.geometry)
+        self.pose_space = pose_space_size(scenario)
+        """:func:`pose_space_size`: the lattice poses, a bound on the reachable ones."""
+        self.checks = tabulation_checks(scenario)
+        """:func:`tabulation_checks`: what the whole table costs."""
+        sizes = np.asarray(lattice_sizes(scenario), dtype=np.int64)
+        self.geometry = check_start(scenario)
         n = scenario.n_joints
         self.actions: tuple[int, ...] = tuple(scenario.actions)
         self.radix = np.array([360**k for k in range(n)], dtype=np.int64)
@@ -210,17 +215,12 @@ class WorldTable:
         self._unknown_distances = array.array(
             "d", [math.nan] * (n * self.geometry.m if self.keeps_distances else 0)
         )
-        self.pose_space = pose_space_size(scenario)
-        """:func:`pose_space_size`: the lattice poses, a bound on the reachable ones."""
-        self.checks = tabulation_checks(scenario)
-        """:func:`tabulation_checks`: what the whole table costs."""
         self.dense = self.pose_space <= DENSE_LIMIT
         self.heavy = self.checks > MAX_TABULATION_CHECKS
         """The whole table would cost more than :data:`MAX_TABULATION_CHECKS`: grow it move by
         move (see :class:`~rsstp_sim.arm.world.World`)."""
         # Rows by pose code: a dense array over a small lattice, else a dict of the poses
         # reached.
-        sizes = np.asarray(lattice_sizes(scenario), dtype=np.int64)
         self._spacing = math.gcd(scenario.step_deg, 360)
         self._lattice_radix = np.concatenate([[1], np.cumprod(sizes)[:-1]]).astype(np.int64)
         self._initial = np.asarray(scenario.initial_deg, dtype=np.int64)
