@@ -1,9 +1,9 @@
 """One run of a sweep, as a worker does it: record, audit, keep the findings beside the file.
 
 :func:`execute_run` records the run to a local temporary file (byte for byte what
-``rsstp-sim record`` writes), audits it against the ground truth (of the world the run was
-recorded in: the world the recorder built is sized and enumerated for it, and the audit
-handed the truth, where it would load it again), copies it into the output
+``rsstp-sim record`` writes), audits it against the ground truth of the world the run was
+recorded in (read from the truth cache, or enumerated by that world's own table, and handed
+to the truth audit), copies it into the output
 directory under a temporary name and renames it there, then writes its findings to
 ``findings/<run>.json``. A recording in the output is therefore finished or absent under its
 own name; a run interrupted anywhere leaves nothing a later sweep would trust.
@@ -31,6 +31,7 @@ from rsstp_sweep.plan import Run
 
 if TYPE_CHECKING:
     from rsstp_sim.interface import World
+    from rsstp_sim.truth import GroundTruth
 
 __all__ = ["FINDINGS", "ROW_FIELDS", "execute_run", "failed_row", "finished_row"]
 
@@ -89,8 +90,9 @@ def execute_run(run: Run, output: str) -> dict[str, Any]:
             if not reused:
                 seconds_record, world = _record(run, local)
             started = time.perf_counter()
-            findings = _audit(local, world)
-            del world
+            truth = None if world is None else _truth_of(world)
+            world = None  # its table goes before the recording is read
+            findings = _audit(local, truth)
             seconds_audit = time.perf_counter() - started
             if not reused:
                 part = f"{target}.part"
@@ -163,15 +165,21 @@ def _record(run: Run, path: Path) -> tuple[float, World]:
     return time.perf_counter() - started, recorder.runner.world
 
 
-def _audit(path: Path, world: World | None) -> dict[str, Any]:
-    """The findings of the recording at ``path``; ``world``: the world it was recorded in
-    (None: a recording kept from an earlier sweep), whose truth the truth audit is handed."""
+def _truth_of(world: World) -> GroundTruth:
+    """The ground truth of the world a run was recorded in: read from the truth cache, or
+    enumerated by the world's own table (not another one built from the scenario)."""
+    from rsstp_sim.truth.cache import load_truth
+
+    return load_truth(world.scenario, world=world)
+
+
+def _audit(path: Path, truth: GroundTruth | None) -> dict[str, Any]:
+    """The findings of the recording at ``path``; ``truth``: its world's ground truth (None:
+    a recording kept from an earlier sweep, whose truth the truth audit loads)."""
     from rsstp_replay.audits import audit_truth, run_audits
     from rsstp_replay.audits.loaded import load
     from rsstp_replay.reader.recording import open_recording
-    from rsstp_sim.truth.cache import load_truth
 
-    truth = None if world is None else load_truth(world.scenario, world=world)
     with open_recording(path) as recording:
         loaded = load(recording)
         report = run_audits(loaded)
