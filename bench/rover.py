@@ -28,6 +28,8 @@ the learner says the run started in (:attr:`LearnerStrategy.start_state
 is from some state of the model (``right model, start unknown``: walls can bring two starts
 to one pose before the sensation is first seen, and then no trajectory tells them apart).
 
+``--mode float``: the float twin of each world (``mode = "float"`` in its ``[feedback]``).
+
 ``--diagnose``: after each run, what the learner's hypothesis got wrong against the truth
 (:func:`diagnose`): duplicate states, and confirmed transitions that lead to the wrong class.
 
@@ -147,10 +149,12 @@ def learn(
     seed: int = 0,
     factor: float = 4.0,
     diagnosis: bool = False,
+    mode: str = "bool",
 ) -> str:
-    scenario = (
-        load_scenario(text_or_name) if "\n" not in text_or_name else parse_scenario(text_or_name)
-    )
+    text = load_scenario(text_or_name).source if "\n" not in text_or_name else text_or_name
+    if mode == "float":
+        text = text.replace("[feedback]\n", '[feedback]\nmode = "float"\n', 1)
+    scenario = parse_scenario(text)
     truth = compute_truth(scenario)
     n = truth.n_classes
     budget = int(factor * n * n) if budget is None else budget
@@ -177,7 +181,8 @@ def learn(
         )
         verdict = "NOT equivalent (right model, start unknown)" if right else "NOT equivalent"
     return (
-        f"{scenario.name} seed {seed}: N = {n:,}, budget {budget:,} ({budget / n**2:.2f} N^2): "
+        f"{scenario.name} ({mode}) seed {seed}: N = {n:,}, "
+        f"budget {budget:,} ({budget / n**2:.2f} N^2): "
         f"{steps:,} steps ({steps / n**2:.2f} N^2) in {seconds:.1f} s, "
         f"{len(runner.model):,} model states, {verdict}"
         + (f" ({runner.stopped})" if runner.stopped else "")
@@ -198,6 +203,9 @@ def main() -> None:
     parser.add_argument("--no-built-ins", action="store_true", help="the learner on rooms only")
     parser.add_argument(
         "--diagnose", action="store_true", help="duplicates and wrong transitions at the end"
+    )
+    parser.add_argument(
+        "--mode", choices=("bool", "float"), default="bool", help="the learner's feedback"
     )
     args = parser.parse_args()
     print(f"load average {os.getloadavg()[0]:.2f}")
@@ -228,9 +236,16 @@ def main() -> None:
     rooms += [generated_room(i) for i in range(args.generated)]
     for seed in range(args.seeds):
         for room in rooms:
-            print(learn(room, None, seed=seed, factor=args.factor, diagnosis=args.diagnose))
+            print(
+                learn(room, None, seed=seed, factor=args.factor, diagnosis=args.diagnose,
+                      mode=args.mode),
+                flush=True,
+            )  # fmt: skip
         for name in () if args.no_built_ins else BUILT_INS:
-            print(learn(name, args.budget, seed=seed, diagnosis=args.diagnose), flush=True)
+            print(
+                learn(name, args.budget, seed=seed, diagnosis=args.diagnose, mode=args.mode),
+                flush=True,
+            )
 
 
 if __name__ == "__main__":

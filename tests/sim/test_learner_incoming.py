@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -170,7 +171,7 @@ def test_the_states_by_feel_are_kept_through_a_whole_run() -> None:
             st.integers(0, 30),
             st.sampled_from([0.25, 0.5, 0.75, float("nan")]),
         ),
-        max_size=40,
+        max_size=80,
     )  # fmt: skip
 )
 def test_the_states_by_feel_follow_new_states_feels_and_merges(
@@ -192,3 +193,26 @@ def test_the_states_by_feel_follow_new_states_feels_and_merges(
             for sensation in (False, True):
                 expected = alive[h.agree(alive, sensation, felt)].tolist()
                 assert h.matching(sensation, felt) == expected
+        # The feel is shared when the felt states are twice the values felt, 16 states at least.
+        felt_states = [int(s) for s in alive if h.feel[s] == h.feel[s]]
+        values = {float(h.feel[s]) for s in felt_states}
+        values |= {v for s in felt_states for v in h.also_felt.get(s, ())}
+        shared = len(felt_states) >= 16 and len(felt_states) >= 2 * len(values)
+        assert h.feel_shared() == shared
+
+
+@pytest.mark.parametrize(
+    ("values", "states", "shared"),
+    [(1, 15, False), (1, 16, True), (8, 16, True), (9, 17, False), (20, 20, False)],
+)
+def test_the_feel_is_shared_when_states_outnumber_the_values_felt_twice(
+    values: int, states: int, shared: bool
+) -> None:
+    # ``states`` states (the landmark among them) felt as ``values`` values in turn.
+    actions = (0, 1)
+    h = Hypothesis(TransitionSystem.universal(actions), actions, landmark=0, feels=True)
+    h.set_feel(0, 0.0)
+    for i in range(1, states):
+        h.create(0, actions[i % 2], False, (), (i % values) / values)
+    assert len(h.states()) == states
+    assert h.feel_shared() == shared

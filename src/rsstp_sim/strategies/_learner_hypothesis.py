@@ -35,6 +35,13 @@ EVIDENCE = 4
 """The confirmed moves by an action, from states known whole, that :meth:`Hypothesis.irreversible`
 needs before it finds that no action undoes it."""
 
+SHARED_FEEL = 2.0
+"""With float feedback, the feel is taken as shared (:meth:`Hypothesis.feel_shared`) when the
+states felt are at least this many times the felt values."""
+
+FELT_STATES = 16
+"""...and at least this many states are felt (a few first states may feel alike by chance)."""
+
 
 class _TooFar:
     """:meth:`Hypothesis._search_near` met too many states: search a level at a time."""
@@ -184,6 +191,16 @@ class Hypothesis:
         if felt != felt or felt == feel:  # (NaN: unknown)
             return True
         return feel in self.also_felt.get(s, ())
+
+    def feel_shared(self) -> bool:
+        """With ``feels``: whether the feel fails to single out poses, :data:`SHARED_FEEL`
+        states or more sharing each felt value on average, once :data:`FELT_STATES` states are
+        felt (a rover's closeness to a region is felt alike in a ring of cells and every
+        heading; an arm's is near one value a pose)."""
+        if not self.feels or not self._by_feel:
+            return False
+        felt = len(self.labels) - len(self._unfelt)
+        return felt >= FELT_STATES and felt >= SHARED_FEEL * len(self._by_feel)
 
     def matching(self, sensation: bool, feel: float) -> list[int]:
         """The states agreeing with what was sensed (and felt), by id."""

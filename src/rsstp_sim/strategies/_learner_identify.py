@@ -30,7 +30,18 @@ fewer steps of Python than the arrays' fixed cost."""
 LOCATED_STEPS = 2
 """With float feedback, a test ends when one candidate is left and it has agreed with what
 was sensed and felt for this many steps: the agent is located there
-(:meth:`Identifier.session`)."""
+(:meth:`Identifier.session`); :data:`SHARED_LOCATED_STEPS` where the feel is shared."""
+
+SHARED_LOCATED_STEPS = 6
+""":data:`LOCATED_STEPS` where many states feel alike (:meth:`Hypothesis.feel_shared`): two
+steps that agree then say little (an 8 x 8 rover room was done with a wrong model)."""
+
+SHARED_DOUBTS = 64
+"""The ``doubts`` (the candidates left after the way back that are still tested one by one,
+:meth:`Identifier.identify`) where many states feel alike, at least: a state taken as new
+there is most often another pose felt alike, and its own transitions, taken as new in turn,
+grow a copy of the room (in rover rooms of 36 to 256 classes, 1 doubt left 2 to 9 states a
+class at 4 N^2 steps; 8 or 64 learned them)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -109,6 +120,7 @@ class Identifier(Walker):
         agent located, :meth:`session`).
         """
         h = self.h
+        shared = h.feel_shared()
         candidates = set(h.matching(label, feel)) - exclude
         undo = h.inverses().get(a)
         ranked = self.predict(q, a, candidates, undo)
@@ -144,7 +156,8 @@ class Identifier(Walker):
                         # transition by ``undo`` leads elsewhere is not it.
                         column = h.column[undo] if undo is not None else 0
                         pool = pool[h.next[pool, column] < 0]
-                        if not len(pool) or len(pool) > self.doubts or tried - set(ranked):
+                        doubts = max(self.doubts, SHARED_DOUBTS) if shared else self.doubts
+                        if not len(pool) or len(pool) > doubts or tried - set(ranked):
                             self.count("taken_as_new")
                             self.new(q, a, label, access, here=False, feel=feel)
                             return
@@ -276,10 +289,12 @@ class Identifier(Walker):
         the candidates that reached the landmark with the world (if it was reached), the
         candidates not ruled out, whether the landmark was reached, and the candidate the
         agent was located as (else None): with float feedback, when one candidate is left,
-        followed, agreeing with what was sensed and felt for :data:`LOCATED_STEPS` steps, the
+        followed, agreeing with what was sensed and felt for :data:`LOCATED_STEPS` steps
+        (:data:`SHARED_LOCATED_STEPS` where the feel is shared), the
         test ends there and the agent believes it is where that candidate is now.
         """
         h = self.h
+        located_after = SHARED_LOCATED_STEPS if h.feel_shared() else LOCATED_STEPS
         ids = np.asarray(sorted(candidates), dtype=np.int64)
         position = ids.copy()
         tracked = np.ones(len(ids), dtype=bool)
@@ -292,7 +307,7 @@ class Identifier(Walker):
                 return (
                     yield from self._session_few(
                         via, ids.tolist(), position.tolist(), tracked.tolist(), chosen, script,
-                        follow=follow, taken=taken,
+                        follow=follow, taken=taken, located_after=located_after,
                     )
                 )  # fmt: skip
             if script:
@@ -329,7 +344,7 @@ class Identifier(Walker):
             if sensation:
                 at_landmark = True
                 break
-            if h.feels and taken >= LOCATED_STEPS and len(ids) == 1 and tracked[0]:
+            if h.feels and taken >= located_after and len(ids) == 1 and tracked[0]:
                 self.belief = int(position[0])
                 self.beliefs[-1] = self.belief
                 return {int(ids[0])}, {int(ids[0])}, False, int(ids[0])
@@ -347,6 +362,7 @@ class Identifier(Walker):
         *,
         follow: bool,
         taken: int,
+        located_after: int,
     ) -> Generator[int, bool, tuple[set[int], set[int], bool, int | None]]:
         """:meth:`session` on from where it is, with :data:`FEW` candidates or fewer: one at a
         time, in lists (``ids[i]`` followed from ``position[i]``, ruled out when it disagrees
@@ -397,7 +413,7 @@ class Identifier(Walker):
             if sensation:
                 at_landmark = True
                 break
-            if h.feels and taken >= LOCATED_STEPS and len(ids) == 1 and tracked[0]:
+            if h.feels and taken >= located_after and len(ids) == 1 and tracked[0]:
                 self.belief = position[0]
                 self.beliefs[-1] = self.belief
                 return {ids[0]}, {ids[0]}, False, ids[0]

@@ -63,7 +63,9 @@ class LearnerStrategy(StrategyBase):
 
     - ``doubts`` (>= 0, default 1): after the way back showed a state is new as far as the
       confirmed transitions tell, how many remaining candidates are still tested one by one;
-      more than that and the state is taken as new (merged later if it was not).
+      more than that and the state is taken as new (merged later if it was not). With float
+      feedback felt alike by many states (on average two or more a value felt, as a rover's
+      closeness to a region is), 64 at least.
     - ``stop`` (default true): end the run when done; false: walk the model and check it
       until the budget of steps is spent.
 
