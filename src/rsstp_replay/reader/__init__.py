@@ -16,6 +16,7 @@ from rsstp_replay.reader._decode import (
 )
 from rsstp_replay.reader._models import (
     ModelHistory,
+    model_history,
     version_alive,
     version_heads,
     version_sizes,
@@ -29,6 +30,7 @@ __all__ = [
     "blocker_label",
     "blocker_texts",
     "body_reader",
+    "model_history",
     "version_alive",
     "version_heads",
     "version_sizes",

@@ -34,6 +34,7 @@ __all__ = [
     "ModelHead",
     "ModelHistory",
     "build_model",
+    "model_history",
     "version_alive",
     "version_heads",
     "version_sizes",
@@ -369,6 +370,19 @@ class ModelHistory(Sequence[ModelRecord]):
                 version=head.version,
             )
 
+    def arrays(self, index: int) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """Version ``index``'s state ids, sorted, and its transitions as rows ``(source,
+        action, target)``, sorted: the operations since the nearest whole model kept applied
+        to arrays, as :meth:`model` applies them, without a model made (a model, when the ids
+        are too wide for the keys). Walking forward reuses the version reached last."""
+        k = range(len(self._heads))[index]
+        keyed = self._keyed_version(k)
+        if keyed is not None:
+            return keyed.arrays()
+        model = self._rebuilt_model(k)
+        rows = np.asarray(model.transitions(), np.int64).reshape(-1, 3)
+        return np.asarray(model.states, np.int64), rows
+
     def _keyed_version(self, k: int) -> KeyedVersion | None:
         """Version ``k``'s transitions as sorted keys, from the last whole model kept at or
         before it (or from the version rebuilt so last, when that lies between); None when
@@ -442,6 +456,26 @@ class ModelHistory(Sequence[ModelRecord]):
         model.current = self._heads[k].current
         self._cache = (k, model)
         return model
+
+
+def model_history(versions: Sequence[ModelRecord]) -> ModelHistory:
+    """``versions`` as a :class:`ModelHistory`: itself (a recording's), or model messages
+    given in a plain sequence (the first whole, each later one's operations applying to the
+    one before, as a recorder makes them) rebuilt one after the other."""
+    if isinstance(versions, ModelHistory):
+        return versions
+    history = ModelHistory()
+    model: TransitionSystem | None = None
+    for record in versions:
+        if model is None:
+            model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
+        else:
+            for operation in record.operations:
+                model.apply(operation.to_operation())
+            model.drain_operations()
+            model.current = record.current
+        history.add(record, model)
+    return history
 
 
 def version_heads(versions: Sequence[ModelRecord]) -> Sequence[ModelRecord]:
