@@ -8,6 +8,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from rsstp_sim.arrays import distinct
+
 __all__ = ["factorized", "first_indices"]
 
 _BLOCK = 1 << 16
@@ -38,12 +40,13 @@ def factorized(
     """``np.unique(values, return_inverse=True)``: the distinct values, sorted (in the dtype of
     ``values``), and each value's index among them. Non-negative integers below four times
     their number (a state, an action, a version number per step) are counted in a table
-    instead of sorted; others are sorted."""
+    instead of sorted; others are sorted (not argsorted, as ``np.unique`` does: the values
+    found, then each one's place among them)."""
     if len(values) and int(values.min()) >= 0 and int(values.max()) < 4 * len(values) + 2**16:
         present = np.zeros(int(values.max()) + 1, np.bool_)
         present[values] = True
         index = np.cumsum(present, dtype=np.intp)
         index -= 1
         return np.flatnonzero(present).astype(values.dtype, copy=False), index[values]
-    distinct, inverse = np.unique(values, return_inverse=True)
-    return distinct, inverse
+    found = distinct(values)
+    return found, np.searchsorted(found, values).astype(np.intp, copy=False)
