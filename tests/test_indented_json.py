@@ -1,6 +1,7 @@
 """``--json`` documents written by :func:`rsstp_cli._json.indented`: the text
-``json.dumps(value, indent=2)`` writes, for any JSON value (nested or not, keys of every kind
-json accepts, text with control characters, the NUL the encoder separates items with)."""
+``json.dumps(value, indent=2)`` writes, for any JSON value (nested or not, containers of
+containers of plain values, keys of every kind json accepts, text with control characters,
+brackets and the NUL the encoder separates items with)."""
 
 from __future__ import annotations
 
@@ -34,10 +35,17 @@ values = st.recursive(
     ),
     max_leaves=40,
 )
+leaves = st.lists(plain, max_size=3) | st.dictionaries(keys, plain, max_size=3)
+shallow = (  # containers of containers of plain values (some empty), written in one call
+    st.lists(st.lists(plain, max_size=3), min_size=1, max_size=4)
+    | st.lists(st.dictionaries(keys, plain, max_size=3), min_size=1, max_size=4)
+    | st.dictionaries(keys, st.lists(plain, max_size=3).map(tuple), min_size=1, max_size=4)
+    | st.dictionaries(keys, leaves, min_size=1, max_size=4)
+)
 
 
-@settings(max_examples=500, deadline=None)
-@given(values)
+@settings(max_examples=800, deadline=None)
+@given(values | shallow | st.lists(shallow, max_size=3))
 def test_the_text_is_json_dumps_with_an_indent_of_two(value: object) -> None:
     assert indented(value) == json.dumps(value, indent=2)
 

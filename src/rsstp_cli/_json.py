@@ -48,16 +48,14 @@ def _write(value: Any, depth: int, parts: list[str]) -> None:
         text = _plain(value)
         parts.append(text[0] + inner + text[1:-1].replace("\0", "," + inner) + closing + text[-1])
         return
+    kinds = {dict if isinstance(item, dict) else isinstance(item, list | tuple) for item in items}
+    if kinds in ({dict}, {True}) and not any(map(_nested, items)):  # containers of plain values
+        _write_leaves(value, dict in kinds, inner, closing, parts)
+        return
     if isinstance(value, dict):
         parts.append("{")
         for k, (key, item) in enumerate(value.items()):
-            # The key as json.dumps writes it (a number, true, false or null as text).
-            name = (
-                encode_basestring_ascii(key)
-                if type(key) is str
-                else json.dumps({key: None})[1 : -len(": null}")]
-            )
-            parts.append(("," if k else "") + inner + name + ": ")
+            parts.append(("," if k else "") + inner + _name(key) + ": ")
             _write(item, depth + 1, parts)
         parts.append(closing + "}")
         return
@@ -66,3 +64,38 @@ def _write(value: Any, depth: int, parts: list[str]) -> None:
         parts.append(("," if k else "") + inner)
         _write(item, depth + 1, parts)
     parts.append(closing + "]")
+
+
+def _nested(value: Any) -> bool:
+    """Whether ``value`` (a container) holds a container."""
+    items = value.values() if isinstance(value, dict) else value
+    return any(map(isinstance, items, repeat(_CONTAINERS)))
+
+
+def _write_leaves(value: Any, of_dicts: bool, inner: str, closing: str, parts: list[str]) -> None:
+    """A container (``inner``, ``closing``: its line breaks) whose items are all containers
+    of plain values, all dicts (``of_dicts``) or all lists: its items encoded in one call,
+    then cut apart where one ends and the next begins (``}\\0{`` or ``]\\0[``: a bare
+    ``"\\0"`` is never inside a string)."""
+    items = list(value.values()) if isinstance(value, dict) else value
+    opening, ending = ("{", "}") if of_dicts else ("[", "]")
+    deeper = inner + " " * _INDENT
+    pieces = _plain(items)[2:-2].split(ending + "\0" + opening)
+    texts = [
+        opening + deeper + piece.replace("\0", "," + deeper) + inner + ending
+        if piece
+        else opening + ending
+        for piece in pieces
+    ]
+    if isinstance(value, dict):
+        names = [_name(key) for key in value]
+        texts = [name + ": " + text for name, text in zip(names, texts, strict=True)]
+    outer = ("{", "}") if isinstance(value, dict) else ("[", "]")
+    parts.append(outer[0] + inner + ("," + inner).join(texts) + closing + outer[1])
+
+
+def _name(key: Any) -> str:
+    """A key as json.dumps writes it (a number, true, false or null as text)."""
+    if type(key) is str:
+        return str(encode_basestring_ascii(key))
+    return json.dumps({key: None})[1 : -len(": null}")]
