@@ -15,6 +15,7 @@ from rsstp_replay.reader._decode import (
     body_reader,
 )
 from rsstp_replay.reader._models import (
+    DeterminismPart,
     ModelHistory,
     model_history,
     version_alive,
@@ -26,6 +27,7 @@ from rsstp_replay.reader._models import (
 __all__ = [
     "BLOCKED_COLUMNS",
     "BodyReader",
+    "DeterminismPart",
     "ModelHistory",
     "blocker_label",
     "blocker_texts",
