@@ -6,6 +6,7 @@
     PYTHONPATH=src python bench/learning.py --spread 10     # steps to learn over seeds 0-9
     PYTHONPATH=src python bench/learning.py --curve --max-n 1200 --no-aalpy   # steps / N^2
     PYTHONPATH=src python bench/learning.py --curve --seeds 5 --no-aalpy      # seeds 0-4
+    PYTHONPATH=src python bench/learning.py --audit RUN.mcap   # audit --truth of a kept run, cold
 
 For each built-in scenario: the ground truth's minimal model (N states); the ``learner``
 strategy run until it is done (or its step budget is spent), its steps, seconds and whether its
@@ -47,6 +48,11 @@ no message indexes, chunks compressed harder). Targets: the record of the 1,200-
 most 2 minutes; for the 4,841-class world (``two-links-5``, issue 32): ``record`` at most 1.5 x
 ``run``, a file of at most 40 MB, ``audit --truth`` within 20 s and 1 GiB, ``view --save``
 within 1 GiB.
+
+``--audit FILE``: ``rsstp-replay audit FILE --truth --json --quiet`` alone, cold in a fresh
+process, ``--repeat`` times (default 3), on a recording kept with ``--keep`` (the 4,841-class
+run takes minutes to record): wall and CPU seconds, peak memory, the load average before each
+run, and the verdict. Target for the 4,841-class run: within 20 s and 1 GiB.
 
 ``--spread K``: the learner alone on each scenario with seeds ``0 .. K-1``, the steps to learn
 (least, median, most, and as multiples of N^2) and how many runs ended equivalent: the seed
@@ -523,6 +529,27 @@ def record(
     return bool(audit["truth"]["final_equivalent"])
 
 
+def audit(mcap: Path, repeat: int) -> bool:
+    """``rsstp-replay audit --truth`` of a kept recording, cold, ``repeat`` times; prints one
+    line each, returns whether the recording's final model is the truth's."""
+    if not mcap.is_file():
+        sys.exit(f"--audit: expected a recording, {mcap} is not a file")
+    replay = str(Path(sys.executable).parent / "rsstp-replay")
+    command = [replay, "audit", str(mcap), "--truth", "--json", "--quiet"]
+    print(f"rsstp-replay audit --truth --json of {mcap} ({mcap.stat().st_size / 1e6:.0f} MB)")
+    for _ in range(repeat):
+        load = os.getloadavg()[0]
+        wall, cpu, peak = measure_cpu(command)
+        print(
+            f"  {wall:7.1f} s wall {cpu:7.1f} s CPU {peak:5.2f} GiB (load average {load:.1f})",
+            flush=True,
+        )
+    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    found = json.loads(done.stdout)
+    print(f"  {found['verdict']['text']}")
+    return bool(found["truth"]["final_equivalent"])
+
+
 def _hw_on(
     name: str, scenario: Scenario, seconds: float, seed: int, memory_gib: float
 ) -> dict[str, Any]:
@@ -582,12 +609,20 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--float", action="store_true", help="--record: the float twin")
     parser.add_argument("--keep", type=Path, metavar="FILE", help="--record: keep the recording")
     parser.add_argument("--compact", action="store_true", help="--record: a compact file")
+    parser.add_argument(
+        "--audit", type=Path, metavar="FILE", help="audit --truth of a recording, cold"
+    )
+    parser.add_argument("--repeat", type=int, default=3, help="--audit: how many times")
     parser.add_argument("--hw-child", metavar="SCENARIO", help=argparse.SUPPRESS)
     parser.add_argument("scenarios", nargs="*", default=list(SCENARIOS))
     args = parser.parse_args(argv)
     if args.hw_child:
         _hw_child(args.hw_child, args.aalpy_seconds, args.seed, args.aalpy_memory_gib)
         return 0
+    if args.audit:
+        if args.repeat < 1:
+            parser.error(f"--repeat must be >= 1, got {args.repeat}")
+        return 0 if audit(args.audit, args.repeat) else 1
     if args.record:
         return (
             0

@@ -28,6 +28,7 @@ from rsstp_cli._commandline import (
     run_command,
     warning_line,
 )
+from rsstp_cli._json import indented
 from rsstp_replay.errors import StepOutOfRange, UnfinishedRecordingWarning
 from rsstp_replay.export.table_files import (
     TABLE_FORMATS,
@@ -236,7 +237,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
                 **document,
                 "truth": truth.to_json(),
             }
-        print(json.dumps(document, indent=2))
+        print(indented(document))  # json.dumps(document, indent=2), faster
     else:
         if truth is not None and explanation is not None:
             print(f"{truth.verdict.to_text()}\n")

@@ -697,3 +697,45 @@ def test_a_recording_whose_numbers_another_geometry_made_opens_and_physics_names
     assert main(["check", str(moved), "--physics"]) == 1
     out = capsys.readouterr().out
     assert f"physics: broken at step 0, truth.joint_positions[{n}].x: recorded" in out
+
+
+def test_the_audits_read_the_model_messages_with_the_steps_and_name_a_bad_step_first(
+    original: Path, damaged: dict[str, Path], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The audits read the model messages in the pass that decodes the steps (each chunk
+    read once): the versions are those read on their own, a broken chain is named as there,
+    and a file with a broken chain and, later, a bad step names the step, as when the model
+    messages were read after the steps."""
+    from rsstp_replay.audits.loaded import load
+    from rsstp_replay.reader._container import Container
+
+    with open_recording(original) as alone:
+        versions = alone.model_versions()
+    read: list[int] = []
+    chunk_data = Container.chunk_data
+
+    def counted(self: Container, stream: Any, ref: Any) -> bytes:
+        read.append(ref.offset)
+        return chunk_data(self, stream, ref)
+
+    monkeypatch.setattr(Container, "chunk_data", counted)
+    with open_recording(original) as together:
+        loaded = load(together)
+        assert together.model_versions() is loaded.model_versions()
+        assert list(loaded.model_versions()) == list(versions)  # every version whole
+    assert sorted(read) == sorted(set(read)) == chunk_offsets(original)
+    with open_recording(damaged["broken-chain"]) as recording:
+        with pytest.raises(errors.CorruptRecording, match=CASES["broken-chain"].match):
+            load(recording)
+
+    def set_late_action(step: dict[str, Any]) -> None:
+        step["agent"]["action"] = 1.5
+
+    both = rewrite(
+        damaged["broken-chain"],
+        tmp_path / "both.mcap",
+        message=edit_json("/rsstp/step", STEPS - 3, set_late_action),
+    )
+    with open_recording(both) as recording:
+        with pytest.raises(errors.CorruptRecording, match=f"at step {STEPS - 3} "):
+            load(recording)

@@ -1,6 +1,5 @@
-"""The model versions kept as changes (every version rebuilt whole from them is the model its
-operations made), and what an operation changes: the truth audit's tracked successor table
-(kept through the touched states, equal to one built afresh)."""
+"""The model versions kept as changes: every version rebuilt from them, whole, as a model or
+as arrays, is the model its operations made (against a replay of the operations by hand)."""
 
 from __future__ import annotations
 
@@ -15,12 +14,13 @@ from rsstp_format.records import ModelRecord, TransitionsRecord
 from rsstp_format.vocabulary import Operation
 from rsstp_replay import open_recording
 from rsstp_replay.audits import audit_truth, run_audits
-from rsstp_replay.audits._equivalence import ModelTable, TrackedTable
 from rsstp_replay.audits.determinism import audit_determinism
 from rsstp_replay.audits.loaded import load
-from rsstp_replay.reader._models import ModelHistory
+from rsstp_replay.reader import DeterminismPart
+from rsstp_replay.reader._models import ModelHistory, model_history
 from rsstp_replay.viewer import view
 from rsstp_sim import load_scenario
+from rsstp_sim.errors import ModelError
 from rsstp_sim.recording.builders import model_record
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -116,22 +116,98 @@ def test_a_history_of_changes_gives_every_version_whole_in_any_order(data: st.Da
     assert alive.tolist() == [s in copies[k] for k, s in pairs]
 
 
-@pytest.mark.slow
-@settings(max_examples=300, deadline=None)
+def replayed_by_hand(
+    records: list[ModelRecord],
+) -> list[tuple[list[int], list[tuple[int, int, int]]]]:
+    """Every version's states and ``(source, action, target)`` transitions, sorted: the
+    first message's, then each message's operations applied by hand to sets."""
+    states, triples = set(records[0].states), set(records[0].triples())
+    found = [(sorted(states), sorted(triples))]
+    for record in records[1:]:
+        for operation in record.operations:
+            kind, args = operation.kind, operation.args
+            if kind in ("add", "delete") and operation.changed:
+                s, t, a = args
+                (triples.add if kind == "add" else triples.discard)((s, a, t))
+            elif kind == "split":  # the new state copies s's row and column
+                s, new = args[0], operation.result
+                states.add(new)
+                out = {(new, a, t) for x, a, t in triples if x == s}
+                loops = {(new, a, new) for x, a, t in triples if x == s and t == s}
+                into = {(u, a, new) for u, a, t in triples if t == s}
+                triples |= out | loops | into
+            elif kind == "merge":  # t's transitions onto s, t gone
+                s, t = args
+                moved = {x for x in triples if t in (x[0], x[2])}
+                triples -= moved
+                triples |= {(s if u == t else u, a, s if v == t else v) for u, a, v in moved}
+                states.discard(t)
+        found.append((sorted(states), sorted(triples)))
+    return found
+
+
+@settings(max_examples=200, deadline=None)
 @given(st.data())
-def test_the_tracked_table_kept_through_touched_states_is_built_afresh(
-    data: st.DataObject,
-) -> None:
+def test_every_version_as_arrays_is_the_one_its_operations_make(data: st.DataObject) -> None:
+    """:meth:`ModelHistory.arrays` (the operations applied to sorted keys), asked for in any
+    order, and of a plain list of messages (:func:`model_history`), against a replay of the
+    messages by hand; so are the pairs with several successors and with none that
+    :meth:`ModelHistory.determinism_changes` keep, added up version by version."""
     model = start_model(data)
-    tracked = TrackedTable(model, (0, 1))
-    for _ in range(data.draw(st.integers(1, 6))):  # one version: several operations
-        touched = random_operations(data, model)
-        tracked.update(model, touched)
-        labels = {s: bool(s % 2) for s in model.states}
-        fresh, kept = ModelTable.of(model, labels, (0, 1)), tracked.table(labels)
-        assert fresh.states.tolist() == kept.states.tolist()
-        assert fresh.successor.tolist() == kept.successor.tolist()
-        assert fresh.label.tolist() == kept.label.tolist()
+    history = ModelHistory(share=data.draw(st.sampled_from([1, 8, 32])))
+    whole = [model_record(model, step=0, operations=())]
+    history.add(whole[0], model)
+    for step in range(1, data.draw(st.integers(1, 30))):
+        if 2 not in model.actions and data.draw(st.booleans()):  # the alphabet grows (alone:
+            source = data.draw(st.sampled_from(model.states))  # see test_a_merge_beside_...)
+            model.add(source, source, 2)
+            touched = {source}
+        else:
+            touched = random_operations(data, model)
+        model.current = data.draw(st.sampled_from(model.states))
+        operations = model.drain_operations()
+        history.add(model_record(model, step=step, operations=operations, keyframe=False), model,
+                    touched=touched)  # fmt: skip
+        whole.append(model_record(model, step=step, operations=operations))
+    expected = replayed_by_hand(whole)
+    assert len(history) == len(expected)
+    for k in data.draw(st.permutations(range(len(expected)))):
+        states, transitions = history.arrays(k)
+        assert (states.tolist(), [tuple(row) for row in transitions.tolist()]) == expected[k]
+    plain = model_history(whole)
+    assert model_history(history) is history
+    for k, (states_k, triples_k) in enumerate(expected):
+        states, transitions = plain.arrays(k)
+        assert (states.tolist(), [tuple(row) for row in transitions.tolist()]) == (
+            states_k,
+            triples_k,
+        ), f"version {k}"
+    for kept in (history, plain):  # the pairs added up over the changes, version by version
+        rows: dict[int, DeterminismPart] = {}
+        for k, (states_k, triples_k) in enumerate(expected):
+            for state, part in kept.determinism_changes(k).items():
+                if part is None:
+                    rows.pop(state, None)
+                else:
+                    rows[state] = part
+            several = [pair for state in sorted(rows) for pair in rows[state][0]]
+            none = [pair for state in sorted(rows) for pair in rows[state][1]]
+            assert (several, none) == pairs_by_hand(states_k, triples_k, whole[k].actions)
+
+
+def pairs_by_hand(
+    states: list[int], triples: list[tuple[int, int, int]], actions: tuple[int, ...]
+) -> tuple[list[tuple[int, int, tuple[int, ...]]], list[tuple[int, int]]]:
+    """The (state, action, successors) with several successors and the (state, action) with
+    none, by state and action."""
+    successors: dict[tuple[int, int], list[int]] = {}
+    for s, a, t in triples:
+        successors.setdefault((s, a), []).append(t)
+    several = [
+        (s, a, tuple(sorted(ts))) for (s, a), ts in sorted(successors.items()) if len(ts) > 1
+    ]
+    none = [(s, a) for s in states for a in sorted(actions) if (s, a) not in successors]
+    return several, none
 
 
 @settings(max_examples=25, deadline=None)
@@ -242,3 +318,25 @@ def test_the_audits_and_the_viewer_rebuild_the_first_and_last_versions_only(
         assert truth.verdict.learned
         view(recording, save=tmp_path / "v.rrd", spawn=False, serve_web=False, start=None, end=None)
     assert set(rebuilt) <= {0, len(versions) - 1}
+
+
+@pytest.mark.xfail(
+    raises=ModelError, strict=True, reason="a known gap, kept as it was (speed work only)"
+)
+def test_a_merge_beside_a_new_action_leaves_no_pair_of_the_state_merged_away() -> None:
+    """A version that merges a state away and adds an action: the determinism audit
+    recomputes every state of the new version (the new action is a pair with no successor
+    for each) and so never clears the pairs of the state merged away, which stay in its
+    count: it refuses the valid history ("has 1 pairs with several successors, the message
+    says 0"), as it did before it read the history's changes."""
+    model = TransitionSystem.from_snapshot(
+        {"states": [0, 1], "next_id": 2, "current": 0, "actions": [0],
+         "transitions": [[0, 0, 0], [1, 0, 0], [1, 0, 1]]}
+    )  # fmt: skip
+    first = model_record(model, step=0, operations=())
+    model.merge(0, 1)
+    model.add(0, 0, 1)
+    second = model_record(model, step=1, operations=model.drain_operations())
+    final = audit_determinism([first, second]).final
+    own = model.determinism_report()
+    assert (final.nondeterministic, final.empty) == (own.nondeterministic, own.empty)

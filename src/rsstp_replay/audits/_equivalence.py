@@ -37,7 +37,7 @@ from rsstp_sim.moore import moore_classes
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth
 
-__all__ = ["NONE", "SEVERAL", "ModelTable", "TrackedTable", "closure", "equivalent_classes"]
+__all__ = ["NONE", "SEVERAL", "ModelTable", "closure", "equivalent_classes"]
 
 _Ints = npt.NDArray[np.int64]
 
@@ -94,55 +94,6 @@ class ModelTable:
     def rows(self, state_ids: _Ints) -> _Ints:
         """The rows of these state ids (each must be a state of the model)."""
         return np.searchsorted(self.states, state_ids)
-
-
-class TrackedTable:
-    """A model's successors over the truth's actions, kept up to date through the states each
-    version's operations changed (:meth:`TransitionSystem.sources_changed_by`) instead of
-    rebuilt from every transition of every version.
-
-    Successors are held as state ids (or :data:`NONE`, :data:`SEVERAL`) in rows of the sorted
-    state ids; :meth:`table` gives a :class:`ModelTable` (rows, labels) when one is needed.
-    """
-
-    def __init__(self, model: TransitionSystem, actions: Sequence[int]) -> None:
-        self._actions = tuple(actions)
-        self._states = np.asarray(model.states, np.int64)
-        self._successor = np.full((len(self._states), len(self._actions)), NONE, np.int64)
-        self._refresh(model, set(model.states))
-
-    def update(self, model: TransitionSystem, changed: set[int]) -> None:
-        """Follow ``model`` after operations that changed the transitions out of ``changed``."""
-        states = np.asarray(model.states, np.int64)
-        if len(states) != len(self._states) or (states != self._states).any():
-            rows = np.searchsorted(states, self._states)
-            kept = (rows < len(states)) & (
-                states[np.minimum(rows, len(states) - 1)] == self._states
-            )
-            successor = np.full((len(states), len(self._actions)), NONE, np.int64)
-            successor[rows[kept]] = self._successor[kept]
-            self._states, self._successor = states, successor
-        self._refresh(model, changed)
-
-    def _refresh(self, model: TransitionSystem, changed: set[int]) -> None:
-        present = sorted(s for s in changed if s in model)
-        if not present:
-            return
-        values = [
-            [NONE if not t else t[0] if len(t) == 1 else SEVERAL for t in
-             (model.successors(s, a) for a in self._actions)]
-            for s in present
-        ]  # fmt: skip
-        self._successor[np.searchsorted(self._states, present)] = values
-
-    def table(self, labels: Mapping[int, bool]) -> ModelTable:
-        """The model as a :class:`ModelTable`, labelled with ``labels``."""
-        ids = self._successor
-        successor = np.where(ids >= 0, np.searchsorted(self._states, np.maximum(ids, 0)), ids)
-        label = np.fromiter(
-            (int(labels.get(s, -1)) for s in self._states.tolist()), np.int64, len(self._states)
-        )
-        return ModelTable(self._states, successor, label)
 
 
 def closure(table: ModelTable, truth: GroundTruth, rows: _Ints, classes: _Ints) -> _Ints | None:

@@ -39,6 +39,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from rsstp_replay.audits._columns import factorized
 from rsstp_replay.audits._suffixes import (
     RangeMin,
     common_prefix_lengths,
@@ -246,8 +247,8 @@ class _VersionStates:
             raise MemoryRangeError(
                 f"model_versions has {len(versions)} entries, the memory {len(states)}"
             )
-        self.version_ids, version_codes = np.unique(versions, return_inverse=True)
-        self.state_ids, state_codes = np.unique(states, return_inverse=True)
+        self.version_ids, version_codes = factorized(versions)
+        self.state_ids, state_codes = factorized(np.asarray(states))
         self.width = max(len(self.state_ids), 1)
         self.codes = version_codes.astype(np.int64) * self.width + state_codes
 
@@ -316,7 +317,7 @@ def _contradictions(
     # audit of ten million steps is bounded by its memory.
     positions = index_type(steps + 1)
     # The string y_p = (a_{p+1}, o_{p+1}), p = 0..T-1: the suffix at p is the memory after time p.
-    action_codes = np.unique(action_column[1:], return_inverse=True)[1].astype(positions)
+    action_codes = factorized(action_column[1:])[1].astype(positions)
     symbols = 2 * action_codes + sensation_column[1:]
     ranked = [suffix_ranks(symbols)]
     del symbols, checked
@@ -341,7 +342,7 @@ def _contradictions_of(
     steps = len(action_column) - 1
     positions = index_type(steps + 1)
     # Every time p = 0..T-1 (time T has nothing after it), sorted by (state, suffix rank).
-    state_ids, state_codes = np.unique(state_column[:steps], return_inverse=True)
+    state_ids, state_codes = factorized(state_column[:steps])
     state_codes = state_codes.astype(positions)
     # One int64 key per time (the suffix ranks are distinct and below ``steps``): one sort,
     # a third of the time of a lexsort over the two columns, the same order.

@@ -19,13 +19,14 @@ What a finding says about the strategy:
   deterministic and complete (one successor for every pair), a finished automaton, even if a
   later change broke it again; ``complete_from`` is the first step from which it stayed so.
 
-The models are rebuilt incrementally: the first version from its snapshot
-(:meth:`TransitionSystem.from_snapshot`), each later one by applying the operations its message
-carries to the previous one (a model message carries the whole model, but rebuilding every
-version from it would cost its full size per version). A message whose operations do not lead to
-its own model (another version number, other states, another number of nondeterministic pairs)
-raises :class:`~rsstp_sim.errors.ModelError`: the audit fails loudly on a recording it cannot
-trust.
+The models are rebuilt incrementally, once, by the model history
+(:func:`~rsstp_replay.reader.model_history`; a recording's as it was read): the first version
+from its snapshot, each later one by applying the operations its message carries to the
+previous one, and each version keeps the pairs of the states its operations touched
+(:meth:`~rsstp_replay.reader.ModelHistory.determinism_changes`), which the audit adds up. A
+message whose operations do not lead to its own model (another version number, other states,
+another number of nondeterministic pairs) raises :class:`~rsstp_sim.errors.ModelError`: the
+audit fails loudly on a recording it cannot trust.
 """
 
 from __future__ import annotations
@@ -37,9 +38,9 @@ from typing import Any, Protocol
 import pandas as pd
 
 from rsstp_format.records import ModelRecord
-from rsstp_replay.reader import version_heads, version_sizes
+from rsstp_replay.reader import DeterminismPart, model_history
 from rsstp_sim.errors import ModelError
-from rsstp_sim.transition_system import DeterminismReport, TransitionSystem
+from rsstp_sim.transition_system import DeterminismReport
 from rsstp_sim.words import counted
 
 __all__ = [
@@ -220,42 +221,26 @@ def audit_determinism(
     themselves, in order. Raises :class:`~rsstp_sim.errors.ModelError` when there is no model
     message, or when a message's operations do not lead from the previous model to its own.
     """
-    history = source if isinstance(source, Sequence) else source.model_versions()
-    if not history:
+    versions = source if isinstance(source, Sequence) else source.model_versions()
+    if not versions:
         raise ModelError("determinism audit: no model message (a recording has one at step 0)")
+    # Each version's changed states and their pairs, kept as the history was rebuilt (a
+    # recording's as it was read): no model rebuilt here.
+    history = model_history(versions)
     found = []
-    model: TransitionSystem | None = None
-    rows: dict[int, tuple[list[tuple[int, int, tuple[int, ...]]], list[tuple[int, int]]]] = {}
-    flagged: set[int] = set()  # the states with a pair of several successors or of none
-    report = DeterminismReport((), ())
-    actions: tuple[int, ...] = ()
-    sizes = zip(*(column.tolist() for column in version_sizes(history)), strict=True)
-    for record, (n_states, n_transitions) in zip(version_heads(history), sizes, strict=True):
-        if model is None:
-            model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
-            changed: set[int] = set(model.states)
-        else:
-            changed = _advance(model, record)
-        if model.actions != actions:  # a new action: every state's empty pairs change
-            actions, changed = model.actions, set(model.states)
+    rows: dict[int, DeterminismPart] = {}  # the states with a pair of several successors
+    report = DeterminismReport((), ())  # or of none, and their pairs
+    sizes = zip(*(column.tolist() for column in history.sizes()), strict=True)
+    for k, (record, (n_states, n_transitions)) in enumerate(zip(history.heads, sizes, strict=True)):
         touched = False
-        for s in changed:  # each state's part kept, redone only where an operation touched it
-            if s in model:
-                rows[s] = part = model.determinism_of(s)
-                if part[0] or part[1]:
-                    touched = True
-                    flagged.add(s)
-                elif s in flagged:
-                    flagged.discard(s)
-                    touched = True
-            elif s in flagged:
-                rows.pop(s, None)
-                flagged.discard(s)
+        for s, part in history.determinism_changes(k).items():
+            if part is not None:
+                rows[s] = part
                 touched = True
-            else:
-                rows.pop(s, None)
+            elif rows.pop(s, None) is not None:
+                touched = True
         if touched:  # (states in order, as the model's own report lists them)
-            ordered = sorted(flagged)
+            ordered = sorted(rows)
             report = DeterminismReport(
                 tuple(pair for s in ordered for pair in rows[s][0]),
                 tuple(pair for s in ordered for pair in rows[s][1]),
@@ -279,33 +264,6 @@ def audit_determinism(
     return DeterminismFindings(tuple(found))
 
 
-def _advance(model: TransitionSystem, record: ModelRecord) -> set[int]:
-    """Apply ``record``'s operations to ``model`` (the previous version) and check the result
-    against the record (version and states; the caller checks the nondeterministic pairs);
-    the states whose outgoing transitions the operations may have changed."""
-    where = f"model version {record.version} (step {record.step})"
-    changed: set[int] = set()
-    for operation in record.operations:
-        try:
-            changed |= model.sources_changed_by(operation.kind, operation.args)
-            model.apply(operation.to_operation())
-        except ModelError as exc:
-            raise ModelError(f"{where}: its operations do not apply: {exc}") from None
-    model.drain_operations()
-    if model.version != record.version:
-        raise ModelError(
-            f"{where}: its operations lead from the previous version to version "
-            f"{model.version}, not {record.version}"
-        )
-    if record.states and model.states != record.states:  # (a change's message has none)
-        raise ModelError(
-            f"{where}: its operations give states {_short(model.states)}, the message says "
-            f"{_short(record.states)}"
-        )
-    model.current = record.current
-    return changed
-
-
 def _stayed_from(versions: Sequence[VersionDeterminism], *, deterministic_only: bool) -> int | None:
     since = None
     for version in reversed(versions):
@@ -326,7 +284,3 @@ def _pair_lines(title: str, items: list[str]) -> list[str]:
 
 
 _plural = counted
-
-
-def _short(states: Sequence[int]) -> str:
-    return str(list(states)) if len(states) <= 20 else counted(len(states), "state")

@@ -4,8 +4,9 @@ Decoding a recording's steps is the cost of an audit (a million steps take secon
 command that runs several audits (``rsstp-replay audit --truth``) would otherwise decode them
 once per audit, and hold each copy. :func:`load` reads the steps table (without the joint
 positions and distances, and without what blocked a move beyond the ``blocked`` flag: no
-audit reads them, and they were half the table) and, from a recording, the events in the
-same read of its chunks; then the model messages, and builds the memory;
+audit reads them, and they were half the table) and, from a recording, the events and the
+model messages in the same read of its chunks (most chunks hold some of each), and builds
+the memory;
 the memory is built from the table's columns, so nothing is decoded twice, and the table
 then reads those columns from the memory. Ten million steps are audited in about 200 bytes
 a step. The result has the
@@ -42,11 +43,11 @@ class LoadedRecording:
     def __init__(self, source: _Source) -> None:
         self.source = source
         detail = [column for names in BLOCKED_COLUMNS.values() for column in names]
-        # A recording reads its steps and events in one pass over its chunks.
+        # A recording reads its steps, events and model messages in one pass over its chunks.
         both = getattr(source, "steps_and_events", None)
         self._events: pd.DataFrame | None = None
         if both is not None:
-            table, self._events = both(geometry=False, blockers=False, narrow=True)
+            table, self._events = both(geometry=False, blockers=False, narrow=True, models=True)
         else:
             table = source.steps(geometry=False)
         table = table.drop(columns=["blocked_kind", *detail], errors="ignore")

@@ -36,13 +36,8 @@ import numpy as np
 import numpy.typing as npt
 
 from rsstp_format.records import ModelRecord
-from rsstp_replay.audits._equivalence import (
-    ModelTable,
-    TrackedTable,
-    closure,
-    equivalent_classes,
-)
-from rsstp_replay.reader import version_heads, version_sizes
+from rsstp_replay.audits._equivalence import ModelTable, closure, equivalent_classes
+from rsstp_replay.reader import model_history, version_heads, version_sizes
 from rsstp_sim.arrays import distinct
 from rsstp_sim.transition_system import TransitionSystem
 from rsstp_sim.truth import GroundTruth, check_equivalence
@@ -254,8 +249,7 @@ class _Labels:
 
     def at(self, states: Sequence[int], step: int) -> dict[int, bool]:
         wanted = np.asarray(states, np.int64)
-        position = np.searchsorted(self.keys, wanted * self.width + step, side="right") - 1
-        found = (position >= 0) & (self.keys[np.maximum(position, 0)] // self.width == wanted)
+        position, found = self._last_seen(wanted, step)
         return dict(
             zip(
                 wanted[found].tolist(),
@@ -263,6 +257,18 @@ class _Labels:
                 strict=True,
             )
         )
+
+    def column(self, states: _Ints, step: int) -> _Ints:
+        """:meth:`at` as a column over ``states``: 1 or 0, -1 where none was seen."""
+        position, found = self._last_seen(states, step)
+        label = np.full(len(states), -1, np.int64)
+        label[found] = self.sensations[position[found]]
+        return label
+
+    def _last_seen(self, wanted: _Ints, step: int) -> tuple[_Ints, npt.NDArray[np.bool_]]:
+        position = np.searchsorted(self.keys, wanted * self.width + step, side="right") - 1
+        found = (position >= 0) & (self.keys[np.maximum(position, 0)] // self.width == wanted)
+        return position, found
 
 
 @dataclass(frozen=True, slots=True)
@@ -344,7 +350,11 @@ def judge_versions(
     ``actions``, ``angles`` to name the move that confined the run) are per step
     (``0 .. T``).
     """
-    history, versions = versions, version_heads(versions)  # each message, not rebuilt
+    # Each message's head; a version's transitions only where it is judged, from the
+    # history's arrays (most versions are left out before: too few states, or aliasing).
+    history = model_history(versions)
+    versions = history.heads
+    n_states = history.sizes()[0]
     steps = len(states) - 1
     labels = _Labels.of(states, sensations)
     starts = np.fromiter((record.step for record in versions), np.int64, len(versions))
@@ -355,21 +365,9 @@ def judge_versions(
 
     equivalent = np.zeros(len(versions), np.bool_)
     final_judged = (False, False)
-    model: TransitionSystem | None = None
-    tracked: TrackedTable | None = None
     for k, record in enumerate(versions):
-        if model is None or tracked is None:
-            model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
-            tracked = TrackedTable(model, truth.actions)
-        else:
-            changed: set[int] = set()
-            for operation in record.operations:
-                changed |= model.sources_changed_by(operation.kind, operation.args)
-                model.apply(operation.to_operation())
-            model.drain_operations()
-            tracked.update(model, changed)
         is_final = k == len(versions) - 1
-        if len(model) < n_classes and not is_final:
+        if n_states[k] < n_classes and not is_final:
             continue  # a state for each class is needed to behave as the start pose
         pair_states, pair_classes = visits.of_version(k)
         if not len(pair_states):
@@ -379,8 +377,10 @@ def judge_versions(
         if len(pair_states) > 1 and (pair_states[1:] == pair_states[:-1]).any() and not is_final:
             continue  # a state stood for two classes
         bound = min(max(int(record.step), int(ends[k]) - 1), steps)
+        model_states, transitions = history.arrays(k)
+        label = labels.column(model_states, bound)
         judged = _judge(
-            tracked.table(labels.at(model.states, bound)),
+            ModelTable.of_arrays(model_states, transitions, label, truth.actions),
             truth,
             pair_states,
             pair_classes,
@@ -390,7 +390,7 @@ def judge_versions(
         if is_final:
             final_judged = judged
 
-    assert model is not None
+    model = history.model(len(versions) - 1)
     final = versions[-1]
     final_labels = labels.at(model.states, steps)
     learned_reachable, has_start_state = final_judged

@@ -15,7 +15,9 @@ from rsstp_replay.reader._decode import (
     body_reader,
 )
 from rsstp_replay.reader._models import (
+    DeterminismPart,
     ModelHistory,
+    model_history,
     version_alive,
     version_heads,
     version_sizes,
@@ -25,10 +27,12 @@ from rsstp_replay.reader._models import (
 __all__ = [
     "BLOCKED_COLUMNS",
     "BodyReader",
+    "DeterminismPart",
     "ModelHistory",
     "blocker_label",
     "blocker_texts",
     "body_reader",
+    "model_history",
     "version_alive",
     "version_heads",
     "version_sizes",

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import bisect
 from array import array
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any, cast, overload
 
@@ -27,13 +27,16 @@ from rsstp_replay.reader._chunks import gc_paused
 from rsstp_replay.reader._replay import KeyedVersion, KeyLayout
 from rsstp_sim.errors import ModelError
 from rsstp_sim.transition_system import TransitionSystem
+from rsstp_sim.words import counted
 
 __all__ = [
     "HEADS",
     "ChainCheck",
+    "DeterminismPart",
     "ModelHead",
     "ModelHistory",
     "build_model",
+    "model_history",
     "version_alive",
     "version_heads",
     "version_sizes",
@@ -54,6 +57,10 @@ fields of :class:`~rsstp_format.records.ModelRecord` but those. What
 
 HEADS = msgspec.json.Decoder(list[ModelHead])
 """Decodes a chunk's model messages joined as one JSON array."""
+
+DeterminismPart = tuple[list[tuple[int, int, tuple[int, ...]]], list[tuple[int, int]]]
+"""A state's pairs with several successors and with none
+(:meth:`TransitionSystem.determinism_of`)."""
 
 
 def build_model(path: Path, record: ModelRecord) -> TransitionSystem:
@@ -241,8 +248,9 @@ class ModelHistory(Sequence[ModelRecord]):
     forward reuses the version rebuilt last, so each version costs its own operations and
     the copy of its transitions. What the audits read of every version needs no rebuilding:
     :attr:`heads` (each message as the file holds a change, no states or transitions; the
-    first one whole), :meth:`sizes` and :meth:`alive`. Memory follows the operations, not
-    the versions times the model's size.
+    first one whole), :meth:`sizes`, :meth:`alive` and :meth:`determinism_changes` (kept as
+    each version is added, from the model its operations made). Memory follows the
+    operations, not the versions times the model's size.
     """
 
     def __init__(self, *, share: int = CHECKPOINT_SHARE) -> None:
@@ -261,6 +269,8 @@ class ModelHistory(Sequence[ModelRecord]):
         self._action_bound = 0  # above every action
         self._cache: tuple[int, TransitionSystem] | None = None
         self._keyed: tuple[int, KeyedVersion] | None = None
+        self._determinism: list[dict[int, DeterminismPart | None]] = []
+        self._actions: tuple[int, ...] = ()
 
     def add(
         self,
@@ -301,6 +311,14 @@ class ModelHistory(Sequence[ModelRecord]):
                 self._merged[operation.args[1]] = k
         self._n_states.append(len(model))
         self._n_transitions.append(model.n_transitions)
+        if touched is None or k == 0 or model.actions != self._actions:
+            touched = set(model.states)  # (a new action: every state's empty pairs change)
+        self._actions = model.actions
+        parts = {}
+        for state in touched:
+            part = model.determinism_of(state) if state in model else None
+            parts[state] = part if part is not None and (part[0] or part[1]) else None
+        self._determinism.append(parts)
 
     def __len__(self) -> int:
         return len(self._heads)
@@ -349,6 +367,13 @@ class ModelHistory(Sequence[ModelRecord]):
         safe = np.where(inside, ids, 0)
         return inside & (born[safe] <= at) & (at < gone[safe])
 
+    def determinism_changes(self, index: int) -> Mapping[int, DeterminismPart | None]:
+        """The states whose part of the determinism report (their pairs with several
+        successors and with none: :meth:`TransitionSystem.determinism_of`) version ``index``
+        may have changed, each with its part, None when it has neither kind of pair or is
+        gone; every state of the first version, and of a version whose actions grew."""
+        return self._determinism[index]
+
     def model(self, index: int) -> TransitionSystem:
         """Version ``index`` (0 .. len - 1) as a model of its own (the caller's to change):
         the operations since the nearest whole model kept applied to arrays, one model made
@@ -368,6 +393,19 @@ class ModelHistory(Sequence[ModelRecord]):
                 current=head.current,
                 version=head.version,
             )
+
+    def arrays(self, index: int) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """Version ``index``'s state ids, sorted, and its transitions as rows ``(source,
+        action, target)``, sorted: the operations since the nearest whole model kept applied
+        to arrays, as :meth:`model` applies them, without a model made (a model, when the ids
+        are too wide for the keys). Walking forward reuses the version reached last."""
+        k = range(len(self._heads))[index]
+        keyed = self._keyed_version(k)
+        if keyed is not None:
+            return keyed.arrays()
+        model = self._rebuilt_model(k)
+        rows = np.asarray(model.transitions(), np.int64).reshape(-1, 3)
+        return np.asarray(model.states, np.int64), rows
 
     def _keyed_version(self, k: int) -> KeyedVersion | None:
         """Version ``k``'s transitions as sorted keys, from the last whole model kept at or
@@ -442,6 +480,55 @@ class ModelHistory(Sequence[ModelRecord]):
         model.current = self._heads[k].current
         self._cache = (k, model)
         return model
+
+
+def model_history(versions: Sequence[ModelRecord]) -> ModelHistory:
+    """``versions`` as a :class:`ModelHistory`: itself (a recording's, checked as it was
+    read), or model messages given in a plain sequence (the first whole, each later one's
+    operations applying to the one before, as a recorder makes them) rebuilt one after the
+    other, each checked against its message's version and states (:class:`ModelError`)."""
+    if isinstance(versions, ModelHistory):
+        return versions
+    history = ModelHistory()
+    model: TransitionSystem | None = None
+    for record in versions:
+        if model is None:
+            model = TransitionSystem.from_snapshot(record.snapshot(), version=record.version)
+            history.add(record, model)
+        else:
+            history.add(record, model, touched=_advance(model, record))
+    return history
+
+
+def _advance(model: TransitionSystem, record: ModelRecord) -> set[int]:
+    """Apply ``record``'s operations to ``model`` (the previous version) and check the result
+    against the record (version and states; :class:`ModelError` names the version); the
+    states whose transitions out the operations may have changed."""
+    where = f"model version {record.version} (step {record.step})"
+    changed: set[int] = set()
+    for operation in record.operations:
+        try:
+            changed |= model.sources_changed_by(operation.kind, operation.args)
+            model.apply(operation.to_operation())
+        except ModelError as exc:
+            raise ModelError(f"{where}: its operations do not apply: {exc}") from None
+    model.drain_operations()
+    if model.version != record.version:
+        raise ModelError(
+            f"{where}: its operations lead from the previous version to version "
+            f"{model.version}, not {record.version}"
+        )
+    if record.states and model.states != record.states:  # (a change's message has none)
+        raise ModelError(
+            f"{where}: its operations give states {_short(model.states)}, the message says "
+            f"{_short(record.states)}"
+        )
+    model.current = record.current
+    return changed
+
+
+def _short(states: Sequence[int]) -> str:
+    return str(list(states)) if len(states) <= 20 else counted(len(states), "state")
 
 
 def version_heads(versions: Sequence[ModelRecord]) -> Sequence[ModelRecord]:

@@ -116,6 +116,17 @@ class KeyedVersion:
             version=version,
         )
 
+    def arrays(self) -> tuple[_Keys, _Keys]:
+        """The version reached: its state ids, sorted, and its transitions as rows
+        ``(source, action, target)``, sorted (copies, the caller's)."""
+        self._flush()
+        keys, layout = self._keys, self.layout
+        rows = np.empty((len(keys), 3), np.int64)
+        rows[:, 0] = keys >> layout.high
+        rows[:, 1] = (keys >> layout.low) & ((1 << (layout.high - layout.low)) - 1)
+        rows[:, 2] = keys & ((1 << layout.low) - 1)
+        return self._states.copy(), rows
+
     def _flush(self) -> None:
         """Apply the adds and deletes noted since the last flush."""
         keys = self._keys

@@ -19,7 +19,7 @@ import bisect
 import operator
 import os
 import warnings
-from collections.abc import Generator, Sequence
+from collections.abc import Callable, Generator, Sequence
 from contextlib import closing
 from functools import partial
 from pathlib import Path
@@ -264,7 +264,12 @@ class Recording:
         return _event_texts(self._events)
 
     def steps_and_events(
-        self, *, geometry: bool = True, blockers: bool = True, narrow: bool = False
+        self,
+        *,
+        geometry: bool = True,
+        blockers: bool = True,
+        narrow: bool = False,
+        models: bool = False,
     ) -> tuple[pd.DataFrame, pd.DataFrame]:
         """:meth:`steps` and :meth:`events` in one read of the chunks (each alone reads
         every chunk, the events being among the steps): what an audit reads.
@@ -274,10 +279,18 @@ class Recording:
         integer columns in the narrowest dtype that holds their values (the agent's ids and
         versions, an arm's angles), not int64, and the events' ``text`` and ``data``
         categorical (each distinct one once: a long run's blocked events repeat a few), in
-        the table the recording keeps (not a copy)."""
+        the table the recording keeps (not a copy); ``models=True``: the model messages are
+        read and checked in the same pass too (what :meth:`model_versions` then gives; most
+        chunks hold some), a corrupt one named after every step is checked, as when they are
+        read on their own."""
         self._check_open()
         events = _EventParts() if self._events is None else None
-        columns = self._step_columns(truth=True, events=events, numbers=geometry)
+        chain = None
+        if models and self._models is None and self.has_model:
+            chain = _ModelPass(ChainCheck(self.path, last_step=self.n_steps))
+        columns = self._step_columns(truth=True, events=events, numbers=geometry, models=chain)
+        if chain is not None:
+            self._models = self._models_checked(chain.finish())
         self._log_times = columns.log_times()
         if events is not None:
             self._events = events.table()
@@ -328,24 +341,34 @@ class Recording:
         """The model messages, each checked against the chain as it is read: a message that
         is byte for byte what its operations make is read without parsing its transitions
         (:meth:`~rsstp_replay.reader._models.ChainCheck.head`)."""
-        topic = "/rsstp/model"
         chain = ChainCheck(self.path, last_step=self.n_steps)
-        for ref, _, parts, times in self._chunks(topic):
-            try:
-                heads = HEADS.decode(json_array(parts))
-            except (msgspec.DecodeError, RecursionError):  # decoded whole below: named there
-                heads = None
-            if heads is None or len(heads) != len(parts):
-                records = self._file.decode_many(topic, parts, times, ref)
-                for record, log_time in zip(records, times.tolist(), strict=True):
-                    chain(self._timed(topic, record, log_time, ref))
-                continue
-            for head, part, log_time in zip(heads, parts, times.tolist(), strict=True):
-                self._timed(topic, head, log_time, ref)
-                decode = partial(self._file.decode_one, topic, part, log_time, ref)
-                chain.head(head, part.tobytes(), decode)
+        for ref, _, parts, times in self._chunks("/rsstp/model"):
+            self._check_models(chain, ref, parts, times)
+        return self._models_checked(chain)
+
+    def _check_models(
+        self, chain: ChainCheck, ref: ChunkRef, parts: list[memoryview], times: _Ints
+    ) -> None:
+        """A chunk's model messages, checked against the chain in order."""
+        topic = "/rsstp/model"
+        try:
+            heads = HEADS.decode(json_array(parts))
+        except (msgspec.DecodeError, RecursionError):  # decoded whole below: named there
+            heads = None
+        if heads is None or len(heads) != len(parts):
+            records = self._file.decode_many(topic, parts, times, ref)
+            for record, log_time in zip(records, times.tolist(), strict=True):
+                chain(self._timed(topic, record, log_time, ref))
+            return
+        for head, part, log_time in zip(heads, parts, times.tolist(), strict=True):
+            self._timed(topic, head, log_time, ref)
+            decode = partial(self._file.decode_one, topic, part, log_time, ref)
+            chain.head(head, part.tobytes(), decode)
+
+    def _models_checked(self, chain: ChainCheck) -> ModelHistory:
+        """The versions of a chain given every model message, counted."""
         found = chain.finish()
-        self._counted(topic, len(found))
+        self._counted("/rsstp/model", len(found))
         return found
 
     def _timed(self, topic: str, record: _Stepped, log_time: int, ref: ChunkRef) -> _Stepped:
@@ -487,13 +510,19 @@ class Recording:
             ) from None
 
     def _step_columns(
-        self, *, truth: bool, events: _EventParts | None = None, numbers: bool = True
+        self,
+        *,
+        truth: bool,
+        events: _EventParts | None = None,
+        numbers: bool = True,
+        models: _ModelPass | None = None,
     ) -> StepColumns:
         """Decode and check every step message; with ``events``, add each chunk's events to
-        it, read in the same pass over the chunks; ``numbers``: an arm's joint positions and
-        distances too (the table's geometry)."""
+        it, and with ``models`` check each chunk's model messages, read in the same pass over
+        the chunks; ``numbers``: an arm's joint positions and distances too (the table's
+        geometry)."""
         columns = self._new_step_columns(truth=truth, numbers=numbers)
-        for _ in self._decoding(columns, events):
+        for _ in self._decoding(columns, events, models):
             pass
         self._check_steps(columns)
         return columns
@@ -530,11 +559,14 @@ class Recording:
         return StepColumns(n_rows, truth=pose, kinds=reader.kinds)
 
     def _decoding(
-        self, columns: StepColumns, events: _EventParts | None
+        self, columns: StepColumns, events: _EventParts | None, models: _ModelPass | None = None
     ) -> Generator[None, None, None]:
         """Decode the step messages into ``columns`` chunk by chunk (pausing after each);
-        with ``events``, add to it each chunk's events as a part of the events table."""
-        topics = ("/rsstp/step",) if events is None else ("/rsstp/step", "/rsstp/event")
+        with ``events``, add to it each chunk's events as a part of the events table; with
+        ``models``, check each chunk's model messages."""
+        topics = ["/rsstp/step"]
+        topics += [] if events is None else ["/rsstp/event"]
+        topics += [] if models is None else ["/rsstp/model"]
         with gc_paused():
             for ref, data, found in self._chunks_of(topics):
                 self._decode_steps(columns, ref, data, found[0].views(data), found[0].times)
@@ -542,6 +574,12 @@ class Recording:
                     event_parts = found[1].views(data)
                     events.add(
                         self._chunk_records("/rsstp/event", ref, event_parts, found[1].times)
+                    )
+                if models is not None:
+                    model_parts = found[-1]
+                    models.check(
+                        partial(self._check_models, models.chain, ref, model_parts.views(data)),
+                        model_parts.times,
                     )
                 yield
         if events is not None:
@@ -594,6 +632,32 @@ class Recording:
         columns = StepColumns(1, keep_steps=True)
         self._decode_steps(columns, ref, data, [part], messages.times[index : index + 1])
         return _row(columns, step)
+
+
+class _ModelPass:
+    """The model messages checked in the pass that decodes the steps (:meth:`Recording.
+    steps_and_events`): the first corrupt one is kept, not raised, and no later one checked,
+    until :meth:`finish`, once every step is decoded and checked, so that a recording with a
+    bad step and a bad model message names the step first, as when the model messages are
+    read after the steps."""
+
+    def __init__(self, chain: ChainCheck) -> None:
+        self.chain = chain
+        self._error: CorruptRecording | None = None
+
+    def check(self, chunk: Callable[[_Ints], None], times: _Ints) -> None:
+        """Check a chunk's model messages (``chunk`` with their log times)."""
+        if self._error is None:
+            try:
+                chunk(times)
+            except CorruptRecording as exc:
+                self._error = exc
+
+    def finish(self) -> ChainCheck:
+        """The chain, every model message given to it; the corrupt one raised."""
+        if self._error is not None:
+            raise self._error
+        return self.chain
 
 
 class _AgentRow(NamedTuple):
