@@ -20,7 +20,6 @@ from rsstp_replay.reader import DeterminismPart
 from rsstp_replay.reader._models import ModelHistory, model_history
 from rsstp_replay.viewer import view
 from rsstp_sim import load_scenario
-from rsstp_sim.errors import ModelError
 from rsstp_sim.recording.builders import model_record
 from rsstp_sim.transition_system import TransitionSystem
 
@@ -320,15 +319,11 @@ def test_the_audits_and_the_viewer_rebuild_the_first_and_last_versions_only(
     assert set(rebuilt) <= {0, len(versions) - 1}
 
 
-@pytest.mark.xfail(
-    raises=ModelError, strict=True, reason="a known gap, kept as it was (speed work only)"
-)
 def test_a_merge_beside_a_new_action_leaves_no_pair_of_the_state_merged_away() -> None:
-    """A version that merges a state away and adds an action: the determinism audit
-    recomputes every state of the new version (the new action is a pair with no successor
-    for each) and so never clears the pairs of the state merged away, which stay in its
-    count: it refuses the valid history ("has 1 pairs with several successors, the message
-    says 0"), as it did before it read the history's changes."""
+    """A version that merges a state away and adds an action: every state of the new version
+    is recomputed (the new action is a pair with no successor for each), and the state merged
+    away, which had a pair with several successors, is cleared with them (the audit refused
+    the valid history before: "has 1 pairs with several successors, the message says 0")."""
     model = TransitionSystem.from_snapshot(
         {"states": [0, 1], "next_id": 2, "current": 0, "actions": [0],
          "transitions": [[0, 0, 0], [1, 0, 0], [1, 0, 1]]}

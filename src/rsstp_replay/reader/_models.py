@@ -271,6 +271,7 @@ class ModelHistory(Sequence[ModelRecord]):
         self._keyed: tuple[int, KeyedVersion] | None = None
         self._determinism: list[dict[int, DeterminismPart | None]] = []
         self._actions: tuple[int, ...] = ()
+        self._with_pairs: set[int] = set()  # the states whose last listed part has pairs
 
     def add(
         self,
@@ -312,12 +313,19 @@ class ModelHistory(Sequence[ModelRecord]):
         self._n_states.append(len(model))
         self._n_transitions.append(model.n_transitions)
         if touched is None or k == 0 or model.actions != self._actions:
-            touched = set(model.states)  # (a new action: every state's empty pairs change)
+            # Every state (a new action: each one's empty pairs change), and the states listed
+            # with pairs before, so that one merged away in the same version is cleared.
+            touched = set(model.states) | (touched or set()) | self._with_pairs
         self._actions = model.actions
-        parts = {}
+        parts: dict[int, DeterminismPart | None] = {}
         for state in touched:
             part = model.determinism_of(state) if state in model else None
-            parts[state] = part if part is not None and (part[0] or part[1]) else None
+            if part is not None and (part[0] or part[1]):
+                parts[state] = part
+                self._with_pairs.add(state)
+            else:
+                parts[state] = None
+                self._with_pairs.discard(state)
         self._determinism.append(parts)
 
     def __len__(self) -> int:
