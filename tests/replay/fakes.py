@@ -1,5 +1,6 @@
-"""Test doubles for the replay side: a recording-like object built from a live run, and a
-strategy that refines its model at random (and counts what it did).
+"""Test doubles for the replay side: a recording-like object built from a live run, a
+strategy that refines its model at random (and counts what it did), and a counter of the
+chunks a reader reads.
 
 :class:`FakeRecording` has what the audits read of a
 :class:`rsstp_replay.reader.recording.Recording` (``memory()``, ``model_versions()``, ``steps()``,
@@ -16,6 +17,7 @@ from typing import Any, ClassVar
 import numpy as np
 import numpy.typing as npt
 import pandas as pd
+import pytest
 
 from rsstp_format import records
 from rsstp_format.schemas import STEP_NS
@@ -265,3 +267,20 @@ class StaticRecording:
 
     def events(self) -> pd.DataFrame:
         return pd.DataFrame({"step": np.array([], np.int64), "kind": [], "text": [], "data": []})
+
+
+def count_chunk_reads(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """The file offset of every chunk the reader reads from now on, in order (repeats kept):
+    :meth:`Container.chunk_data <rsstp_replay.reader._container.Container.chunk_data>`
+    counted, for the rest of the test."""
+    from rsstp_replay.reader._container import Container
+
+    reads: list[int] = []
+    chunk_data = Container.chunk_data
+
+    def counted(self: Container, stream: Any, ref: Any) -> bytes:
+        reads.append(ref.offset)
+        return chunk_data(self, stream, ref)
+
+    monkeypatch.setattr(Container, "chunk_data", counted)
+    return reads

@@ -22,6 +22,7 @@ from typing import Any, ClassVar
 
 import pandas as pd
 import pytest
+from fakes import count_chunk_reads
 from mcap.reader import make_reader
 from mcap.writer import CompressionType, Writer
 
@@ -707,18 +708,10 @@ def test_the_audits_read_the_model_messages_with_the_steps_and_name_a_bad_step_f
     and a file with a broken chain and, later, a bad step names the step, as when the model
     messages were read after the steps."""
     from rsstp_replay.audits.loaded import load
-    from rsstp_replay.reader._container import Container
 
     with open_recording(original) as alone:
         versions = alone.model_versions()
-    read: list[int] = []
-    chunk_data = Container.chunk_data
-
-    def counted(self: Container, stream: Any, ref: Any) -> bytes:
-        read.append(ref.offset)
-        return chunk_data(self, stream, ref)
-
-    monkeypatch.setattr(Container, "chunk_data", counted)
+    read = count_chunk_reads(monkeypatch)
     with open_recording(original) as together:
         loaded = load(together)
         assert together.model_versions() is loaded.model_versions()

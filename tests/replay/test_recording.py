@@ -22,7 +22,7 @@ from typing import Any, ClassVar
 import numpy as np
 import pandas as pd
 import pytest
-from fakes import RandomRefiner
+from fakes import RandomRefiner, count_chunk_reads
 from mcap.reader import make_reader
 
 from rsstp_format import records
@@ -33,7 +33,6 @@ from rsstp_replay.errors import (
     TableError,
     UnfinishedRecordingWarning,
 )
-from rsstp_replay.reader._container import Container
 from rsstp_replay.reader._models import ModelHistory
 from rsstp_sim import AgentView, Memory, Runner, StrategyBase, load_scenario, make_strategy
 from rsstp_sim.recording.recorder import record
@@ -291,14 +290,7 @@ def test_steps_and_events_read_in_one_pass_equal_them_read_apart(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UnfinishedRecordingWarning)
         apart, together = open_recording(path), open_recording(path)
-    reads: list[int] = []
-    chunk_data = Container.chunk_data
-
-    def counted(self: Container, stream: Any, ref: Any) -> bytes:
-        reads.append(ref.offset)
-        return chunk_data(self, stream, ref)
-
-    monkeypatch.setattr(Container, "chunk_data", counted)
+    reads = count_chunk_reads(monkeypatch)
     steps, events = apart.steps(), apart.events()
     read_apart, reads[:] = set(reads), []
     both_steps, both_events = together.steps_and_events()
