@@ -237,7 +237,7 @@ def _cmd_audit(args: argparse.Namespace) -> int:
                 **document,
                 "truth": truth.to_json(),
             }
-        print(indented(document))  # json.dumps(document, indent=2), faster
+        print(indented(document))
     else:
         if truth is not None and explanation is not None:
             print(f"{truth.verdict.to_text()}\n")
@@ -296,7 +296,7 @@ def _cmd_check(args: argparse.Namespace) -> int:
         document = {**document, "metadata_verified": recording.metadata_verified}
         if physics is not None:
             document = {**document, "physics": physics.to_json()}
-        print(json.dumps(document, indent=2))
+        print(indented(document))
     else:
         print(
             f"{recording.path}: {counted(recording.n_steps + 1, 'step')}, "
@@ -336,7 +336,7 @@ def _cmd_compare(args: argparse.Namespace) -> int:
             raise UsageError(f"compare: N and M must differ (both are {args.n})")
         findings = compare(recording, args.n, args.m)
     if args.json:
-        print(json.dumps(findings.to_json(), indent=2))
+        print(indented(findings.to_json()))
     else:
         print(findings.to_text())
     return 0

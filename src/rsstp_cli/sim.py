@@ -24,6 +24,7 @@ from rsstp_cli._commandline import (
     run_command,
     warning_line,
 )
+from rsstp_cli._json import indented
 from rsstp_sim import graph
 from rsstp_sim.bodies import body_of
 from rsstp_sim.errors import RecordingWriteError
@@ -271,7 +272,7 @@ def _cmd_truth(args: argparse.Namespace) -> int:
 
     if args.cache_info:
         info = cache_info()
-        print(json.dumps(info.to_json(), indent=2) if args.json else info.to_text())
+        print(indented(info.to_json()) if args.json else info.to_text())
         return 0
     if args.scenario is None:
         raise UsageError("truth: name a scenario (or ask for --cache-info)")
@@ -279,7 +280,7 @@ def _cmd_truth(args: argparse.Namespace) -> int:
     _warn_about(scenario)
     truth = load_truth(scenario, cache=not args.no_cache, max_poses=args.max_poses)
     if args.json:
-        print(json.dumps(truth.to_json(), indent=2))
+        print(indented(truth.to_json()))
     else:
         print(format_truth(truth))
     return 0
